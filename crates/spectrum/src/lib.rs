@@ -1,0 +1,1 @@
+//! Spectra (placeholder while the crate is written).

@@ -1,0 +1,116 @@
+//! Spectrace's project automation, run as `cargo xtask <command>` (a cargo alias in
+//! `.cargo/config.toml`). It has no dependencies and one function per subcommand.
+//!
+//! Commands today:
+//! - `cargo xtask` / `cargo xtask status`: what Spectrace contains so far and how to use it.
+//! - `cargo xtask bench`: runs every crate's benchmarks in release mode.
+//! - `cargo xtask ci`: runs the same checks as `.ci/run` (tests, rustfmt, clippy).
+//!
+//! `cargo xtask render` arrives with the renderer (issue 5) and becomes the main command.
+
+use std::process::{Command, ExitCode};
+
+/// One workspace crate as the status page lists it.
+struct CrateInfo {
+    package: &'static str,
+    path: &'static str,
+    what: &'static str,
+}
+
+/// The crates that exist today, bottom layer first.
+const CRATES: &[CrateInfo] = &[
+    CrateInfo {
+        package: "spectrace-sampling",
+        path: "crates/sampling",
+        what: "exact inverse-CDF generators: Discrete, AliasTable, PiecewiseConstant, PiecewiseLinear",
+    },
+    CrateInfo {
+        package: "spectrace-spectrum",
+        path: "crates/spectrum",
+        what: "SPDs (tabulated, binned, blackbody, Gaussian, monochromatic, uniform, mixture, CIE \
+               illuminants), reflectance spectra, CIE 1931 XYZ and sRGB",
+    },
+];
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let command = args.first().map(String::as_str).unwrap_or("status");
+    match command {
+        "status" => status(),
+        "bench" => run_all(&[
+            &["bench", "-p", "spectrace-sampling"],
+            &["bench", "-p", "spectrace-spectrum"],
+        ]),
+        "ci" => run_all(&[
+            &["test", "--workspace"],
+            &["fmt", "--all", "--check"],
+            &["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"],
+        ]),
+        "help" | "-h" | "--help" => {
+            print_help();
+            ExitCode::SUCCESS
+        }
+        "render" => {
+            eprintln!(
+                "cargo xtask render: the renderer does not exist yet (it is issue 5: geometry, \
+                 materials, light tracer). Today Spectrace is its sampling and spectrum layers; run \
+                 `cargo xtask status` to see them."
+            );
+            ExitCode::from(2)
+        }
+        other => {
+            eprintln!("unknown command `{other}`\n");
+            print_help();
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn print_help() {
+    println!(
+        "usage: cargo xtask [COMMAND]\n\n\
+         commands:\n  \
+         status   what Spectrace contains so far (default)\n  \
+         bench    run every crate's benchmarks (release)\n  \
+         ci       run the checks CI runs: tests, rustfmt, clippy -D warnings\n  \
+         help     this text"
+    );
+}
+
+fn status() -> ExitCode {
+    println!(
+        "Spectrace: a spectral Monte Carlo renderer built around light sources as beam generators.\n"
+    );
+    println!("Crates in this workspace (bottom layer first):");
+    for c in CRATES {
+        println!("  {:<20} {:<17} {}", c.package, c.path, c.what);
+    }
+    println!(
+        "\nNot built yet: lights (issue 4), geometry/materials/tracer/renderer and `cargo xtask \
+         render` (issue 5).\n\n\
+         Run every test:         cargo test --workspace\n\
+         Run the benchmarks:     cargo xtask bench\n\
+         Example:                cargo run --release -p spectrace-spectrum --example chromaticity"
+    );
+    ExitCode::SUCCESS
+}
+
+/// Runs `cargo <args>` for each argument list in turn; stops at the first failure.
+fn run_all(commands: &[&[&str]]) -> ExitCode {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
+    for args in commands {
+        eprintln!("$ cargo {}", args.join(" "));
+        match Command::new(&cargo).args(*args).status() {
+            Ok(s) if s.success() => {}
+            Ok(s) => {
+                eprintln!("`cargo {}` failed ({s})", args.join(" "));
+                return ExitCode::FAILURE;
+            }
+            Err(e) => {
+                eprintln!("could not run cargo: {e}");
+                return ExitCode::FAILURE;
+            }
+        }
+    }
+    ExitCode::SUCCESS
+}
