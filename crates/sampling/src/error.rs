@@ -121,6 +121,36 @@ impl SamplingError {
         }
     }
 
+    /// The same error with the array renamed, for callers that expose the table under their own
+    /// field names (e.g. a spectrum's `nm` and `values` instead of `xs` and `ys`).
+    pub fn with_array(mut self, from: &'static str, to: &'static str) -> Self {
+        match &mut self {
+            Self::Empty { array }
+            | Self::TooFewPoints { array, .. }
+            | Self::NaN { array, .. }
+            | Self::Infinite { array, .. }
+            | Self::Negative { array, .. }
+            | Self::NotIncreasing { array, .. }
+            | Self::SpanOverflow { array, .. }
+            | Self::ZeroTotal { array }
+            | Self::TotalOverflow { array }
+            | Self::DensityOverflow { array, .. } => {
+                if *array == from {
+                    *array = to;
+                }
+            }
+            Self::LengthMismatch { first, second, .. } => {
+                if *first == from {
+                    *first = to;
+                }
+                if *second == from {
+                    *second = to;
+                }
+            }
+        }
+        self
+    }
+
     /// The name of the input array the error concerns.
     pub fn array(&self) -> &'static str {
         match self {

@@ -40,5 +40,5 @@ pub use alias::AliasTable;
 pub use discrete::Discrete;
 pub use error::SamplingError;
 pub use piecewise_constant::PiecewiseConstant;
-pub use piecewise_linear::PiecewiseLinear;
+pub use piecewise_linear::{PiecewiseLinear, linear_segment_inverse};
 pub use table::ONE_MINUS_EPSILON;

@@ -318,6 +318,20 @@ impl PiecewiseLinear {
     }
 }
 
+/// Inverts the CDF of one linear segment: given end densities `a`, `b` (non-negative, not both
+/// zero) and a fraction `s` in `[0, 1]` of the segment's mass, returns the position `t` in `[0, 1]`
+/// with `a t + (b - a) t^2 / 2 = s (a + b) / 2`. Cancellation-free, no division by the slope, and
+/// non-decreasing in `s` (the in-segment step of [`PiecewiseLinear::sample`]).
+///
+/// Useful as the first guess of an inverse-CDF sampler for a smooth density tabulated on a grid.
+pub fn linear_segment_inverse(a: f64, b: f64, s: f64) -> f64 {
+    let m = a.max(b);
+    if !(m > 0.0 && m.is_finite()) || s.is_nan() {
+        return s.clamp(0.0, 1.0);
+    }
+    invert_linear_segment(a / m, b / m, s.clamp(0.0, 1.0))
+}
+
 /// The unnormalised density `a (1 - t) + b t` at position `t` of a segment: both terms are
 /// non-negative, and the ends are exact.
 #[inline(always)]

@@ -272,8 +272,11 @@ impl Cdf {
     /// total. Such an `i` always has positive mass.
     #[inline]
     fn search(&self, target: f64) -> usize {
-        let j = self.edges[1..].partition_point(|&c| c <= target);
-        if j < self.len() { j } else { self.last_positive }
+        // The last edge is the total and needs no comparison: landing on the last entry means
+        // either that entry (target below the total) or a target rounded up to the total.
+        let n = self.len();
+        let j = self.edges[1..n].partition_point(|&c| c <= target);
+        if j + 1 < n || target < self.total_scaled { j } else { self.last_positive }
     }
 
     /// Finds the entry that `u` (already in `[0, 1)`) falls into, with its rescaled target mass.

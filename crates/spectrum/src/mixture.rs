@@ -1,0 +1,121 @@
+//! [`Mixture`]: a weighted sum of spectra (a lamp with a phosphor continuum and lines, an LED with
+//! two emitters, ...).
+//!
+//! | type | JSON |
+//! |---|---|
+//! | `Mixture` | `{"type": "Mixture", "components": [{"weight": 0.7, "spd": {"type": "Blackbody", "kelvin": 3000}}, {"weight": 0.3, "spd": {"type": "Monochromatic", "lambda_nm": 546.1}}]}` |
+//!
+//! `weight` is the fraction of the power in each component (relative: they need not sum to 1).
+//! Each component is itself normalised, so the mixture's density is `sum(w_i value_i) / sum(w_i)`.
+
+use serde::{Deserialize, Serialize};
+use spectrace_sampling::Discrete;
+
+use crate::error::SpectrumError;
+use crate::spd::SpectralPowerDistribution;
+
+/// One component of a [`Mixture`]: a relative power weight and a spectrum.
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Component {
+    /// Relative share of the power (non-negative).
+    pub weight: f64,
+    /// The component's spectrum.
+    pub spd: Box<dyn SpectralPowerDistribution>,
+}
+
+/// A weighted sum of spectra, sampled by choosing a component in proportion to its weight and then
+/// sampling it with the same uniform, remapped.
+#[derive(Debug, Deserialize)]
+#[serde(try_from = "MixtureRepr")]
+pub struct Mixture {
+    components: Vec<Component>,
+    choice: Discrete,
+    range: (f64, f64),
+}
+
+/// Scene-file form of [`Mixture`].
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MixtureRepr {
+    components: Vec<Component>,
+}
+
+impl TryFrom<MixtureRepr> for Mixture {
+    type Error = SpectrumError;
+    fn try_from(r: MixtureRepr) -> Result<Self, SpectrumError> {
+        Self::new(r.components)
+    }
+}
+
+impl Serialize for Mixture {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let mut s = serializer.serialize_struct("Mixture", 1)?;
+        s.serialize_field("components", &self.components)?;
+        s.end()
+    }
+}
+
+impl Mixture {
+    /// Builds the mixture.
+    ///
+    /// # Errors
+    /// [`SpectrumError::EmptyMixture`] without components; [`SpectrumError::Table`] naming
+    /// `weight[i]` for a NaN, infinite or negative weight, or when all weights are zero.
+    pub fn new(components: Vec<Component>) -> Result<Self, SpectrumError> {
+        if components.is_empty() {
+            return Err(SpectrumError::EmptyMixture);
+        }
+        let weights: Vec<f64> = components.iter().map(|c| c.weight).collect();
+        let choice = Discrete::new(&weights)
+            .map_err(|e| SpectrumError::table("Mixture", &[("weights", "components.weight")], e))?;
+        let range = components
+            .iter()
+            .zip(&weights)
+            .filter(|(_, w)| **w > 0.0)
+            .map(|(c, _)| c.spd.range())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (lo, hi)| (a.min(lo), b.max(hi)));
+        Ok(Self { components, choice, range })
+    }
+
+    /// The components.
+    pub fn components(&self) -> &[Component] {
+        &self.components
+    }
+}
+
+#[typetag::serde]
+impl SpectralPowerDistribution for Mixture {
+    fn sample_lambda(&self, u: f64) -> f64 {
+        let (i, v) = self.choice.sample_remapped(crate::unit(u));
+        self.components[i].spd.sample_lambda(v)
+    }
+    fn value(&self, lambda: f64) -> f64 {
+        self.components
+            .iter()
+            .enumerate()
+            .map(|(i, c)| self.choice.pmf(i) * c.spd.value(lambda))
+            .sum()
+    }
+    fn range(&self) -> (f64, f64) {
+        self.range
+    }
+    fn integrate(&self, f: &dyn Fn(f64) -> f64) -> f64 {
+        self.components
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| self.choice.pmf(*i) > 0.0)
+            .map(|(i, c)| self.choice.pmf(i) * c.spd.integrate(f))
+            .sum()
+    }
+    fn breakpoints(&self) -> Vec<f64> {
+        self.components.iter().flat_map(|c| c.spd.breakpoints()).collect()
+    }
+    fn is_delta(&self) -> bool {
+        self.components
+            .iter()
+            .enumerate()
+            .all(|(i, c)| self.choice.pmf(i) == 0.0 || c.spd.is_delta())
+    }
+}
