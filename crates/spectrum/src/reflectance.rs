@@ -14,8 +14,7 @@ use spectrace_sampling::SamplingError;
 
 /// A spectral reflectance (or transmittance): a fraction in `[0, 1]` at each wavelength, linear
 /// between tabulated points and constant beyond the ends.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "ReflectanceRepr", into = "ReflectanceRepr")]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Reflectance {
     nm: Vec<f64>,
     values: Vec<f64>,
@@ -24,12 +23,49 @@ pub struct Reflectance {
 /// A transmittance spectrum has the same representation and rules as a reflectance.
 pub type Transmittance = Reflectance;
 
-/// Scene-file form of [`Reflectance`]: a number or a table.
+/// Scene-file form of [`Reflectance`]: a number or a table (untagged, for JSON).
 #[derive(Serialize, Deserialize)]
 #[serde(untagged)]
 enum ReflectanceRepr {
     Constant(f64),
     Table { nm: Vec<f64>, values: Vec<f64> },
+}
+
+/// Binary form of [`Reflectance`] (externally tagged: formats such as bincode are not
+/// self-describing and cannot read an untagged enum).
+#[derive(Serialize, Deserialize)]
+enum ReflectanceBinary {
+    Constant(f64),
+    Table { nm: Vec<f64>, values: Vec<f64> },
+}
+
+impl Serialize for Reflectance {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let repr = ReflectanceRepr::from(self.clone());
+        if serializer.is_human_readable() {
+            repr.serialize(serializer)
+        } else {
+            match repr {
+                ReflectanceRepr::Constant(v) => ReflectanceBinary::Constant(v),
+                ReflectanceRepr::Table { nm, values } => ReflectanceBinary::Table { nm, values },
+            }
+            .serialize(serializer)
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Reflectance {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let repr = if deserializer.is_human_readable() {
+            ReflectanceRepr::deserialize(deserializer)?
+        } else {
+            match ReflectanceBinary::deserialize(deserializer)? {
+                ReflectanceBinary::Constant(v) => ReflectanceRepr::Constant(v),
+                ReflectanceBinary::Table { nm, values } => ReflectanceRepr::Table { nm, values },
+            }
+        };
+        Self::try_from(repr).map_err(serde::de::Error::custom)
+    }
 }
 
 impl TryFrom<ReflectanceRepr> for Reflectance {
@@ -177,5 +213,19 @@ mod tests {
         assert_eq!(t.value(550.0), 0.5);
         assert_eq!(serde_json::to_string(&c).unwrap(), "0.25");
         assert!(serde_json::from_str::<Reflectance>("1.5").is_err());
+    }
+
+    #[test]
+    fn bincode_round_trip() {
+        let config = bincode::config::standard();
+        for r in [
+            Reflectance::constant(0.25).unwrap(),
+            Reflectance::from_table(&[400.0, 700.0], &[0.1, 0.9]).unwrap(),
+        ] {
+            let bytes = bincode::serde::encode_to_vec(&r, config).unwrap();
+            let (back, _): (Reflectance, usize) =
+                bincode::serde::decode_from_slice(&bytes, config).unwrap();
+            assert_eq!(back, r);
+        }
     }
 }
