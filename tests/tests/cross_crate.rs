@@ -72,3 +72,64 @@ fn third_party_spd_deserialises_beside_built_in_ones() {
     let back = serde_json::to_string(&spds).unwrap();
     assert!(back.contains(r#""type":"Sawtooth""#), "{back}");
 }
+
+// ---------------------------------------------------------------------------------------------
+// Third-party lights by serialisation
+// ---------------------------------------------------------------------------------------------
+
+// Linking the plugin crate is what makes typetag's registry see `RingLight` (see its docs).
+use spectrace_lights::{Beam, LightId, LightSet, LightSource};
+use spectrace_plugin_ring_light as _;
+
+const SCENE_LIGHTS: &str = r#"{"type": "LightSet", "lights": [
+    {"type": "RingLight", "center": [0, 2, 0], "axis": [0, 1, 0], "radius": 0.3, "power": 40,
+     "spd": {"type": "CieIlluminant", "name": "F2"}},
+    {"type": "PointLight", "position": [1, 1, 1], "power": 10, "spd": {"type": "Blackbody", "kelvin": 2700}}
+]}"#;
+
+fn first_beams(light: &dyn LightSource) -> Vec<Beam> {
+    let mut rng = Pcg64::seed_from_u64(3);
+    (0..1000).map(|_| light.next_beam(&mut rng)).collect()
+}
+
+#[test]
+fn plugin_light_loads_from_json_beside_built_in_lights() {
+    let set: Box<dyn LightSource> = serde_json::from_str(SCENE_LIGHTS).unwrap();
+    assert_eq!(set.power(), 50.0);
+    let beams = first_beams(set.as_ref());
+    let ring: Vec<&Beam> = beams.iter().filter(|b| b.parent == LightId(0)).collect();
+    assert!(
+        ring.len() > 700 && ring.len() < 900,
+        "ring share {} of 1000 (expected 800)",
+        ring.len()
+    );
+    for b in ring {
+        // Origins on the circle of radius 0.3 around (0, 2, 0) in the y = 2 plane.
+        let d = b.origin - glam::DVec3::new(0.0, 2.0, 0.0);
+        assert!((d.length() - 0.3).abs() < 1e-12 && d.y.abs() < 1e-12, "{:?}", b.origin);
+        assert!((b.direction.length() - 1.0).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn plugin_light_round_trips_through_json_and_bincode() {
+    let set: Box<dyn LightSource> = serde_json::from_str(SCENE_LIGHTS).unwrap();
+    let json = serde_json::to_string(&set).unwrap();
+    assert!(json.contains(r#""type":"RingLight""#), "{json}");
+    let again: Box<dyn LightSource> = serde_json::from_str(&json).unwrap();
+    let config = bincode::config::standard();
+    let bytes = bincode::serde::encode_to_vec(&set, config).unwrap();
+    let (binary, _): (Box<dyn LightSource>, usize) =
+        bincode::serde::decode_from_slice(&bytes, config).unwrap();
+    let reference = first_beams(set.as_ref());
+    assert_eq!(first_beams(again.as_ref()), reference);
+    assert_eq!(first_beams(binary.as_ref()), reference);
+}
+
+#[test]
+fn unknown_light_types_are_named_in_the_error() {
+    let e =
+        serde_json::from_str::<LightSet>(r#"{"lights": [{"type": "CandleLight", "power": 1}]}"#)
+            .unwrap_err();
+    assert!(e.to_string().contains("CandleLight"), "{e}");
+}

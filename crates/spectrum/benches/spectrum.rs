@@ -46,8 +46,14 @@ fn build(name: &str) -> Box<dyn SpectralPowerDistribution> {
         "Blackbody 6500 K" => Box::new(Blackbody::new(6500.0).unwrap()),
         "Mixture (blackbody + line)" => Box::new(
             Mixture::new(vec![
-                Component { weight: 0.8, spd: Box::new(Blackbody::new(3000.0).unwrap()) },
-                Component { weight: 0.2, spd: Box::new(Monochromatic::new(546.1).unwrap()) },
+                Component {
+                    weight: 0.8,
+                    spd: std::sync::Arc::new(Blackbody::new(3000.0).unwrap()),
+                },
+                Component {
+                    weight: 0.2,
+                    spd: std::sync::Arc::new(Monochromatic::new(546.1).unwrap()),
+                },
             ])
             .unwrap(),
         ),

@@ -8,6 +8,8 @@
 //! `weight` is the fraction of the power in each component (relative: they need not sum to 1).
 //! Each component is itself normalised, so the mixture's density is `sum(w_i value_i) / sum(w_i)`.
 
+use std::sync::Arc;
+
 use serde::{Deserialize, Serialize};
 use spectrace_sampling::Discrete;
 
@@ -20,8 +22,8 @@ use crate::spd::SpectralPowerDistribution;
 pub struct Component {
     /// Relative share of the power (non-negative).
     pub weight: f64,
-    /// The component's spectrum.
-    pub spd: Box<dyn SpectralPowerDistribution>,
+    /// The component's spectrum (shared: a light set builds its mixture from its lights' SPDs).
+    pub spd: Arc<dyn SpectralPowerDistribution>,
 }
 
 /// A weighted sum of spectra, sampled by choosing a component in proportion to its weight and then

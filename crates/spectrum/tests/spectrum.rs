@@ -16,8 +16,10 @@ const ALPHA: f64 = 1e-3;
 
 /// One of every SPD type, including hard parameters.
 fn zoo() -> Vec<(&'static str, Box<dyn SpectralPowerDistribution>)> {
-    let component =
-        |weight: f64, spd: Box<dyn SpectralPowerDistribution>| Component { weight, spd };
+    let component = |weight: f64, spd: Box<dyn SpectralPowerDistribution>| Component {
+        weight,
+        spd: spd.into(),
+    };
     vec![
         (
             "Tabulated irregular",
@@ -254,8 +256,8 @@ fn monochromatic_is_a_delta() {
     assert_eq!(xyz_of(&m), cmf(555.0));
     // In a mixture the line contributes its weight's share.
     let mix = Mixture::new(vec![
-        Component { weight: 1.0, spd: Box::new(m) },
-        Component { weight: 1.0, spd: Box::new(Uniform::new(400.0, 700.0).unwrap()) },
+        Component { weight: 1.0, spd: std::sync::Arc::new(m) },
+        Component { weight: 1.0, spd: std::sync::Arc::new(Uniform::new(400.0, 700.0).unwrap()) },
     ])
     .unwrap();
     let y = xyz_of(&mix).y;
@@ -319,8 +321,11 @@ fn bad_input_names_the_field() {
     assert!(e.to_string().contains("unknown CIE illuminant `D66`; known: A, D50"), "{e}");
     assert!(CieIlluminant::new("F13").is_err() && CieIlluminant::new("F02").is_err());
     assert!(matches!(Mixture::new(vec![]), Err(SpectrumError::EmptyMixture)));
-    let e = Mixture::new(vec![Component { weight: -1.0, spd: Box::new(Uniform::equal_energy()) }])
-        .unwrap_err();
+    let e = Mixture::new(vec![Component {
+        weight: -1.0,
+        spd: std::sync::Arc::new(Uniform::equal_energy()),
+    }])
+    .unwrap_err();
     assert!(e.to_string().contains("components.weight[0] is negative"), "{e}");
 }
 

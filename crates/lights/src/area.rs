@@ -1,0 +1,313 @@
+//! Lambertian area lights: [`RectangleLight`] and [`DiskLight`], one-sided by default.
+//!
+//! Every point of the surface emits the same radiance `L = power / (pi * area)` (halved when
+//! two-sided) into the hemisphere around the normal, so beams start uniformly over the surface
+//! and leave with a cosine-weighted direction. The normal of a rectangle is
+//! `normalize(edge_u x edge_v)` (right-handed); a disk gives it explicitly.
+//!
+//! | light | field | unit | default | meaning |
+//! |---|---|---|---|---|
+//! | both | `power` | W | required | total emitted power (both sides together when two-sided) |
+//! | both | `spd` | SPD | required | spectrum |
+//! | both | `two_sided` | | `false` | emit from both faces |
+//! | both | `wavelength_sampling` | | `"importance"` | `"importance"` or `"equal_wavelengths"` |
+//! | rectangle | `corner`, `edge_u`, `edge_v` | m | required | the rectangle `corner + s edge_u + t edge_v` |
+//! | disk | `center` | m | required | centre |
+//! | disk | `normal` | | required | emitting side |
+//! | disk | `radius` | m | required | > 0 |
+//!
+//! ```json
+//! {"type": "RectangleLight", "corner": [-0.25, 1.99, -0.25], "edge_u": [0.5, 0, 0],
+//!  "edge_v": [0, 0, 0.5], "power": 50, "spd": {"type": "Blackbody", "kelvin": 4000}}
+//! {"type": "DiskLight", "center": [0, 2, 0], "normal": [0, -1, 0], "radius": 0.2, "power": 20,
+//!  "spd": {"type": "CieIlluminant", "name": "F11"}, "two_sided": true}
+//! ```
+
+use std::f64::consts::PI;
+use std::sync::Arc;
+
+use glam::DVec3;
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+use spectrace_spectrum::SpectralPowerDistribution;
+
+use crate::geometry::{Frame, concentric_disk, finite_point, positive, unit_direction};
+use crate::sky::rectangle_normal;
+use crate::source::uniform;
+use crate::{Beam, LightError, LightFlags, LightSample, LightSource, SpdLight, WavelengthSampling};
+
+/// A cosine-weighted direction around `frame.n`, flipped to the back face with probability 1/2
+/// when two-sided (the choice uses the top half of `u_side`).
+fn lambertian_direction(frame: &Frame, two_sided: bool, u1: f64, u2: f64, u_side: f64) -> DVec3 {
+    // Malley's method: a uniform point on the disk lifted to the hemisphere.
+    let (x, y) = concentric_disk(u1, u2);
+    let z = (1.0 - x * x - y * y).max(0.0).sqrt();
+    let z = if two_sided && u_side >= 0.5 { -z } else { z };
+    frame.local_to_world(x, y, z).normalize()
+}
+
+/// The sample of an area light at `position` (normal `normal`, area `area`, radiance `radiance`)
+/// as seen from `receiver`.
+fn area_sample(
+    position: DVec3,
+    normal: DVec3,
+    area: f64,
+    radiance: f64,
+    two_sided: bool,
+    receiver: DVec3,
+) -> Option<LightSample> {
+    let to = receiver - position;
+    let distance = to.length();
+    if !(distance > 0.0 && distance.is_finite()) {
+        return None;
+    }
+    let direction = to / distance;
+    let cos = direction.dot(normal);
+    let cos = if two_sided { cos.abs() } else { cos.max(0.0) };
+    let pdf = if cos > 0.0 { distance * distance / (area * cos) } else { 0.0 };
+    Some(LightSample {
+        position,
+        direction,
+        distance,
+        intensity: radiance * cos * area,
+        pdf,
+        delta: false,
+    })
+}
+
+/// A Lambertian emitter on the rectangle `corner + s edge_u + t edge_v`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(try_from = "RectangleRepr", into = "RectangleRepr")]
+pub struct RectangleLight {
+    emission: SpdLight,
+    corner: DVec3,
+    edge_u: DVec3,
+    edge_v: DVec3,
+    two_sided: bool,
+    frame: Frame,
+    area: f64,
+}
+
+/// Scene-file form of [`RectangleLight`].
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RectangleRepr {
+    corner: DVec3,
+    edge_u: DVec3,
+    edge_v: DVec3,
+    power: f64,
+    spd: Arc<dyn SpectralPowerDistribution>,
+    #[serde(default)]
+    two_sided: bool,
+    #[serde(default)]
+    wavelength_sampling: WavelengthSampling,
+}
+
+impl TryFrom<RectangleRepr> for RectangleLight {
+    type Error = LightError;
+    fn try_from(r: RectangleRepr) -> Result<Self, LightError> {
+        Self::new(r.corner, r.edge_u, r.edge_v, r.power, r.spd, r.two_sided, r.wavelength_sampling)
+    }
+}
+
+impl From<RectangleLight> for RectangleRepr {
+    fn from(l: RectangleLight) -> Self {
+        Self {
+            corner: l.corner,
+            edge_u: l.edge_u,
+            edge_v: l.edge_v,
+            power: l.emission.power(),
+            spd: l.emission.spd().clone(),
+            two_sided: l.two_sided,
+            wavelength_sampling: l.emission.sampling(),
+        }
+    }
+}
+
+impl RectangleLight {
+    /// A Lambertian rectangle emitting towards `edge_u x edge_v` (both ways if `two_sided`).
+    ///
+    /// # Errors
+    /// [`LightError::Parameter`] naming `corner`, `edge_u`/`edge_v` (degenerate rectangle) or
+    /// `power`.
+    pub fn new(
+        corner: DVec3,
+        edge_u: DVec3,
+        edge_v: DVec3,
+        power: f64,
+        spd: Arc<dyn SpectralPowerDistribution>,
+        two_sided: bool,
+        wavelength_sampling: WavelengthSampling,
+    ) -> Result<Self, LightError> {
+        const L: &str = "RectangleLight";
+        let corner = finite_point(L, "corner", corner)?;
+        let normal = rectangle_normal(L, edge_u, edge_v)?;
+        let emission = SpdLight::new(L, spd, power, wavelength_sampling)?;
+        let area = edge_u.cross(edge_v).length();
+        Ok(Self { emission, corner, edge_u, edge_v, two_sided, frame: Frame::new(normal), area })
+    }
+
+    /// Emitted radiance (W m^-2 sr^-1, whole spectrum): `power / (pi * area)`, halved if two-sided.
+    pub fn radiance(&self) -> f64 {
+        self.emission.power() / (PI * self.area * if self.two_sided { 2.0 } else { 1.0 })
+    }
+
+    /// The unit normal of the emitting side.
+    pub fn normal(&self) -> DVec3 {
+        self.frame.n
+    }
+}
+
+#[typetag::serde]
+impl LightSource for RectangleLight {
+    fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
+        let (lambda, scale) = self.emission.wavelength(uniform(rng));
+        let origin = self.corner + self.edge_u * uniform(rng) + self.edge_v * uniform(rng);
+        let (u1, u2, u3) = (uniform(rng), uniform(rng), uniform(rng));
+        let direction = lambertian_direction(&self.frame, self.two_sided, u1, u2, u3);
+        self.emission.count();
+        Beam::new(origin, direction, lambda, scale)
+    }
+    fn number_of_beams(&self) -> u64 {
+        self.emission.number_of_beams()
+    }
+    fn power(&self) -> f64 {
+        self.emission.power()
+    }
+    fn spd(&self) -> Arc<dyn SpectralPowerDistribution> {
+        self.emission.spd().clone()
+    }
+    fn reset_count(&self) {
+        self.emission.reset_count();
+    }
+    fn flags(&self) -> Option<LightFlags> {
+        Some(LightFlags::default())
+    }
+    fn sample_towards(&self, receiver: DVec3, u: [f64; 2]) -> Option<LightSample> {
+        let position = self.corner + self.edge_u * u[0] + self.edge_v * u[1];
+        area_sample(position, self.frame.n, self.area, self.radiance(), self.two_sided, receiver)
+    }
+}
+
+/// A Lambertian emitter on a disk.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(try_from = "DiskRepr", into = "DiskRepr")]
+pub struct DiskLight {
+    emission: SpdLight,
+    center: DVec3,
+    normal: DVec3,
+    radius: f64,
+    two_sided: bool,
+    frame: Frame,
+}
+
+/// Scene-file form of [`DiskLight`].
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DiskRepr {
+    center: DVec3,
+    normal: DVec3,
+    radius: f64,
+    power: f64,
+    spd: Arc<dyn SpectralPowerDistribution>,
+    #[serde(default)]
+    two_sided: bool,
+    #[serde(default)]
+    wavelength_sampling: WavelengthSampling,
+}
+
+impl TryFrom<DiskRepr> for DiskLight {
+    type Error = LightError;
+    fn try_from(r: DiskRepr) -> Result<Self, LightError> {
+        Self::new(r.center, r.normal, r.radius, r.power, r.spd, r.two_sided, r.wavelength_sampling)
+    }
+}
+
+impl From<DiskLight> for DiskRepr {
+    fn from(l: DiskLight) -> Self {
+        Self {
+            center: l.center,
+            normal: l.normal,
+            radius: l.radius,
+            power: l.emission.power(),
+            spd: l.emission.spd().clone(),
+            two_sided: l.two_sided,
+            wavelength_sampling: l.emission.sampling(),
+        }
+    }
+}
+
+impl DiskLight {
+    /// A Lambertian disk of `radius` at `center` emitting towards `normal`.
+    ///
+    /// # Errors
+    /// [`LightError::Parameter`] naming `center`, `normal`, `radius` or `power`.
+    pub fn new(
+        center: DVec3,
+        normal: DVec3,
+        radius: f64,
+        power: f64,
+        spd: Arc<dyn SpectralPowerDistribution>,
+        two_sided: bool,
+        wavelength_sampling: WavelengthSampling,
+    ) -> Result<Self, LightError> {
+        const L: &str = "DiskLight";
+        let center = finite_point(L, "center", center)?;
+        let normal = unit_direction(L, "normal", normal)?;
+        let radius = positive(L, "radius", radius)?;
+        let emission = SpdLight::new(L, spd, power, wavelength_sampling)?;
+        Ok(Self { emission, center, normal, radius, two_sided, frame: Frame::new(normal) })
+    }
+
+    /// The disk's area (m^2).
+    pub fn area(&self) -> f64 {
+        PI * self.radius * self.radius
+    }
+
+    /// Emitted radiance (W m^-2 sr^-1, whole spectrum).
+    pub fn radiance(&self) -> f64 {
+        self.emission.power() / (PI * self.area() * if self.two_sided { 2.0 } else { 1.0 })
+    }
+
+    fn point(&self, u1: f64, u2: f64) -> DVec3 {
+        let (x, y) = concentric_disk(u1, u2);
+        self.center + self.frame.local_to_world(x, y, 0.0) * self.radius
+    }
+}
+
+#[typetag::serde]
+impl LightSource for DiskLight {
+    fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
+        let (lambda, scale) = self.emission.wavelength(uniform(rng));
+        let origin = self.point(uniform(rng), uniform(rng));
+        let (u1, u2, u3) = (uniform(rng), uniform(rng), uniform(rng));
+        let direction = lambertian_direction(&self.frame, self.two_sided, u1, u2, u3);
+        self.emission.count();
+        Beam::new(origin, direction, lambda, scale)
+    }
+    fn number_of_beams(&self) -> u64 {
+        self.emission.number_of_beams()
+    }
+    fn power(&self) -> f64 {
+        self.emission.power()
+    }
+    fn spd(&self) -> Arc<dyn SpectralPowerDistribution> {
+        self.emission.spd().clone()
+    }
+    fn reset_count(&self) {
+        self.emission.reset_count();
+    }
+    fn flags(&self) -> Option<LightFlags> {
+        Some(LightFlags::default())
+    }
+    fn sample_towards(&self, receiver: DVec3, u: [f64; 2]) -> Option<LightSample> {
+        area_sample(
+            self.point(u[0], u[1]),
+            self.normal,
+            self.area(),
+            self.radiance(),
+            self.two_sided,
+            receiver,
+        )
+    }
+}

@@ -1,0 +1,146 @@
+//! [`LightSet`]: the seed's LightSourceManager ("master light source", seed 3.3).
+//!
+//! ```json
+//! {"type": "LightSet", "lights": [
+//!   {"type": "PointLight", "position": [0, 2, 0], "power": 60, "spd": {"type": "Blackbody", "kelvin": 2700}},
+//!   {"type": "Laser", "position": [0, 1, 0], "direction": [1, 0, 0], "power": 0.005,
+//!    "spd": {"type": "Monochromatic", "lambda_nm": 532}}
+//! ]}
+//! ```
+
+use std::sync::Arc;
+
+use glam::DVec3;
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+use spectrace_sampling::Discrete;
+use spectrace_spectrum::{Component, Mixture, SpectralPowerDistribution};
+
+use crate::source::uniform;
+use crate::{Beam, BeamCounter, LightError, LightFlags, LightId, LightSample, LightSource};
+
+/// A set of lights that is itself a light: each beam comes from a light chosen with probability
+/// proportional to its power, and carries that light's index as its `parent`.
+///
+/// Its power is the sum of the lights' powers and its SPD their power-weighted mixture. The
+/// lights keep their own beam counts, so a beam's power can be computed from its parent
+/// (`lights()[parent].power() / lights()[parent].number_of_beams() * scale`) or, equivalently in
+/// expectation, from the set (`power() / number_of_beams() * scale`).
+#[derive(Debug, Deserialize)]
+#[serde(try_from = "LightSetRepr")]
+pub struct LightSet {
+    lights: Vec<Box<dyn LightSource>>,
+    choice: Discrete,
+    spd: Arc<dyn SpectralPowerDistribution>,
+    power: f64,
+    counter: BeamCounter,
+}
+
+/// Scene-file form of [`LightSet`].
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LightSetRepr {
+    lights: Vec<Box<dyn LightSource>>,
+}
+
+impl TryFrom<LightSetRepr> for LightSet {
+    type Error = LightError;
+    fn try_from(r: LightSetRepr) -> Result<Self, LightError> {
+        Self::new(r.lights)
+    }
+}
+
+impl Serialize for LightSet {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let mut s = serializer.serialize_struct("LightSet", 1)?;
+        s.serialize_field("lights", &self.lights)?;
+        s.end()
+    }
+}
+
+impl LightSet {
+    /// A set of lights.
+    ///
+    /// # Errors
+    /// [`LightError::EmptySet`] when there are no lights, when every light has zero power, or
+    /// when a power is not finite or the total overflows.
+    pub fn new(lights: Vec<Box<dyn LightSource>>) -> Result<Self, LightError> {
+        if lights.is_empty() {
+            return Err(LightError::EmptySet { reason: "a light set needs at least one light" });
+        }
+        let powers: Vec<f64> = lights.iter().map(|l| l.power()).collect();
+        let choice = Discrete::new(&powers).map_err(|_| LightError::EmptySet {
+            reason: "the lights' powers must be finite, >= 0, not all zero, with a finite total",
+        })?;
+        let power = choice.total();
+        let components = lights
+            .iter()
+            .zip(&powers)
+            .map(|(l, &weight)| Component { weight, spd: l.spd() })
+            .collect();
+        let spd = Arc::new(
+            Mixture::new(components)
+                .map_err(|source| LightError::Spectrum { light: "LightSet", source })?,
+        );
+        Ok(Self { lights, choice, spd, power, counter: BeamCounter::new() })
+    }
+
+    /// The lights, in `parent` order.
+    pub fn lights(&self) -> &[Box<dyn LightSource>] {
+        &self.lights
+    }
+
+    /// The light a beam came from.
+    pub fn light(&self, id: LightId) -> Option<&dyn LightSource> {
+        self.lights.get(id.0 as usize).map(|l| l.as_ref())
+    }
+
+    /// Probability that a beam comes from light `id`: its share of the total power.
+    pub fn probability(&self, id: LightId) -> f64 {
+        self.choice.pmf(id.0 as usize)
+    }
+}
+
+#[typetag::serde]
+impl LightSource for LightSet {
+    fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
+        let i = self.choice.sample(uniform(rng));
+        let mut beam = self.lights[i].next_beam(rng);
+        beam.parent = LightId(i as u32);
+        self.counter.increment();
+        beam
+    }
+    fn number_of_beams(&self) -> u64 {
+        self.counter.total()
+    }
+    fn power(&self) -> f64 {
+        self.power
+    }
+    fn spd(&self) -> Arc<dyn SpectralPowerDistribution> {
+        self.spd.clone()
+    }
+    fn reset_count(&self) {
+        self.counter.reset();
+        for l in &self.lights {
+            l.reset_count();
+        }
+    }
+    fn flags(&self) -> Option<LightFlags> {
+        // The set is a delta in a dimension only if every light is.
+        let all: Option<Vec<LightFlags>> = self.lights.iter().map(|l| l.flags()).collect();
+        all.map(|f| LightFlags {
+            delta_position: f.iter().all(|x| x.delta_position),
+            delta_direction: f.iter().all(|x| x.delta_direction),
+        })
+    }
+    fn sample_towards(&self, receiver: DVec3, u: [f64; 2]) -> Option<LightSample> {
+        // Choose a light by power with the first uniform, remapped to drive the light's own choice.
+        let (i, remapped) = self.choice.sample_remapped(u[0]);
+        let p = self.choice.pmf(i);
+        let mut s = self.lights[i].sample_towards(receiver, [remapped, u[1]])?;
+        s.intensity /= p;
+        s.pdf *= p;
+        Some(s)
+    }
+}

@@ -1,0 +1,159 @@
+//! [`Sky`]: parallel beams over a rectangle, the seed's "array of lasers" (seed 2.4.2).
+//!
+//! The rectangle is `corner + s * edge_u + t * edge_v` for `s, t` in `[0, 1]`: beams start
+//! uniformly over it and all travel along `direction`. (The seed's corners A and B are
+//! `corner` and `corner + edge_u + edge_v`; two edge vectors make the orientation explicit.)
+//!
+//! | field | unit | default | meaning |
+//! |---|---|---|---|
+//! | `corner` | m | required | one corner of the rectangle |
+//! | `edge_u`, `edge_v` | m | required | the two edges from `corner`; must span a rectangle (not parallel, not zero) |
+//! | `direction` | | required | direction of every beam; must not lie in the rectangle's plane |
+//! | `power` | W | required | total power through the rectangle |
+//! | `spd` | SPD | required | spectrum, e.g. `{"type": "CieIlluminant", "name": "D65"}` |
+//! | `wavelength_sampling` | | `"importance"` | `"importance"` or `"equal_wavelengths"` |
+//!
+//! ```json
+//! {"type": "Sky", "corner": [-1, 2, -1], "edge_u": [2, 0, 0], "edge_v": [0, 0, 2],
+//!  "direction": [0, -1, 0], "power": 10, "spd": {"type": "CieIlluminant", "name": "D65"}}
+//! ```
+
+use std::sync::Arc;
+
+use glam::DVec3;
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+use spectrace_spectrum::SpectralPowerDistribution;
+
+use crate::geometry::{finite_point, unit_direction};
+use crate::source::uniform;
+use crate::{Beam, LightError, LightFlags, LightSource, SpdLight, WavelengthSampling};
+
+/// Parallel beams starting uniformly over a rectangle.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(try_from = "SkyRepr", into = "SkyRepr")]
+pub struct Sky {
+    emission: SpdLight,
+    corner: DVec3,
+    edge_u: DVec3,
+    edge_v: DVec3,
+    direction: DVec3,
+}
+
+/// Scene-file form of [`Sky`].
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SkyRepr {
+    corner: DVec3,
+    edge_u: DVec3,
+    edge_v: DVec3,
+    direction: DVec3,
+    power: f64,
+    spd: Arc<dyn SpectralPowerDistribution>,
+    #[serde(default)]
+    wavelength_sampling: WavelengthSampling,
+}
+
+impl TryFrom<SkyRepr> for Sky {
+    type Error = LightError;
+    fn try_from(r: SkyRepr) -> Result<Self, LightError> {
+        Self::new(r.corner, r.edge_u, r.edge_v, r.direction, r.power, r.spd, r.wavelength_sampling)
+    }
+}
+
+impl From<Sky> for SkyRepr {
+    fn from(s: Sky) -> Self {
+        Self {
+            corner: s.corner,
+            edge_u: s.edge_u,
+            edge_v: s.edge_v,
+            direction: s.direction,
+            power: s.emission.power(),
+            spd: s.emission.spd().clone(),
+            wavelength_sampling: s.emission.sampling(),
+        }
+    }
+}
+
+/// Checks that two edges span a parallelogram of non-zero area; returns its unit normal.
+pub(crate) fn rectangle_normal(
+    light: &'static str,
+    edge_u: DVec3,
+    edge_v: DVec3,
+) -> Result<DVec3, LightError> {
+    finite_point(light, "edge_u", edge_u)?;
+    finite_point(light, "edge_v", edge_v)?;
+    let cross = edge_u.cross(edge_v);
+    let scale = edge_u.length() * edge_v.length();
+    if !(scale > 0.0) || !(cross.length() > 1e-12 * scale) || !cross.is_finite() {
+        return Err(LightError::parameter(
+            light,
+            "edge_v",
+            edge_v.to_array(),
+            "edge_u and edge_v must be non-zero and not parallel (the rectangle is degenerate)",
+        ));
+    }
+    Ok(cross.normalize())
+}
+
+impl Sky {
+    /// Parallel beams along `direction` from the rectangle `corner + s edge_u + t edge_v`.
+    ///
+    /// # Errors
+    /// [`LightError::Parameter`] naming `corner`, `edge_u`/`edge_v` (degenerate rectangle),
+    /// `direction` (zero, or lying in the rectangle's plane) or `power`.
+    pub fn new(
+        corner: DVec3,
+        edge_u: DVec3,
+        edge_v: DVec3,
+        direction: DVec3,
+        power: f64,
+        spd: Arc<dyn SpectralPowerDistribution>,
+        wavelength_sampling: WavelengthSampling,
+    ) -> Result<Self, LightError> {
+        const L: &str = "Sky";
+        let corner = finite_point(L, "corner", corner)?;
+        let normal = rectangle_normal(L, edge_u, edge_v)?;
+        let direction = unit_direction(L, "direction", direction)?;
+        if direction.dot(normal).abs() < 1e-9 {
+            return Err(LightError::parameter(
+                L,
+                "direction",
+                direction.to_array(),
+                "lies in the rectangle's plane, so no beam would cross it",
+            ));
+        }
+        let emission = SpdLight::new(L, spd, power, wavelength_sampling)?;
+        Ok(Self { emission, corner, edge_u, edge_v, direction })
+    }
+
+    /// Where `(s, t)` in the unit square lands on the rectangle.
+    pub fn point(&self, s: f64, t: f64) -> DVec3 {
+        self.corner + self.edge_u * s + self.edge_v * t
+    }
+}
+
+#[typetag::serde]
+impl LightSource for Sky {
+    fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
+        let (lambda, scale) = self.emission.wavelength(uniform(rng));
+        let origin = self.point(uniform(rng), uniform(rng));
+        self.emission.count();
+        Beam::new(origin, self.direction, lambda, scale)
+    }
+    fn number_of_beams(&self) -> u64 {
+        self.emission.number_of_beams()
+    }
+    fn power(&self) -> f64 {
+        self.emission.power()
+    }
+    fn spd(&self) -> Arc<dyn SpectralPowerDistribution> {
+        self.emission.spd().clone()
+    }
+    fn reset_count(&self) {
+        self.emission.reset_count();
+    }
+    fn flags(&self) -> Option<LightFlags> {
+        Some(LightFlags { delta_position: false, delta_direction: true })
+    }
+}

@@ -1,0 +1,211 @@
+//! The [`LightSource`] trait (seed section 2), the records its optional methods return, and
+//! [`SpdLight`], the seed's `spdLightSource` that every built-in light builds on.
+
+use std::fmt::Debug;
+use std::sync::Arc;
+
+use glam::DVec3;
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+use spectrace_spectrum::{SpectralPowerDistribution, integrate_panels};
+
+use crate::{Beam, BeamCounter, LightError};
+
+/// A light source as a beam generator (seed section 2).
+///
+/// A light gives out beams ([`next_beam`](Self::next_beam)) and counts them
+/// ([`number_of_beams`](Self::number_of_beams)); a beam's power is
+/// `power() / number_of_beams() * beam.scale`. Counting must be exact and cheap from many threads
+/// at once ([`BeamCounter`] does that for the built-in lights).
+///
+/// The trait is typetag-serialisable: a scene file names any light by its type,
+/// `{"type": "Laser", ...}`, and a crate that depends on `spectrace-lights` alone can add a light
+/// type that the renderer then accepts from scene files (see the crate README).
+///
+/// Methods that bidirectional rendering needs (sampling the light towards a point, emission
+/// densities, delta flags) are *default methods*: a light that implements only the seed's four
+/// methods keeps working with the light tracer, and [`LightSource::sample_towards`] /
+/// [`LightSource::flags`] report that it offers nothing more.
+#[typetag::serde(tag = "type")]
+pub trait LightSource: Send + Sync + Debug {
+    /// Emits the next beam: origin, unit direction, a wavelength from the light's SPD, a weight,
+    /// `level` 0. Counts it.
+    fn next_beam(&self, rng: &mut dyn Rng) -> Beam;
+
+    /// How many beams this light has emitted so far.
+    fn number_of_beams(&self) -> u64;
+
+    /// Total emitted power (W).
+    fn power(&self) -> f64;
+
+    /// The normalised spectral power distribution of the emitted light.
+    fn spd(&self) -> Arc<dyn SpectralPowerDistribution>;
+
+    /// Sets the beam count back to zero, before emitting for a new image. The default does
+    /// nothing (for lights that do not count).
+    fn reset_count(&self) {}
+
+    /// What kind of light this is, for integrators that need to know (delta position or
+    /// direction). `None` (the default) means the light does not say, and only the light tracer
+    /// can use it.
+    fn flags(&self) -> Option<LightFlags> {
+        None
+    }
+
+    /// Samples the light as seen from `receiver` (for connecting a surface point to the light):
+    /// a point on the light, the direction from it towards the receiver, the radiant intensity
+    /// that way, and the density of the choice. `None` (the default) when the light cannot be
+    /// sampled this way (parallel beams, or a light that implements only the seed's methods).
+    fn sample_towards(&self, receiver: DVec3, u: [f64; 2]) -> Option<LightSample> {
+        let _ = (receiver, u);
+        None
+    }
+}
+
+/// Which dimensions of a light's emission are Dirac deltas.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct LightFlags {
+    /// All beams start at one point (point and spot lights, lasers).
+    pub delta_position: bool,
+    /// All beams share one direction (lasers, sky).
+    pub delta_direction: bool,
+}
+
+/// A sample of a light as seen from a receiving point (see [`LightSource::sample_towards`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightSample {
+    /// The point on the light.
+    pub position: DVec3,
+    /// Unit direction from `position` towards the receiver.
+    pub direction: DVec3,
+    /// Distance from `position` to the receiver (m).
+    pub distance: f64,
+    /// Radiant intensity towards the receiver (W/sr, whole spectrum: multiply by
+    /// `spd().value(lambda)` for W/sr/nm), already divided by the density of the sampled point
+    /// for area lights (`L cos(theta_light) * area`), so that for every light
+    /// `intensity * cos(theta_receiver) / distance^2` is an unbiased estimate of the irradiance
+    /// the light gives the receiver.
+    pub intensity: f64,
+    /// Density of having chosen this sample, in solid angle at the receiver (for multiple
+    /// importance sampling); 1 for a delta position.
+    pub pdf: f64,
+    /// `true` if the sample is a delta (point and spot lights).
+    pub delta: bool,
+}
+
+/// How a light gives its beams their wavelengths (seed 2.2 and 2.2.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WavelengthSampling {
+    /// `lambda` drawn from the normalised SPD, `scale` 1 (seed 2.2). The default.
+    #[default]
+    Importance,
+    /// `lambda` uniform over the SPD's range, `scale = value(lambda) * (max - min)` (seed 2.2.2):
+    /// every wavelength equally often, weighted by the spectrum.
+    EqualWavelengths,
+}
+
+/// The seed's `spdLightSource`: an SPD, a power, how wavelengths are drawn, and the beam count.
+/// Every built-in light embeds one.
+#[derive(Debug, Clone)]
+pub struct SpdLight {
+    spd: Arc<dyn SpectralPowerDistribution>,
+    power: f64,
+    sampling: WavelengthSampling,
+    counter: BeamCounter,
+}
+
+impl SpdLight {
+    /// An emitter of `power` watts with spectrum `spd`. `light` names the light type in errors.
+    ///
+    /// # Errors
+    /// [`LightError::Parameter`] for a power that is negative, NaN or infinite;
+    /// [`LightError::Spectrum`] when `EqualWavelengths` is asked of an SPD with delta lines (they
+    /// have no density to weight by: use `Importance`).
+    pub fn new(
+        light: &'static str,
+        spd: Arc<dyn SpectralPowerDistribution>,
+        power: f64,
+        sampling: WavelengthSampling,
+    ) -> Result<Self, LightError> {
+        if !(power >= 0.0 && power.is_finite()) {
+            return Err(LightError::parameter(
+                light,
+                "power",
+                power,
+                "must be finite and >= 0 (watts)",
+            ));
+        }
+        if sampling == WavelengthSampling::EqualWavelengths {
+            let (lo, hi) = spd.range();
+            if hi > lo {
+                let density_mass = integrate_panels(&|l| spd.value(l), lo, hi, &spd.breakpoints());
+                if (density_mass - 1.0).abs() > 1e-6 {
+                    return Err(LightError::parameter(
+                        light,
+                        "wavelength_sampling",
+                        "equal_wavelengths",
+                        "needs an SPD without delta lines (its density integrates to less than 1); use \"importance\"",
+                    ));
+                }
+            }
+        }
+        Ok(Self { spd, power, sampling, counter: BeamCounter::new() })
+    }
+
+    /// Draws a wavelength (nm) and the beam's `scale` from a uniform `u` in `[0, 1)`, according
+    /// to the light's [`WavelengthSampling`]. A pure line spectrum always gives its line with
+    /// scale 1.
+    #[inline]
+    pub fn wavelength(&self, u: f64) -> (f64, f64) {
+        match self.sampling {
+            WavelengthSampling::Importance => (self.spd.sample_lambda(u), 1.0),
+            WavelengthSampling::EqualWavelengths => {
+                let (lo, hi) = self.spd.range();
+                if hi > lo {
+                    let lambda = (lo + u * (hi - lo)).min(hi);
+                    (lambda, self.spd.value(lambda) * (hi - lo))
+                } else {
+                    (self.spd.sample_lambda(u), 1.0)
+                }
+            }
+        }
+    }
+
+    /// Counts one emitted beam.
+    #[inline]
+    pub fn count(&self) {
+        self.counter.increment();
+    }
+
+    /// Beams emitted so far.
+    pub fn number_of_beams(&self) -> u64 {
+        self.counter.total()
+    }
+
+    /// Sets the beam count to zero.
+    pub fn reset_count(&self) {
+        self.counter.reset();
+    }
+
+    /// Emitted power (W).
+    pub fn power(&self) -> f64 {
+        self.power
+    }
+
+    /// The spectrum.
+    pub fn spd(&self) -> &Arc<dyn SpectralPowerDistribution> {
+        &self.spd
+    }
+
+    /// How wavelengths are drawn.
+    pub fn sampling(&self) -> WavelengthSampling {
+        self.sampling
+    }
+}
+
+/// Draws a uniform in `[0, 1)` from a generator (53 random bits).
+#[inline]
+pub(crate) fn uniform(rng: &mut dyn Rng) -> f64 {
+    (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+}
