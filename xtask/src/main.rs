@@ -30,6 +30,12 @@ const CRATES: &[CrateInfo] = &[
         what: "SPDs (tabulated, binned, blackbody, Gaussian, monochromatic, uniform, mixture, CIE \
                illuminants), reflectance spectra, CIE 1931 XYZ and sRGB",
     },
+    CrateInfo {
+        package: "spectrace-lights",
+        path: "crates/lights",
+        what: "LightSource trait, Beam, Laser, Sky, uniform/fading spots, point, rectangle and disk \
+               lights, LightSet; third-party lights by typetag",
+    },
 ];
 
 fn main() -> ExitCode {
@@ -86,11 +92,12 @@ fn status() -> ExitCode {
         println!("  {:<20} {:<17} {}", c.package, c.path, c.what);
     }
     println!(
-        "\nNot built yet: lights (issue 4), geometry/materials/tracer/renderer and `cargo xtask \
+        "\nNot built yet: geometry, materials, the light tracer, the renderer and `cargo xtask \
          render` (issue 5).\n\n\
          Run every test:         cargo test --workspace\n\
          Run the benchmarks:     cargo xtask bench\n\
-         Example:                cargo run --release -p spectrace-spectrum --example chromaticity"
+         Examples:               cargo run --release -p spectrace-spectrum --example chromaticity\n\
+         \x20                       cargo run -p spectrace-lights --example beams -- '<light JSON>'"
     );
     ExitCode::SUCCESS
 }

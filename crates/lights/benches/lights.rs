@@ -23,6 +23,9 @@ fn main() {
 }
 
 const BATCH: usize = 1000;
+/// Increments per iteration in the counter benchmarks: long enough (~0.3 ms) that the threads'
+/// loops overlap, so contention shows.
+const COUNT_BATCH: usize = 100_000;
 const THREADS: [usize; 2] = [1, 2];
 
 thread_local! {
@@ -97,8 +100,8 @@ fn next_beam(bencher: Bencher<'_, '_>, name: &str) {
 #[divan::bench(threads = THREADS)]
 fn count_sharded(bencher: Bencher<'_, '_>) {
     let counter = BeamCounter::new();
-    bencher.counter(ItemsCount::new(BATCH)).bench(|| {
-        for _ in 0..BATCH {
+    bencher.counter(ItemsCount::new(COUNT_BATCH)).bench(|| {
+        for _ in 0..COUNT_BATCH {
             counter.increment();
         }
     });
@@ -108,8 +111,8 @@ fn count_sharded(bencher: Bencher<'_, '_>) {
 #[divan::bench(threads = THREADS)]
 fn count_one_shared_atomic(bencher: Bencher<'_, '_>) {
     let counter = AtomicU64::new(0);
-    bencher.counter(ItemsCount::new(BATCH)).bench(|| {
-        for _ in 0..BATCH {
+    bencher.counter(ItemsCount::new(COUNT_BATCH)).bench(|| {
+        for _ in 0..COUNT_BATCH {
             counter.fetch_add(1, Ordering::Relaxed);
         }
     });
