@@ -110,18 +110,7 @@ impl LightSource for Laser {
         self.emission.count();
         Beam::new(origin, self.direction, lambda, scale)
     }
-    fn number_of_beams(&self) -> u64 {
-        self.emission.number_of_beams()
-    }
-    fn power(&self) -> f64 {
-        self.emission.power()
-    }
-    fn spd(&self) -> Arc<dyn SpectralPowerDistribution> {
-        self.emission.spd().clone()
-    }
-    fn reset_count(&self) {
-        self.emission.reset_count();
-    }
+    crate::delegate_to_spd_light!(emission);
     fn flags(&self) -> Option<LightFlags> {
         Some(LightFlags { delta_position: self.beam_radius == 0.0, delta_direction: true })
     }

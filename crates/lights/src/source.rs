@@ -209,3 +209,31 @@ impl SpdLight {
 pub(crate) fn uniform(rng: &mut dyn Rng) -> f64 {
     (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
+
+/// Implements the counting, power and spectrum methods of [`LightSource`] by delegating to an
+/// [`SpdLight`] field, inside an `impl LightSource for ...` block:
+///
+/// ```ignore
+/// #[typetag::serde]
+/// impl LightSource for MyLight {
+///     fn next_beam(&self, rng: &mut dyn rand::Rng) -> Beam { ... }
+///     spectrace_lights::delegate_to_spd_light!(emission);
+/// }
+/// ```
+#[macro_export]
+macro_rules! delegate_to_spd_light {
+    ($field:ident) => {
+        fn number_of_beams(&self) -> u64 {
+            self.$field.number_of_beams()
+        }
+        fn power(&self) -> f64 {
+            self.$field.power()
+        }
+        fn spd(&self) -> ::std::sync::Arc<dyn $crate::spectrum::SpectralPowerDistribution> {
+            self.$field.spd().clone()
+        }
+        fn reset_count(&self) {
+            self.$field.reset_count();
+        }
+    };
+}

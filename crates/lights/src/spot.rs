@@ -177,18 +177,7 @@ impl LightSource for UniformSpotLight {
         self.emission.count();
         Beam::new(self.position, direction, lambda, scale)
     }
-    fn number_of_beams(&self) -> u64 {
-        self.emission.number_of_beams()
-    }
-    fn power(&self) -> f64 {
-        self.emission.power()
-    }
-    fn spd(&self) -> Arc<dyn SpectralPowerDistribution> {
-        self.emission.spd().clone()
-    }
-    fn reset_count(&self) {
-        self.emission.reset_count();
-    }
+    crate::delegate_to_spd_light!(emission);
     fn flags(&self) -> Option<LightFlags> {
         Some(LightFlags { delta_position: true, delta_direction: false })
     }
@@ -364,18 +353,7 @@ impl LightSource for FadingSpotLight {
         self.emission.count();
         Beam::new(self.position, direction, lambda, scale)
     }
-    fn number_of_beams(&self) -> u64 {
-        self.emission.number_of_beams()
-    }
-    fn power(&self) -> f64 {
-        self.emission.power()
-    }
-    fn spd(&self) -> Arc<dyn SpectralPowerDistribution> {
-        self.emission.spd().clone()
-    }
-    fn reset_count(&self) {
-        self.emission.reset_count();
-    }
+    crate::delegate_to_spd_light!(emission);
     fn flags(&self) -> Option<LightFlags> {
         Some(LightFlags { delta_position: true, delta_direction: false })
     }
@@ -458,18 +436,7 @@ impl LightSource for PointLight {
         self.emission.count();
         Beam::new(self.position, direction, lambda, scale)
     }
-    fn number_of_beams(&self) -> u64 {
-        self.emission.number_of_beams()
-    }
-    fn power(&self) -> f64 {
-        self.emission.power()
-    }
-    fn spd(&self) -> Arc<dyn SpectralPowerDistribution> {
-        self.emission.spd().clone()
-    }
-    fn reset_count(&self) {
-        self.emission.reset_count();
-    }
+    crate::delegate_to_spd_light!(emission);
     fn flags(&self) -> Option<LightFlags> {
         Some(LightFlags { delta_position: true, delta_direction: false })
     }

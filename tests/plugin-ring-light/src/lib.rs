@@ -122,16 +122,5 @@ impl LightSource for RingLight {
         self.emission.count();
         Beam::new(origin, direction, lambda, scale)
     }
-    fn number_of_beams(&self) -> u64 {
-        self.emission.number_of_beams()
-    }
-    fn power(&self) -> f64 {
-        self.emission.power()
-    }
-    fn spd(&self) -> Arc<dyn SpectralPowerDistribution> {
-        self.emission.spd().clone()
-    }
-    fn reset_count(&self) {
-        self.emission.reset_count();
-    }
+    spectrace_lights::delegate_to_spd_light!(emission);
 }
