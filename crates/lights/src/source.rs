@@ -213,7 +213,7 @@ pub(crate) fn uniform(rng: &mut dyn Rng) -> f64 {
 /// Implements the counting, power and spectrum methods of [`LightSource`] by delegating to an
 /// [`SpdLight`] field, inside an `impl LightSource for ...` block:
 ///
-/// ```ignore
+/// ```text
 /// #[typetag::serde]
 /// impl LightSource for MyLight {
 ///     fn next_beam(&self, rng: &mut dyn rand::Rng) -> Beam { ... }

@@ -1,0 +1,1 @@
+//! Rays, shapes and the BVH of Spectrace (being written).
