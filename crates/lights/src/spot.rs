@@ -302,11 +302,23 @@ impl FadingSpotLight {
         let theta = PiecewiseLinear::new(&thetas, &density).map_err(|_| {
             LightError::parameter(L, "cone_angle", cone_angle, "the cone is too narrow to tabulate")
         })?;
-        // Closed form of the integral of I(theta) sin(theta) over the cone (profile 1 at centre):
-        // (1 - cos tf) + k (sin tf - sin tc + (tc - tf) cos tf), with k = 1 / (tc - tf).
+        // Integral of I(theta) sin(theta) over the cone (profile 1 at the centre): the core is
+        // 1 - cos tf = 2 sin^2(tf / 2); the ring's closed form cancels catastrophically for
+        // narrow fades, so it is integrated by 8-point Gauss-Legendre on 8 panels (the
+        // integrand is smooth, so this is exact to rounding).
         let half = tf / 2.0;
-        let z = 2.0 * half.sin() * half.sin()
-            + (tf.sin() - tc.sin() + (tc - tf) * tf.cos()) / (tc - tf);
+        let ring_integrand = |t: f64| (tc - t) / (tc - tf) * t.sin();
+        let panel = (tc - tf) / 8.0;
+        let ring: f64 = (0..8)
+            .map(|k| {
+                gauss_legendre_8(
+                    &ring_integrand,
+                    tf + panel * k as f64,
+                    tf + panel * (k + 1) as f64,
+                )
+            })
+            .sum();
+        let z = 2.0 * half.sin() * half.sin() + ring;
         let peak_intensity = power / (TAU * z);
         Ok(Self {
             emission,
@@ -362,6 +374,18 @@ impl LightSource for FadingSpotLight {
             self.peak_intensity * self.profile(c.clamp(-1.0, 1.0).acos().to_degrees())
         })
     }
+}
+
+/// Integrates `f` over `[a, b]` with 8-point Gauss-Legendre quadrature (exact to degree 15).
+fn gauss_legendre_8(f: &dyn Fn(f64) -> f64, a: f64, b: f64) -> f64 {
+    const NODES: [(f64, f64); 4] = [
+        (0.183_434_642_495_649_8, 0.362_683_783_378_362),
+        (0.525_532_409_916_329, 0.313_706_645_877_887_3),
+        (0.796_666_477_413_626_7, 0.222_381_034_453_374_5),
+        (0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
+    ];
+    let (mid, half) = ((a + b) / 2.0, (b - a) / 2.0);
+    half * NODES.iter().map(|&(x, w)| w * (f(mid - half * x) + f(mid + half * x))).sum::<f64>()
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -322,6 +322,53 @@ fn fading_spot_tabulation_matches_the_stated_intensity() {
 }
 
 #[test]
+fn fading_spot_power_normalisation_matches_the_closed_form_and_survives_narrow_fades() {
+    // Wide fade: the quadrature agrees with the closed form (1 - cos tf) + k (sin tf - sin tc +
+    // (tc - tf) cos tf), k = 1 / (tc - tf).
+    let spot = FadingSpotLight::new(
+        DVec3::ZERO,
+        DVec3::Z,
+        50.0,
+        0.05,
+        2.0,
+        d65(),
+        WavelengthSampling::Importance,
+    )
+    .unwrap();
+    let (tc, tf) = (50f64.to_radians(), 30f64.to_radians());
+    let z = (1.0 - tf.cos()) + (tf.sin() - tc.sin() + (tc - tf) * tf.cos()) / (tc - tf);
+    assert!((spot.peak_intensity() / (2.0 / (2.0 * PI * z)) - 1.0).abs() < 1e-12);
+    // A fade of 1e-6 degrees on a 1e-4 degree cone: still finite, positive, and equal to a
+    // uniform spot of the same cone to first order.
+    let narrow = FadingSpotLight::new(
+        DVec3::ZERO,
+        DVec3::Z,
+        1e-4,
+        1e6,
+        1.0,
+        d65(),
+        WavelengthSampling::Importance,
+    )
+    .unwrap();
+    let uniform = UniformSpotLight::new(
+        DVec3::ZERO,
+        DVec3::Z,
+        1e-4,
+        1.0,
+        d65(),
+        WavelengthSampling::Importance,
+    )
+    .unwrap();
+    assert!(narrow.peak_intensity().is_finite() && narrow.peak_intensity() > 0.0);
+    assert!(
+        (narrow.peak_intensity() / uniform.intensity() - 1.0).abs() < 0.03,
+        "{} vs {}",
+        narrow.peak_intensity(),
+        uniform.intensity()
+    );
+}
+
+#[test]
 fn point_light_is_uniform_on_the_sphere() {
     let light = PointLight::new(DVec3::ZERO, 1.0, d65(), WavelengthSampling::Importance).unwrap();
     let mut rng = Pcg64::seed_from_u64(12);
