@@ -245,7 +245,7 @@ mod tests {
             one.add_spectral(x, y, l, w);
         }
         let mut parts =
-            vec![Film::new(8, 5).unwrap(), Film::new(8, 5).unwrap(), Film::new(8, 5).unwrap()];
+            [Film::new(8, 5).unwrap(), Film::new(8, 5).unwrap(), Film::new(8, 5).unwrap()];
         for (k, &(x, y, l, w)) in contributions.iter().enumerate() {
             parts[k % 3].add_spectral(x, y, l, w);
         }
