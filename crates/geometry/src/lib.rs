@@ -1,1 +1,54 @@
-//! Rays, shapes and the BVH of Spectrace (being written).
+//! Rays, shapes and the BVH of Spectrace: where does a beam next meet a surface?
+//!
+//! The tracer asks one question of geometry, millions of times: given a [`Ray`], what is the
+//! nearest [`Hit`] in a [`World`] (and, for shadow rays, is anything in the way)? A hit carries
+//! the point, the geometric normal (on the shape's outward side), a shading normal, surface
+//! coordinates `uv`, the index of the shape it belongs to, and a conservative bound on the
+//! floating-point error of its point. Shapes come from scene files as tagged JSON (see
+//! [`Shape`]): [`Sphere`], [`Rectangle`], [`Disk`], open [`Cylinder`], [`Torus`], triangle
+//! [`Mesh`]es (inline or OBJ through `tobj`) and the glass [`Prism`], each with an optional
+//! [`Transform`] written row-major or as scale/rotate/translate.
+//!
+//! The key design decision is robustness by error bounds rather than epsilons. All ray and shape
+//! arithmetic is f64; each intersection routine is written to avoid cancellation (the vector form
+//! of the ray/sphere discriminant, Woop's watertight triangle test, root isolation instead of a
+//! closed-form quartic for the torus) and re-projects its hit onto the surface, so the error of
+//! the point is small and known. [`Hit::spawn_ray`] then offsets the next ray's origin just past
+//! that error along the normal, so a bounce never re-hits its own surface at `t ~ 0`, at the
+//! origin or `1e5` m away, without a scene-dependent epsilon. The BVH is `obvhs`'s, built from f32
+//! boxes rounded outwards from the exact f64 bounds; traversal is done here in f64, so the BVH can
+//! only cost time, never a hit.
+//!
+//! Layering: this crate depends on none of Spectrace's crates.
+
+mod bounds;
+mod cylinder;
+mod disk;
+mod error;
+mod float;
+mod mesh;
+mod prism;
+mod ray;
+mod rectangle;
+mod shape;
+mod sphere;
+mod torus;
+mod transform;
+mod world;
+
+pub use bounds::Bounds;
+pub use cylinder::Cylinder;
+pub use disk::Disk;
+pub use error::GeometryError;
+pub use mesh::Mesh;
+pub use prism::Prism;
+pub use ray::{Hit, Ray};
+pub use rectangle::Rectangle;
+pub use shape::Shape;
+pub use sphere::Sphere;
+pub use torus::Torus;
+pub use transform::Transform;
+pub use world::World;
+
+/// Vectors and matrices (`DVec3`, `DMat4`), re-exported so callers use the same `glam`.
+pub use glam;

@@ -46,6 +46,13 @@ fn lambertian_direction(frame: &Frame, two_sided: bool, u1: f64, u2: f64, u_side
     frame.local_to_world(x, y, z).normalize()
 }
 
+/// Solid-angle density of a Lambertian emitter's directions: `cos / pi` on the emitting side,
+/// `|cos| / (2 pi)` when two-sided.
+fn lambertian_density(normal: DVec3, two_sided: bool, direction: DVec3) -> f64 {
+    let c = direction.dot(normal);
+    if two_sided { c.abs() / (2.0 * PI) } else { c.max(0.0) / PI }
+}
+
 /// The sample of an area light at `position` (normal `normal`, area `area`, radiance `radiance`)
 /// as seen from `receiver`.
 fn area_sample(
@@ -172,6 +179,9 @@ impl LightSource for RectangleLight {
     fn flags(&self) -> Option<LightFlags> {
         Some(LightFlags::default())
     }
+    fn emission_density(&self, _origin: DVec3, direction: DVec3) -> f64 {
+        lambertian_density(self.frame.n, self.two_sided, direction)
+    }
     fn sample_towards(&self, receiver: DVec3, u: [f64; 2]) -> Option<LightSample> {
         let position = self.corner + self.edge_u * u[0] + self.edge_v * u[1];
         area_sample(position, self.frame.n, self.area, self.radiance(), self.two_sided, receiver)
@@ -277,6 +287,9 @@ impl LightSource for DiskLight {
     crate::delegate_to_spd_light!(emission);
     fn flags(&self) -> Option<LightFlags> {
         Some(LightFlags::default())
+    }
+    fn emission_density(&self, _origin: DVec3, direction: DVec3) -> f64 {
+        lambertian_density(self.normal, self.two_sided, direction)
     }
     fn sample_towards(&self, receiver: DVec3, u: [f64; 2]) -> Option<LightSample> {
         area_sample(

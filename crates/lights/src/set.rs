@@ -134,6 +134,10 @@ impl LightSource for LightSet {
             delta_direction: f.iter().all(|x| x.delta_direction),
         })
     }
+    fn emission_density(&self, _origin: DVec3, _direction: DVec3) -> f64 {
+        // A set's beams come from different lights: ask the beam's own light (its `parent`).
+        0.0
+    }
     fn sample_towards(&self, receiver: DVec3, u: [f64; 2]) -> Option<LightSample> {
         // Choose a light by power with the first uniform, remapped to drive the light's own choice.
         let (i, remapped) = self.choice.sample_remapped(u[0]);

@@ -52,6 +52,17 @@ pub trait LightSource: Send + Sync + Debug {
         None
     }
 
+    /// Solid-angle density (sr^-1) of the directions of the beams this light emits from
+    /// `origin` (a beam's starting point) towards `direction` (unit): the radiant intensity
+    /// of one beam's share of the power that way is `beam power * emission_density`. The light
+    /// tracer uses it to connect emission points to the camera, so that lights seen directly
+    /// appear in the image. The default, 0, means the light is never seen directly (right for
+    /// parallel beams, whose direction is a delta).
+    fn emission_density(&self, origin: DVec3, direction: DVec3) -> f64 {
+        let _ = (origin, direction);
+        0.0
+    }
+
     /// Samples the light as seen from `receiver` (for connecting a surface point to the light):
     /// a point on the light, the direction from it towards the receiver, the radiant intensity
     /// that way, and the density of the choice. `None` (the default) when the light cannot be

@@ -181,6 +181,13 @@ impl LightSource for UniformSpotLight {
     fn flags(&self) -> Option<LightFlags> {
         Some(LightFlags { delta_position: true, delta_direction: false })
     }
+    fn emission_density(&self, _origin: DVec3, direction: DVec3) -> f64 {
+        if direction.dot(self.direction) >= self.cos_cone() {
+            1.0 / (TAU * self.one_minus_cos)
+        } else {
+            0.0
+        }
+    }
     fn sample_towards(&self, receiver: DVec3, _u: [f64; 2]) -> Option<LightSample> {
         let (cos_cone, i) = (self.cos_cone(), self.intensity());
         point_sample(
@@ -369,6 +376,14 @@ impl LightSource for FadingSpotLight {
     fn flags(&self) -> Option<LightFlags> {
         Some(LightFlags { delta_position: true, delta_direction: false })
     }
+    fn emission_density(&self, _origin: DVec3, direction: DVec3) -> f64 {
+        let theta = direction.dot(self.direction).clamp(-1.0, 1.0).acos().to_degrees();
+        if self.emission.power() > 0.0 {
+            self.peak_intensity * self.profile(theta) / self.emission.power()
+        } else {
+            0.0
+        }
+    }
     fn sample_towards(&self, receiver: DVec3, _u: [f64; 2]) -> Option<LightSample> {
         point_sample(self.position, self.direction, receiver, |c| {
             self.peak_intensity * self.profile(c.clamp(-1.0, 1.0).acos().to_degrees())
@@ -463,6 +478,9 @@ impl LightSource for PointLight {
     crate::delegate_to_spd_light!(emission);
     fn flags(&self) -> Option<LightFlags> {
         Some(LightFlags { delta_position: true, delta_direction: false })
+    }
+    fn emission_density(&self, _origin: DVec3, _direction: DVec3) -> f64 {
+        1.0 / (4.0 * PI)
     }
     fn sample_towards(&self, receiver: DVec3, _u: [f64; 2]) -> Option<LightSample> {
         let i = self.intensity();

@@ -685,6 +685,97 @@ fn bad_lights_are_rejected_with_the_field_named() {
 }
 
 #[test]
+fn emission_densities_integrate_to_one() {
+    // Over the sphere of directions, each light's emission density integrates to 1 (midpoint rule
+    // on a fine grid in cos(theta) and phi around +z); the direction tests above check that the
+    // beams follow the same shapes.
+    let lights: Vec<(&str, Box<dyn LightSource>)> = vec![
+        (
+            "point",
+            Box::new(
+                PointLight::new(DVec3::ZERO, 1.0, d65(), WavelengthSampling::Importance).unwrap(),
+            ),
+        ),
+        (
+            "uniform spot",
+            Box::new(
+                UniformSpotLight::new(
+                    DVec3::ZERO,
+                    DVec3::Z,
+                    35.0,
+                    1.0,
+                    d65(),
+                    WavelengthSampling::Importance,
+                )
+                .unwrap(),
+            ),
+        ),
+        (
+            "fading spot",
+            Box::new(
+                FadingSpotLight::new(
+                    DVec3::ZERO,
+                    DVec3::Z,
+                    35.0,
+                    0.1,
+                    1.0,
+                    d65(),
+                    WavelengthSampling::Importance,
+                )
+                .unwrap(),
+            ),
+        ),
+        (
+            "rectangle",
+            Box::new(
+                RectangleLight::new(
+                    DVec3::ZERO,
+                    DVec3::X,
+                    DVec3::Y,
+                    1.0,
+                    d65(),
+                    false,
+                    WavelengthSampling::Importance,
+                )
+                .unwrap(),
+            ),
+        ),
+        (
+            "disk two-sided",
+            Box::new(
+                DiskLight::new(
+                    DVec3::ZERO,
+                    DVec3::Z,
+                    1.0,
+                    1.0,
+                    d65(),
+                    true,
+                    WavelengthSampling::Importance,
+                )
+                .unwrap(),
+            ),
+        ),
+    ];
+    let (nc, np) = (2000, 64);
+    for (name, light) in &lights {
+        let mut total = 0.0;
+        for i in 0..nc {
+            let c = -1.0 + 2.0 * (i as f64 + 0.5) / nc as f64;
+            let s = (1.0 - c * c).sqrt();
+            for j in 0..np {
+                let phi = 2.0 * PI * (j as f64 + 0.5) / np as f64;
+                total += light.emission_density(DVec3::ZERO, v(s * phi.cos(), s * phi.sin(), c));
+            }
+        }
+        total *= (2.0 / nc as f64) * (2.0 * PI / np as f64);
+        assert!((total - 1.0).abs() < 2e-3, "{name}: density integrates to {total}");
+    }
+    let laser =
+        Laser::new(DVec3::ZERO, DVec3::X, 1.0, d65(), 0.0, WavelengthSampling::Importance).unwrap();
+    assert_eq!(laser.emission_density(DVec3::ZERO, DVec3::X), 0.0);
+}
+
+#[test]
 fn sample_towards_gives_the_closed_form_irradiance() {
     // E = I cos / r^2 for point lights; for an area light, the mean of intensity cos / r^2 over
     // its samples converges to the closed form of a disk seen on-axis: E = L pi R^2 / (R^2 + h^2).

@@ -1,1 +1,64 @@
-//! Materials of Spectrace (being written).
+//! Materials for Spectrace: what a surface does to a beam (the seed's material function, 3.5).
+//!
+//! A beam arriving at a surface ([`Incoming`]: direction of travel, the outward shading normal,
+//! the wavelength) either leaves it as a new beam ([`Scattered`]: a unit direction, a factor for
+//! the beam's weight, the kind of lobe and its density) or is absorbed (`None`). That is the
+//! [`Material`] trait's [`scatter`](Material::scatter); bidirectional rendering adds
+//! [`eval`](Material::eval) (the BSDF, for connecting a surface to the camera) and
+//! [`pdf`](Material::pdf), and the effects analysis asks [`is_specular`](Material::is_specular)
+//! and [`is_dispersive`](Material::is_dispersive). The trait is typetag-serialisable, so scene
+//! files name a material by type and other crates can add their own.
+//!
+//! | material | what it does | lobes |
+//! |---|---|---|
+//! | [`Diffuse`] | Lambertian, spectral reflectance, two-sided | one, cosine-sampled |
+//! | [`Mirror`] | perfect reflection, spectral reflectance, two-sided | one delta |
+//! | [`Dielectric`] | Fresnel reflection + Snell refraction, total internal reflection, dispersion | two deltas |
+//!
+//! The key design decision is that every property is a function of wavelength, evaluated per
+//! beam: reflectances are [`Reflectance`](spectrace_spectrum::Reflectance) spectra and indices of
+//! refraction are [`Ior`] laws (constant, Sellmeier, Cauchy, tabulated, or a named glass from
+//! the [`GLASSES`] catalog with its published coefficients), so an object's colour and a prism's
+//! spread come out of the light's spectrum rather than out of RGB. Samplers take explicit
+//! uniforms and return weights that are already `f |cos| / pdf` (the reflectance for a diffuse
+//! or mirror bounce, 1 or the transmittance for a dielectric), which is what the light tracer
+//! multiplies a beam's `scale` by. Beams carry flux: refraction applies no `(n_t/n_i)^2`
+//! radiance scaling unless asked for with [`Transport::Radiance`]. Every material and index is
+//! validated when built and when deserialised; a bad field is a [`MaterialError`] that names it
+//! (`Dielectric.ior.sellmeier.c[2] = ...`), never a panic.
+//!
+//! # Example
+//! ```
+//! use spectrace_materials::{Dielectric, Incoming, Material, glam::DVec3};
+//! let glass = Dielectric::glass("BK7").unwrap();
+//! let beam = Incoming { direction: DVec3::new(0.0, -1.0, 0.0), normal: DVec3::Y, lambda: 550.0 };
+//! // Normal incidence: 4.2 % is reflected, so u[0] = 0.5 refracts straight through.
+//! let out = glass.scatter(&beam, [0.5, 0.0, 0.0]).unwrap();
+//! assert_eq!(out.weight, 1.0);
+//! assert!((out.direction - DVec3::new(0.0, -1.0, 0.0)).length() < 1e-12);
+//! assert!(glass.is_specular() && glass.is_dispersive());
+//! ```
+
+mod dielectric;
+mod diffuse;
+mod error;
+mod frame;
+mod fresnel;
+mod glass;
+mod ior;
+mod material;
+mod mirror;
+
+pub use dielectric::Dielectric;
+pub use diffuse::Diffuse;
+pub use error::MaterialError;
+pub use fresnel::{Polarised, fresnel_dielectric, fresnel_dielectric_polarised, reflect, refract};
+pub use glass::{GLASSES, Glass, find_glass, known_glasses};
+pub use ior::{FRAUNHOFER_C_NM, FRAUNHOFER_D_NM, FRAUNHOFER_F_NM, Ior, VALID_MAX_NM, VALID_MIN_NM};
+pub use material::{Incoming, Material, ScatterKind, Scattered, Transport};
+pub use mirror::Mirror;
+
+/// Vectors (`DVec3`), re-exported so users need no direct dependency.
+pub use glam;
+/// Spectra (reflectance, transmittance), re-exported.
+pub use spectrace_spectrum as spectrum;

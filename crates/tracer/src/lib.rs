@@ -7,7 +7,15 @@
 //! film with the importance a light-tracing connection needs. The light tracer joins them next.
 
 mod camera;
+mod effects;
 mod film;
+mod light_tracer;
+mod render;
 
 pub use camera::{CameraError, CameraRepr, FovAxis, PinholeCamera, Projection};
+pub use effects::{BUNDLE, Effects, EffectsMode, SceneFeatures};
 pub use film::{ExactSum, Film, FilmError};
+pub use light_tracer::{
+    LightTracerScene, LightTracerSettings, TraceStats, chunk_rng, image_scale, trace_chunk,
+};
+pub use render::{DEFAULT_CHUNK_BEAMS, RenderOutput, RenderPlan, render};

@@ -1,0 +1,108 @@
+//! Floating-point helpers: error bounds (`gamma`), outward rounding, validation, frames.
+
+use glam::DVec3;
+
+use crate::GeometryError;
+
+/// Unit roundoff of f64 (half an ulp of 1).
+const MACHINE_EPSILON: f64 = f64::EPSILON * 0.5;
+
+/// Higham's bound `n u / (1 - n u)` on the relative error of `n` chained floating-point operations.
+pub(crate) fn gamma(n: u32) -> f64 {
+    let nu = f64::from(n) * MACHINE_EPSILON;
+    nu / (1.0 - nu)
+}
+
+/// A finite point, or an error naming the field.
+pub(crate) fn finite_point(
+    shape: &'static str,
+    field: &'static str,
+    p: DVec3,
+) -> Result<DVec3, GeometryError> {
+    if p.is_finite() {
+        Ok(p)
+    } else {
+        Err(GeometryError::parameter(shape, field, p, "must be finite"))
+    }
+}
+
+/// A unit vector along `v`, or an error naming the field when `v` is zero or not finite.
+pub(crate) fn unit_direction(
+    shape: &'static str,
+    field: &'static str,
+    v: DVec3,
+) -> Result<DVec3, GeometryError> {
+    let len = v.length();
+    if v.is_finite() && len > 0.0 && len.is_finite() {
+        Ok(v / len)
+    } else {
+        Err(GeometryError::parameter(shape, field, v, "must be finite and non-zero"))
+    }
+}
+
+/// A finite value `> 0`, or an error naming the field.
+pub(crate) fn positive(
+    shape: &'static str,
+    field: &'static str,
+    x: f64,
+) -> Result<f64, GeometryError> {
+    if x > 0.0 && x.is_finite() {
+        Ok(x)
+    } else {
+        Err(GeometryError::parameter(shape, field, x, "must be finite and > 0"))
+    }
+}
+
+/// An orthonormal, right-handed frame `(u, v, n)` with `u x v = n`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Frame {
+    /// First tangent.
+    pub(crate) u: DVec3,
+    /// Second tangent.
+    pub(crate) v: DVec3,
+    /// The frame's axis.
+    pub(crate) n: DVec3,
+}
+
+impl Frame {
+    /// A frame around the unit vector `n` (Duff et al. 2017, branchless ONB).
+    pub(crate) fn new(n: DVec3) -> Self {
+        let sign = 1.0_f64.copysign(n.z);
+        let a = -1.0 / (sign + n.z);
+        let b = n.x * n.y * a;
+        let u = DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+        let v = DVec3::new(b, sign + n.y * n.y * a, -n.y);
+        Self { u, v, n }
+    }
+
+    /// A frame from a unit axis and a preferred first tangent (Gram-Schmidt; falls back to
+    /// [`Frame::new`] when the tangent is parallel to the axis).
+    pub(crate) fn with_tangent(n: DVec3, tangent: DVec3) -> Self {
+        let t = tangent - n * tangent.dot(n);
+        let len = t.length();
+        if len > 1e-9 && len.is_finite() {
+            let u = t / len;
+            Self { u, v: n.cross(u), n }
+        } else {
+            Self::new(n)
+        }
+    }
+
+    /// World vector to local coordinates.
+    pub(crate) fn local(self, w: DVec3) -> DVec3 {
+        DVec3::new(w.dot(self.u), w.dot(self.v), w.dot(self.n))
+    }
+
+    /// Local coordinates to a world vector.
+    pub(crate) fn world(self, l: DVec3) -> DVec3 {
+        self.u * l.x + self.v * l.y + self.n * l.z
+    }
+}
+
+/// The stable roots `t0 <= t1` of `a t^2 + 2 b t + c = 0` given the reduced discriminant
+/// `disc = b^2 - a c >= 0` computed by the caller (in a cancellation-free form).
+pub(crate) fn stable_quadratic_roots(a: f64, b: f64, c: f64, disc: f64) -> (f64, f64) {
+    let q = -(b + b.signum() * disc.sqrt());
+    let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (c / q, q / a) };
+    if t0 <= t1 { (t0, t1) } else { (t1, t0) }
+}

@@ -1,0 +1,408 @@
+//! [`Mesh`]: triangle meshes, inline or loaded from Wavefront OBJ (through `tobj`).
+//!
+//! | field | unit | default | meaning |
+//! |---|---|---|---|
+//! | `obj` | path | none | OBJ file, relative to the base directory the caller passes ([`crate::World::with_base_dir`]); polygons are triangulated, normals and texture coordinates kept when present |
+//! | `positions` | m, `[[x, y, z], ...]` | none | inline vertices (instead of `obj`) |
+//! | `triangles` | `[[i, j, k], ...]` | required with `positions` | 0-based vertex indices, counter-clockwise seen from the outward side |
+//! | `normals` | `[[x, y, z], ...]` | none | per-vertex shading normals (inline only; as many as `positions`) |
+//! | `uvs` | `[[u, v], ...]` | none | per-vertex texture coordinates (inline only; as many as `positions`) |
+//! | `transform` | [`Transform`] | none | any affine transform; a mirroring transform reverses the winding so outward stays outward |
+//!
+//! ```json
+//! {"type": "Mesh", "obj": "models/bunny.obj", "transform": {"scale": 0.1}}
+//! {"type": "Mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "triangles": [[0, 1, 2]]}
+//! ```
+//!
+//! Geometric normal: `normalize((p1 - p0) x (p2 - p0))`. `uv`: interpolated `uvs` when present,
+//! else the barycentric coordinates `(b1, b2)`. Each triangle is one BVH primitive.
+//!
+//! Robustness: the watertight ray/triangle test of Woop, Benthin and Wald (2013) in f64 —
+//! vertices are translated to the ray origin, permuted so the ray's largest direction component
+//! is `z`, sheared, and the three edge functions decide inside/outside with a consistent rule for
+//! exact zeros, so a ray through a shared edge or vertex hits at least one of the triangles
+//! sharing it. The `t > 0` test is made conservative with pbrt's bound on `t`'s rounding error,
+//! and the point `b0 p0 + b1 p1 + b2 p2` carries the error `gamma(7) sum |b_i p_i|`.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::{DVec2, DVec3};
+use serde::{Deserialize, Serialize};
+
+use crate::float::gamma;
+use crate::shape::Primitives;
+use crate::{Bounds, GeometryError, Hit, Ray, Transform};
+
+/// The world-space data of a loaded mesh.
+#[derive(Debug, Clone, PartialEq)]
+struct MeshData {
+    positions: Vec<DVec3>,
+    triangles: Vec<[u32; 3]>,
+    normals: Option<Vec<DVec3>>,
+    uvs: Option<Vec<DVec2>>,
+}
+
+/// A triangle mesh. One given by an OBJ path is loaded by [`Mesh::load`] (or
+/// [`crate::World::with_base_dir`]), since the path is relative to the scene file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "MeshRepr", into = "MeshRepr")]
+pub struct Mesh {
+    data: Option<Arc<MeshData>>,
+    repr: Box<MeshRepr>,
+}
+
+/// Scene-file form of [`Mesh`].
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MeshRepr {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    obj: Option<PathBuf>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    positions: Option<Vec<DVec3>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    triangles: Option<Vec<[u32; 3]>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    normals: Option<Vec<DVec3>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    uvs: Option<Vec<DVec2>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    transform: Option<Transform>,
+}
+
+impl TryFrom<MeshRepr> for Mesh {
+    type Error = GeometryError;
+    fn try_from(r: MeshRepr) -> Result<Self, GeometryError> {
+        const S: &str = "Mesh";
+        match (&r.obj, &r.positions, &r.triangles) {
+            (Some(path), None, None) => {
+                if r.normals.is_some() || r.uvs.is_some() {
+                    return Err(GeometryError::parameter(
+                        S,
+                        "normals",
+                        path,
+                        "normals/uvs are inline only; an OBJ file brings its own",
+                    ));
+                }
+                Ok(Self { data: None, repr: Box::new(r) })
+            }
+            (None, Some(p), Some(t)) => {
+                let data = build(
+                    p.clone(),
+                    t.clone(),
+                    r.normals.clone(),
+                    r.uvs.clone(),
+                    r.transform.as_ref(),
+                )?;
+                Ok(Self { data: Some(Arc::new(data)), repr: Box::new(r) })
+            }
+            (None, Some(_), None) => {
+                Err(GeometryError::parameter(S, "triangles", "missing", "required with positions"))
+            }
+            (None, None, _) => Err(GeometryError::parameter(
+                S,
+                "positions",
+                "missing",
+                "give either obj or positions and triangles",
+            )),
+            (Some(path), _, _) => Err(GeometryError::parameter(
+                S,
+                "obj",
+                path,
+                "give either obj or positions/triangles, not both",
+            )),
+        }
+    }
+}
+
+impl From<Mesh> for MeshRepr {
+    fn from(m: Mesh) -> Self {
+        *m.repr
+    }
+}
+
+/// Validates and transforms mesh data.
+fn build(
+    positions: Vec<DVec3>,
+    mut triangles: Vec<[u32; 3]>,
+    normals: Option<Vec<DVec3>>,
+    uvs: Option<Vec<DVec2>>,
+    transform: Option<&Transform>,
+) -> Result<MeshData, GeometryError> {
+    const S: &str = "Mesh";
+    if triangles.is_empty() {
+        return Err(GeometryError::parameter(S, "triangles", "[]", "must not be empty"));
+    }
+    if let Some((i, p)) = positions.iter().enumerate().find(|(_, p)| !p.is_finite()) {
+        return Err(GeometryError::parameter(S, "positions", (i, p), "must be finite"));
+    }
+    let count = positions.len();
+    for (triangle, tri) in triangles.iter().enumerate() {
+        if let Some(&index) = tri.iter().find(|&&i| i as usize >= count) {
+            return Err(GeometryError::IndexOutOfRange { triangle, index, count });
+        }
+    }
+    if let Some(n) = &normals {
+        if n.len() != count {
+            return Err(GeometryError::parameter(S, "normals", n.len(), "one per position"));
+        }
+        if let Some((i, v)) = n.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(GeometryError::parameter(S, "normals", (i, v), "must be finite"));
+        }
+    }
+    if let Some(uv) = &uvs
+        && uv.len() != count
+    {
+        return Err(GeometryError::parameter(S, "uvs", uv.len(), "one per position"));
+    }
+    let t = transform.copied().unwrap_or_default();
+    let positions: Vec<DVec3> = positions.into_iter().map(|p| t.point(p)).collect();
+    if positions.iter().any(|p| !p.is_finite()) {
+        return Err(GeometryError::parameter(S, "transform", t.to_rows(), "overflows positions"));
+    }
+    let normals = normals.map(|n| n.into_iter().map(|v| t.normal(v).normalize_or_zero()).collect());
+    if t.flips_orientation() {
+        for tri in &mut triangles {
+            tri.swap(1, 2);
+        }
+    }
+    Ok(MeshData { positions, triangles, normals, uvs })
+}
+
+/// Reads an OBJ file into mesh data (all models merged).
+fn read_obj(path: &Path, transform: Option<&Transform>) -> Result<MeshData, GeometryError> {
+    let err = |reason: String| GeometryError::Obj { path: path.to_path_buf(), reason };
+    let (models, _materials) =
+        tobj::load_obj(path, &tobj::GPU_LOAD_OPTIONS).map_err(|e| err(e.to_string()))?;
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    let mut normals = Some(Vec::new());
+    let mut uvs = Some(Vec::new());
+    for model in &models {
+        let m = &model.mesh;
+        let base = u32::try_from(positions.len()).map_err(|_| err("too many vertices".into()))?;
+        let n = m.positions.len() / 3;
+        positions.extend(
+            m.positions
+                .chunks_exact(3)
+                .map(|c| DVec3::new(f64::from(c[0]), f64::from(c[1]), f64::from(c[2]))),
+        );
+        normals = normals.filter(|_| m.normals.len() == 3 * n).map(|mut v| {
+            v.extend(
+                m.normals
+                    .chunks_exact(3)
+                    .map(|c| DVec3::new(f64::from(c[0]), f64::from(c[1]), f64::from(c[2]))),
+            );
+            v
+        });
+        uvs = uvs.filter(|_| m.texcoords.len() == 2 * n).map(|mut v| {
+            v.extend(
+                m.texcoords.chunks_exact(2).map(|c| DVec2::new(f64::from(c[0]), f64::from(c[1]))),
+            );
+            v
+        });
+        triangles
+            .extend(m.indices.chunks_exact(3).map(|c| [c[0] + base, c[1] + base, c[2] + base]));
+    }
+    if triangles.is_empty() {
+        return Err(err("no triangles".into()));
+    }
+    build(positions, triangles, normals, uvs, transform)
+}
+
+impl Mesh {
+    /// A mesh from world-space positions and counter-clockwise triangles.
+    ///
+    /// # Errors
+    /// [`GeometryError::IndexOutOfRange`] naming the triangle and index, or
+    /// [`GeometryError::Parameter`] naming `positions` or `triangles`.
+    pub fn from_triangles(
+        positions: Vec<DVec3>,
+        triangles: Vec<[u32; 3]>,
+    ) -> Result<Self, GeometryError> {
+        MeshRepr { positions: Some(positions), triangles: Some(triangles), ..Default::default() }
+            .try_into()
+    }
+
+    /// A mesh to be read from the OBJ file `path` (relative paths resolve against the base
+    /// directory given to [`Mesh::load`]); not loaded yet.
+    pub fn from_obj(path: impl Into<PathBuf>, transform: Option<Transform>) -> Self {
+        Self {
+            data: None,
+            repr: Box::new(MeshRepr { obj: Some(path.into()), transform, ..Default::default() }),
+        }
+    }
+
+    /// This mesh with `transform` applied after its own (an OBJ mesh must be reloaded).
+    ///
+    /// # Errors
+    /// As [`Mesh::from_triangles`].
+    pub fn transformed(&self, transform: &Transform) -> Result<Self, GeometryError> {
+        let t = self.repr.transform.map_or(*transform, |own| own.then(transform));
+        MeshRepr { transform: Some(t), ..(*self.repr).clone() }.try_into()
+    }
+
+    /// Reads the OBJ file (if this mesh names one and is not yet loaded), resolving a relative
+    /// path against `base_dir`.
+    ///
+    /// # Errors
+    /// [`GeometryError::Obj`] if the file cannot be read or has no triangles, or the validation
+    /// errors of [`Mesh::from_triangles`].
+    pub fn load(&mut self, base_dir: &Path) -> Result<(), GeometryError> {
+        if self.data.is_some() {
+            return Ok(());
+        }
+        if let Some(obj) = &self.repr.obj {
+            let path = base_dir.join(obj);
+            self.data = Some(Arc::new(read_obj(&path, self.repr.transform.as_ref())?));
+        }
+        Ok(())
+    }
+
+    /// Whether the triangles are available (inline, or an OBJ already loaded).
+    pub fn is_loaded(&self) -> bool {
+        self.data.is_some()
+    }
+
+    /// The OBJ path, if the mesh comes from a file.
+    pub fn obj_path(&self) -> Option<&Path> {
+        self.repr.obj.as_deref()
+    }
+
+    /// World-space vertex positions (empty until loaded).
+    pub fn positions(&self) -> &[DVec3] {
+        self.data.as_ref().map_or(&[], |d| &d.positions)
+    }
+
+    /// Vertex indices of each triangle (empty until loaded).
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        self.data.as_ref().map_or(&[], |d| &d.triangles)
+    }
+
+    /// The three vertices of triangle `index`.
+    fn vertices(d: &MeshData, index: u32) -> ([u32; 3], [DVec3; 3]) {
+        let tri = d.triangles[index as usize];
+        (tri, tri.map(|i| d.positions[i as usize]))
+    }
+}
+
+/// The watertight ray/triangle test: `(t, [b0, b1, b2])` with `0 < t < t_max`.
+pub(crate) fn intersect_triangle(p: [DVec3; 3], ray: &Ray, t_max: f64) -> Option<(f64, [f64; 3])> {
+    let d = ray.direction;
+    let ad = d.abs();
+    let kz = if ad.x > ad.y {
+        if ad.x > ad.z { 0 } else { 2 }
+    } else if ad.y > ad.z {
+        1
+    } else {
+        2
+    };
+    let kx = (kz + 1) % 3;
+    let ky = (kx + 1) % 3;
+    let perm = |v: DVec3| DVec3::new(v[kx], v[ky], v[kz]);
+    let d = perm(d);
+    let mut q = p.map(|v| perm(v - ray.origin));
+    let sx = -d.x / d.z;
+    let sy = -d.y / d.z;
+    let sz = 1.0 / d.z;
+    for v in &mut q {
+        v.x += sx * v.z;
+        v.y += sy * v.z;
+    }
+    let e0 = q[1].x * q[2].y - q[1].y * q[2].x;
+    let e1 = q[2].x * q[0].y - q[2].y * q[0].x;
+    let e2 = q[0].x * q[1].y - q[0].y * q[1].x;
+    if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
+        return None;
+    }
+    let det = e0 + e1 + e2;
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    for v in &mut q {
+        v.z *= sz;
+    }
+    let t_scaled = e0 * q[0].z + e1 * q[1].z + e2 * q[2].z;
+    if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
+        return None;
+    }
+    if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
+        return None;
+    }
+    let inv_det = 1.0 / det;
+    let b = [e0 * inv_det, e1 * inv_det, e2 * inv_det];
+    let t = t_scaled * inv_det;
+    // Conservative t > 0 (pbrt-v3, section 3.9.6).
+    let max_z = q.iter().map(|v| v.z.abs()).fold(0.0, f64::max);
+    let max_x = q.iter().map(|v| v.x.abs()).fold(0.0, f64::max);
+    let max_y = q.iter().map(|v| v.y.abs()).fold(0.0, f64::max);
+    let delta_z = gamma(3) * max_z;
+    let delta_x = gamma(5) * (max_x + max_z);
+    let delta_y = gamma(5) * (max_y + max_z);
+    let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+    let max_e = e0.abs().max(e1.abs()).max(e2.abs());
+    let delta_t =
+        3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv_det.abs();
+    if !(t > delta_t && t < t_max) {
+        return None;
+    }
+    Some((t, b))
+}
+
+impl Primitives for Mesh {
+    fn count(&self) -> usize {
+        self.triangles().len()
+    }
+
+    fn bounds(&self, index: u32) -> Bounds {
+        match &self.data {
+            Some(d) => Bounds::from_points(Self::vertices(d, index).1),
+            None => Bounds::EMPTY,
+        }
+    }
+
+    fn intersect(&self, index: u32, ray: &Ray, t_max: f64) -> Option<Hit> {
+        let d = self.data.as_ref()?;
+        let (tri, p) = Self::vertices(d, index);
+        let (t, b) = intersect_triangle(p, ray, t_max)?;
+        let n = (p[1] - p[0]).cross(p[2] - p[0]);
+        let len = n.length();
+        if !(len > 0.0) {
+            return None;
+        }
+        let n = n / len;
+        let terms = [p[0] * b[0], p[1] * b[1], p[2] * b[2]];
+        let point = terms[0] + terms[1] + terms[2];
+        let error = (terms[0].abs() + terms[1].abs() + terms[2].abs()) * gamma(7);
+        let shading_normal = d
+            .normals
+            .as_ref()
+            .map(|ns| {
+                let s = (ns[tri[0] as usize] * b[0]
+                    + ns[tri[1] as usize] * b[1]
+                    + ns[tri[2] as usize] * b[2])
+                    .normalize_or_zero();
+                if s == DVec3::ZERO {
+                    n
+                } else if s.dot(n) < 0.0 {
+                    -s
+                } else {
+                    s
+                }
+            })
+            .unwrap_or(n);
+        let uv = d.uvs.as_ref().map_or(DVec2::new(b[1], b[2]), |uvs| {
+            uvs[tri[0] as usize] * b[0] + uvs[tri[1] as usize] * b[1] + uvs[tri[2] as usize] * b[2]
+        });
+        Some(Hit {
+            t,
+            point,
+            geometric_normal: n,
+            shading_normal,
+            uv,
+            primitive: 0,
+            triangle: index,
+            error,
+        })
+    }
+}

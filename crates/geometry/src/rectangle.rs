@@ -1,0 +1,170 @@
+//! [`Rectangle`]: the parallelogram `corner + s edge_u + t edge_v`, `s, t` in `[0, 1]`.
+//!
+//! | field | unit | default | meaning |
+//! |---|---|---|---|
+//! | `corner` | m, `[x, y, z]` | required | one corner |
+//! | `edge_u` | m, `[x, y, z]` | required | first edge from `corner` |
+//! | `edge_v` | m, `[x, y, z]` | required | second edge from `corner`; not parallel to `edge_u` (else "degenerate") |
+//! | `transform` | [`Transform`] | none | any affine transform (a parallelogram stays one) |
+//!
+//! ```json
+//! {"type": "Rectangle", "corner": [-1, 0, -1], "edge_u": [0, 0, 2], "edge_v": [2, 0, 0]}
+//! ```
+//!
+//! The edges need not be perpendicular (any parallelogram). Geometric normal:
+//! `normalize(edge_u x edge_v)` of the transformed edges (the example faces `+y`);
+//! `uv = (s, t)`.
+//!
+//! Robustness: the hit point `o + t d` is re-projected onto the plane, so its error no longer
+//! depends on `t` (grazing rays); what remains is bounded by
+//! `gamma(12) (|p| + |corner|) + gamma(6) |p - corner|` per axis.
+
+use glam::{DVec2, DVec3};
+use serde::{Deserialize, Serialize};
+
+use crate::float::{finite_point, gamma};
+use crate::shape::Primitives;
+use crate::{Bounds, GeometryError, Hit, Ray, Transform};
+
+/// A parallelogram (a rectangle when the edges are perpendicular).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RectangleRepr", into = "RectangleRepr")]
+pub struct Rectangle {
+    corner: DVec3,
+    edge_u: DVec3,
+    edge_v: DVec3,
+    normal: DVec3,
+    dual_u: DVec3,
+    dual_v: DVec3,
+    repr: Box<RectangleRepr>,
+}
+
+/// Scene-file form of [`Rectangle`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RectangleRepr {
+    corner: DVec3,
+    edge_u: DVec3,
+    edge_v: DVec3,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    transform: Option<Transform>,
+}
+
+impl TryFrom<RectangleRepr> for Rectangle {
+    type Error = GeometryError;
+    fn try_from(r: RectangleRepr) -> Result<Self, GeometryError> {
+        const S: &str = "Rectangle";
+        finite_point(S, "corner", r.corner)?;
+        finite_point(S, "edge_u", r.edge_u)?;
+        finite_point(S, "edge_v", r.edge_v)?;
+        let t = r.transform.unwrap_or_default();
+        let corner = finite_point(S, "transform", t.point(r.corner))?;
+        let edge_u = t.vector(r.edge_u);
+        let edge_v = t.vector(r.edge_v);
+        let cross = edge_u.cross(edge_v);
+        let area = cross.length();
+        let scale = edge_u.length() * edge_v.length();
+        if !(area > 1e-12 * scale) || !area.is_finite() {
+            return Err(GeometryError::parameter(
+                S,
+                "edge_v",
+                r.edge_v,
+                "degenerate: edges are zero or parallel",
+            ));
+        }
+        let c2 = cross.length_squared();
+        Ok(Self {
+            corner,
+            edge_u,
+            edge_v,
+            normal: cross / area,
+            dual_u: edge_v.cross(cross) / c2,
+            dual_v: cross.cross(edge_u) / c2,
+            repr: Box::new(r),
+        })
+    }
+}
+
+impl From<Rectangle> for RectangleRepr {
+    fn from(s: Rectangle) -> Self {
+        *s.repr
+    }
+}
+
+impl Rectangle {
+    /// The parallelogram `corner + s edge_u + t edge_v`.
+    ///
+    /// # Errors
+    /// [`GeometryError::Parameter`] naming a non-finite field, or `edge_v` when degenerate.
+    pub fn new(corner: DVec3, edge_u: DVec3, edge_v: DVec3) -> Result<Self, GeometryError> {
+        RectangleRepr { corner, edge_u, edge_v, transform: None }.try_into()
+    }
+
+    /// This rectangle with `transform` applied.
+    ///
+    /// # Errors
+    /// As [`Rectangle::new`].
+    pub fn transformed(&self, transform: &Transform) -> Result<Self, GeometryError> {
+        let t = self.repr.transform.map_or(*transform, |own| own.then(transform));
+        RectangleRepr { transform: Some(t), ..(*self.repr).clone() }.try_into()
+    }
+
+    /// Unit normal `edge_u x edge_v`, normalised.
+    pub fn normal(&self) -> DVec3 {
+        self.normal
+    }
+}
+
+/// The ray's crossing of the plane through `origin_point` with unit `normal`, in `(0, t_max)`,
+/// re-projected onto the plane: `(t, point, error)`.
+pub(crate) fn plane_hit(
+    anchor: DVec3,
+    normal: DVec3,
+    ray: &Ray,
+    t_max: f64,
+) -> Option<(f64, DVec3, DVec3)> {
+    let den = ray.direction.dot(normal);
+    if den == 0.0 {
+        return None;
+    }
+    let t = (anchor - ray.origin).dot(normal) / den;
+    if !(t > 0.0 && t < t_max) {
+        return None;
+    }
+    let p = ray.at(t);
+    let p = p - normal * (p - anchor).dot(normal);
+    let q = (p - anchor).abs().max_element();
+    let error = (p.abs() + anchor.abs()) * gamma(12) + DVec3::splat(gamma(6) * q);
+    Some((t, p, error))
+}
+
+impl Primitives for Rectangle {
+    fn count(&self) -> usize {
+        1
+    }
+
+    fn bounds(&self, _index: u32) -> Bounds {
+        let c = self.corner;
+        Bounds::from_points([c, c + self.edge_u, c + self.edge_v, c + self.edge_u + self.edge_v])
+    }
+
+    fn intersect(&self, _index: u32, ray: &Ray, t_max: f64) -> Option<Hit> {
+        let (t, point, error) = plane_hit(self.corner, self.normal, ray, t_max)?;
+        let q = point - self.corner;
+        let s = q.dot(self.dual_u);
+        let v = q.dot(self.dual_v);
+        if !((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&v)) {
+            return None;
+        }
+        Some(Hit {
+            t,
+            point,
+            geometric_normal: self.normal,
+            shading_normal: self.normal,
+            uv: DVec2::new(s, v),
+            primitive: 0,
+            triangle: 0,
+            error,
+        })
+    }
+}

@@ -1,0 +1,128 @@
+//! [`Shape`]: the scene-file union of all shapes, and the per-primitive interface the BVH uses.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::{
+    Bounds, Cylinder, Disk, GeometryError, Hit, Mesh, Prism, Ray, Rectangle, Sphere, Torus,
+    Transform,
+};
+
+/// What the world needs of a shape: its primitives (one for analytic shapes, one per triangle
+/// for meshes), their bounds, and exact f64 intersection of one of them.
+pub(crate) trait Primitives {
+    /// How many primitives.
+    fn count(&self) -> usize;
+    /// Bounds of primitive `index`.
+    fn bounds(&self, index: u32) -> Bounds;
+    /// The hit with primitive `index` in `(0, t_max)`, with `primitive = 0` (the world fills it).
+    fn intersect(&self, index: u32, ray: &Ray, t_max: f64) -> Option<Hit>;
+}
+
+/// The uniform scale of `t` if it is a similarity, else an error naming `shape.transform`.
+pub(crate) fn similarity(shape: &'static str, t: &Transform) -> Result<f64, GeometryError> {
+    t.similarity_scale().ok_or_else(|| {
+        GeometryError::parameter(
+            shape,
+            "transform",
+            t.to_rows(),
+            "must be a similarity (rotation, uniform scale, translation); use a Mesh otherwise",
+        )
+    })
+}
+
+/// Any shape, as scene files name it: `{"type": "Sphere", ...}`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type")]
+#[non_exhaustive]
+pub enum Shape {
+    /// A sphere.
+    Sphere(Sphere),
+    /// A parallelogram.
+    Rectangle(Rectangle),
+    /// A disk.
+    Disk(Disk),
+    /// An open cylinder.
+    Cylinder(Cylinder),
+    /// A ring torus.
+    Torus(Torus),
+    /// A triangle mesh.
+    Mesh(Mesh),
+    /// A triangular prism.
+    Prism(Prism),
+}
+
+macro_rules! from_shape {
+    ($($t:ident),*) => {$(
+        impl From<$t> for Shape {
+            fn from(s: $t) -> Self {
+                Shape::$t(s)
+            }
+        }
+    )*};
+}
+from_shape!(Sphere, Rectangle, Disk, Cylinder, Torus, Mesh, Prism);
+
+impl Shape {
+    /// The shape's primitives (the one place that dispatches on the variant).
+    pub(crate) fn primitives(&self) -> &dyn Primitives {
+        match self {
+            Shape::Sphere(s) => s,
+            Shape::Rectangle(s) => s,
+            Shape::Disk(s) => s,
+            Shape::Cylinder(s) => s,
+            Shape::Torus(s) => s,
+            Shape::Mesh(s) => s,
+            Shape::Prism(s) => s.mesh(),
+        }
+    }
+
+    /// The type name as in scene files.
+    pub fn type_name(&self) -> &'static str {
+        match self {
+            Shape::Sphere(_) => "Sphere",
+            Shape::Rectangle(_) => "Rectangle",
+            Shape::Disk(_) => "Disk",
+            Shape::Cylinder(_) => "Cylinder",
+            Shape::Torus(_) => "Torus",
+            Shape::Mesh(_) => "Mesh",
+            Shape::Prism(_) => "Prism",
+        }
+    }
+
+    /// Loads an OBJ mesh relative to `base_dir` (no-op for other shapes).
+    ///
+    /// # Errors
+    /// [`GeometryError::Obj`] if the file cannot be read.
+    pub fn load(&mut self, base_dir: &Path) -> Result<(), GeometryError> {
+        match self {
+            Shape::Mesh(m) => m.load(base_dir),
+            _ => Ok(()),
+        }
+    }
+
+    /// How many BVH primitives the shape contributes (triangles for meshes, else 1).
+    pub fn primitive_count(&self) -> usize {
+        self.primitives().count()
+    }
+
+    /// World-space bounds (empty for an unloaded mesh).
+    pub fn bounds(&self) -> Bounds {
+        let p = self.primitives();
+        (0..p.count() as u32).fold(Bounds::EMPTY, |b, i| b.union(p.bounds(i)))
+    }
+
+    /// The nearest hit in `(0, t_max)` by testing every primitive (no BVH), `primitive = 0`.
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<Hit> {
+        let p = self.primitives();
+        let mut best: Option<Hit> = None;
+        for i in 0..p.count() as u32 {
+            let limit = best.map_or(t_max, |h| h.t);
+            if let Some(h) = p.intersect(i, ray, limit) {
+                best = Some(h);
+            }
+        }
+        best
+    }
+}

@@ -1,0 +1,734 @@
+//! Tests of `spectrace-geometry` through its public API: accuracy far from the origin, tangent and
+//! grazing rays, watertightness, self-intersection after spawning, a closed mirror box, the torus,
+//! transforms, scene-file validation, OBJ loading, and the BVH against brute force.
+#![allow(clippy::unwrap_used)]
+
+use std::f64::consts::PI;
+
+use glam::{DMat4, DVec3};
+use proptest::prelude::*;
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg64;
+use spectrace_geometry::*;
+
+fn v(x: f64, y: f64, z: f64) -> DVec3 {
+    DVec3::new(x, y, z)
+}
+
+fn rng(seed: u64) -> Pcg64 {
+    Pcg64::seed_from_u64(seed)
+}
+
+/// A uniform random unit vector.
+fn unit(r: &mut Pcg64) -> DVec3 {
+    let z: f64 = r.random_range(-1.0..1.0);
+    let phi: f64 = r.random_range(0.0..2.0 * PI);
+    let s = (1.0 - z * z).sqrt();
+    v(s * phi.cos(), s * phi.sin(), z)
+}
+
+/// A random unit vector in the hemisphere around `n`.
+fn hemisphere(r: &mut Pcg64, n: DVec3) -> DVec3 {
+    let d = unit(r);
+    if d.dot(n) < 0.0 { -d } else { d }
+}
+
+fn reflect(d: DVec3, n: DVec3) -> DVec3 {
+    d - n * (2.0 * d.dot(n))
+}
+
+fn shape(json: &str) -> Shape {
+    serde_json::from_str(json).unwrap()
+}
+
+fn shape_err(json: &str) -> String {
+    serde_json::from_str::<Shape>(json).unwrap_err().to_string()
+}
+
+// ---------------------------------------------------------------------------------------------
+// Sphere accuracy and tangents
+
+#[test]
+fn sphere_radius_1_at_distance_1e5_hit_at_right_t() {
+    let c = v(1e5, 2e4, -3e4);
+    let world = World::new(vec![Sphere::new(c, 1.0).unwrap().into()]).unwrap();
+    let mut r = rng(1);
+    for _ in 0..2000 {
+        let origin = unit(&mut r) * r.random_range(0.0..10.0);
+        // A point on the half of the sphere facing the origin, within 60 degrees of it.
+        let towards = (origin - c).normalize();
+        let n = loop {
+            let n = unit(&mut r);
+            if n.dot(towards) > 0.5 {
+                break n;
+            }
+        };
+        let p = c + n * 1.0;
+        let t_true = (p - origin).length();
+        let ray = Ray::new(origin, p - origin);
+        let hit = world.intersect(&ray, f64::INFINITY).unwrap();
+        assert!((hit.t - t_true).abs() <= 1e-12 * t_true, "t {} vs {}", hit.t, t_true);
+        assert!((hit.point - p).length() < 1e-6);
+        assert!((hit.geometric_normal - n).length() < 1e-6);
+        assert!(hit.error.max_element() < 1e-9 && hit.error.min_element() > 0.0);
+    }
+}
+
+#[test]
+fn ray_tangent_to_sphere_is_consistent_and_finite() {
+    for c in [DVec3::ZERO, v(1e5, -1e5, 3e5)] {
+        let s = Sphere::new(c, 1.0).unwrap();
+        let sh: Shape = s.into();
+        for start in [-10.0, -3.0, -1e3] {
+            // Exactly tangent at c + (1, 0, 0).
+            let ray = Ray::new(c + v(1.0, start, 0.0), v(0.0, 1.0, 0.0));
+            if let Some(h) = sh.intersect(&ray, f64::INFINITY) {
+                assert!(h.t.is_finite() && h.point.is_finite() && h.geometric_normal.is_finite());
+                assert!((h.point - (c + v(1.0, 0.0, 0.0))).length() < 1e-4, "{h:?}");
+                assert!((h.t + start).abs() < 1e-4 * start.abs().max(1.0));
+            }
+            // Just inside: always a hit, near the tangent point; just outside: always a miss.
+            let inside = Ray::new(c + v(1.0 - 1e-6, start, 0.0), v(0.0, 1.0, 0.0));
+            let h = sh.intersect(&inside, f64::INFINITY).unwrap();
+            assert!(h.point.is_finite() && (h.point - (c + v(1.0, 0.0, 0.0))).length() < 3e-3);
+            let outside = Ray::new(c + v(1.0 + 1e-6, start, 0.0), v(0.0, 1.0, 0.0));
+            assert!(sh.intersect(&outside, f64::INFINITY).is_none());
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Grazing rays
+
+#[test]
+fn grazing_rays_hit_rectangles_and_triangles_at_the_right_point() {
+    let rect: Shape =
+        Rectangle::new(v(-1.0, 0.0, -1.0), v(0.0, 0.0, 2.0), v(2.0, 0.0, 0.0)).unwrap().into();
+    let tris: Shape = Mesh::from_triangles(
+        vec![v(-1.0, 0.0, -1.0), v(-1.0, 0.0, 1.0), v(1.0, 0.0, 1.0), v(1.0, 0.0, -1.0)],
+        vec![[0, 1, 2], [0, 2, 3]],
+    )
+    .unwrap()
+    .into();
+    let mut r = rng(2);
+    for s in [&rect, &tris] {
+        for _ in 0..1000 {
+            let target = v(r.random_range(-0.9..0.9), 0.0, r.random_range(-0.9..0.9));
+            let angle: f64 = 10f64.powf(r.random_range(-9.0..-3.0));
+            let az: f64 = r.random_range(0.0..2.0 * PI);
+            let below = r.random_bool(0.5);
+            let dir = v(az.cos() * angle.cos(), -angle.sin(), az.sin() * angle.cos());
+            let dir = if below { v(dir.x, -dir.y, dir.z) } else { dir };
+            let dist = 0.05;
+            let ray = Ray::new(target - dir * dist, dir);
+            let h = s.intersect(&ray, f64::INFINITY).unwrap_or_else(|| panic!("{ray:?}"));
+            // The point is on the plane; along the ray it may be off by ~eps / angle.
+            assert!(h.point.y.abs() <= h.error.y + 1e-300, "{h:?}");
+            assert!((h.point - target).length() < 1e-15 / angle + 1e-12, "{h:?}");
+            assert!((h.t - dist).abs() < 1e-15 / angle + 1e-12);
+        }
+        // Exactly in the plane: a miss, and nothing is NaN.
+        let ray = Ray::new(v(-2.0, 0.0, 0.3), v(1.0, 0.0, 0.0));
+        assert!(s.intersect(&ray, f64::INFINITY).is_none_or(|h| h.t.is_finite()));
+    }
+}
+
+#[test]
+fn shared_edge_rays_never_pass_between_two_triangles() {
+    // Two triangles sharing the diagonal (a, b) of a skew quad, and a fan sharing a vertex.
+    let (a, b) = (v(0.1, 0.2, 0.3), v(1.3, 0.9, -0.7));
+    let mesh = Mesh::from_triangles(
+        vec![a, b, v(1.0, -0.5, 0.2), v(0.2, 1.1, -0.4)],
+        vec![[0, 2, 1], [0, 1, 3]],
+    )
+    .unwrap();
+    let s: Shape = mesh.into();
+    let (c, d) = (v(1.0, -0.5, 0.2), v(0.2, 1.1, -0.4));
+    // The same edge in a planar quad (a parallelogram).
+    let planar: Shape =
+        Mesh::from_triangles(vec![a, b, c, a + b - c], vec![[0, 2, 1], [0, 1, 3]]).unwrap().into();
+    let mut r = rng(3);
+    let mut tested = 0;
+    for _ in 0..20_000 {
+        let on_edge = a + (b - a) * r.random_range(0.0..1.0);
+        let origin = on_edge + unit(&mut r) * r.random_range(0.1..100.0);
+        let ray = Ray::new(origin, on_edge - origin);
+        assert!(planar.intersect(&ray, f64::INFINITY).is_some(), "{ray:?} passed the planar edge");
+        // In the skew quad the edge is a silhouette from some viewpoints (both triangles on one
+        // side); a ray must hit whenever the triangles lie on both sides of the edge as seen.
+        let plane = (b - a).cross(on_edge - origin);
+        if (c - origin).dot(plane) * (d - origin).dot(plane) < 0.0 {
+            tested += 1;
+            assert!(s.intersect(&ray, f64::INFINITY).is_some(), "{ray:?} passed through the edge");
+        }
+    }
+    assert!(tested > 5000);
+    let center = v(0.3, -0.2, 0.1);
+    let n = 12;
+    let ring: Vec<DVec3> = (0..n)
+        .map(|i| {
+            let a = 2.0 * PI * i as f64 / n as f64;
+            center + v(a.cos(), a.sin(), 0.3 * (3.0 * a).sin())
+        })
+        .collect();
+    let mut positions = vec![center];
+    positions.extend(ring);
+    let triangles: Vec<[u32; 3]> = (0..n).map(|i| [0, 1 + i, 1 + (i + 1) % n]).collect();
+    let fan: Shape = Mesh::from_triangles(positions, triangles).unwrap().into();
+    for _ in 0..5000 {
+        let origin = center + unit(&mut r) * r.random_range(0.1..10.0);
+        // Steeper than the fan's slopes, so the fan covers all directions around the vertex.
+        if (origin - center).normalize().z.abs() < 0.5 {
+            continue;
+        }
+        let ray = Ray::new(origin, center - origin);
+        assert!(fan.intersect(&ray, f64::INFINITY).is_some(), "{ray:?} passed through the vertex");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Self-intersection after spawning
+
+/// Shoots random rays at `shape`, spawns outgoing rays to both sides of each hit, and checks that
+/// none re-hits the same surface at t ~ 0 (closed convex shapes see no outward re-hit at all).
+fn check_no_acne(shape: Shape, center: DVec3, convex: bool, seed: u64) {
+    let world = World::new(vec![shape]).unwrap();
+    let scale = world.bounds().diagonal().length();
+    let mut r = rng(seed);
+    let mut hits = 0;
+    for _ in 0..3000 {
+        let origin = center + unit(&mut r) * scale * 2.0;
+        let target = center + unit(&mut r) * scale * 0.3;
+        let Some(h) = world.intersect(&Ray::new(origin, target - origin), f64::INFINITY) else {
+            continue;
+        };
+        hits += 1;
+        let n = h.geometric_normal;
+        for side in [1.0, -1.0] {
+            let dir = hemisphere(&mut r, n * side);
+            let ray = h.spawn_ray(dir);
+            if let Some(h2) = world.intersect(&ray, f64::INFINITY) {
+                assert!(h2.t > 1e-6 * scale, "acne: t = {} at {:?} side {side}", h2.t, h.point);
+                if convex && side > 0.0 {
+                    panic!("re-hit a convex shape from outside: {h2:?}");
+                }
+            }
+        }
+    }
+    assert!(hits > 500, "only {hits} hits");
+}
+
+#[test]
+fn spawned_rays_never_rehit_spheres_near_and_far_from_origin() {
+    for (i, c) in [DVec3::ZERO, v(1e5, 0.0, 0.0), v(-3e5, 7e4, 1e5)].into_iter().enumerate() {
+        for radius in [1e-3, 1.0, 100.0] {
+            check_no_acne(Sphere::new(c, radius).unwrap().into(), c, true, 10 + i as u64);
+        }
+    }
+}
+
+#[test]
+fn spawned_rays_never_rehit_planes_cylinders_tori_and_meshes() {
+    for (i, c) in [DVec3::ZERO, v(1e5, -2e5, 5e4)].into_iter().enumerate() {
+        let seed = 20 + i as u64;
+        let rect = Rectangle::new(c - v(1.0, 0.3, 1.0), v(2.0, 0.4, 0.0), v(0.0, 0.3, 2.0));
+        check_no_acne(rect.unwrap().into(), c, false, seed);
+        check_no_acne(Disk::new(c, v(0.3, 1.0, -0.2), 1.0).unwrap().into(), c, false, seed);
+        let cyl = Cylinder::new(c - v(0.0, 0.5, 0.0), v(0.2, 1.0, 0.1), 1.0, 0.7).unwrap();
+        check_no_acne(cyl.into(), c, false, seed);
+        let torus = Torus::new(c, v(0.1, 1.0, 0.3), 1.0, 0.3).unwrap();
+        check_no_acne(torus.into(), c, false, seed);
+        let prism = Prism::new(c, 60.0, 1.0, 1.5).unwrap();
+        check_no_acne(prism.into(), c, true, seed);
+    }
+}
+
+/// A closed box of the given half size around `c`, as six inward or outward rectangles.
+fn box_rectangles(c: DVec3, h: f64) -> Vec<Shape> {
+    let mut shapes = Vec::new();
+    for axis in 0..3 {
+        let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
+        for sign in [-1.0, 1.0] {
+            let mut corner = c - DVec3::splat(h);
+            corner[axis] = c[axis] + sign * h;
+            let (mut eu, mut ev) = (DVec3::ZERO, DVec3::ZERO);
+            eu[u] = 2.0 * h;
+            ev[w] = 2.0 * h;
+            shapes.push(Rectangle::new(corner, eu, ev).unwrap().into());
+        }
+    }
+    shapes
+}
+
+/// The 12-triangle mesh of the same box.
+fn box_mesh(c: DVec3, h: f64) -> Shape {
+    let p: Vec<DVec3> = (0..8)
+        .map(|i| {
+            c + v(
+                if i & 1 == 0 { -h } else { h },
+                if i & 2 == 0 { -h } else { h },
+                if i & 4 == 0 { -h } else { h },
+            )
+        })
+        .collect();
+    let quads =
+        [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let tris = quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
+    Mesh::from_triangles(p, tris).unwrap().into()
+}
+
+#[test]
+fn a_beam_bouncing_1000_times_inside_a_closed_mirror_box_never_escapes_or_sticks() {
+    for (k, c) in [DVec3::ZERO, v(1e5, 1e5, -1e5), v(0.25, -3.0, 7.0)].into_iter().enumerate() {
+        for (j, h) in [1.0, 1e-2, 40.0].into_iter().enumerate() {
+            for shapes in [box_rectangles(c, h), vec![box_mesh(c, h)]] {
+                let world = World::new(shapes).unwrap();
+                let inside =
+                    world.bounds().expanded(DVec3::splat(1e-9 * (h + c.abs().max_element())));
+                let mut r = rng(100 + (k * 3 + j) as u64);
+                let mut ray = Ray::new(c + unit(&mut r) * 0.3 * h, unit(&mut r));
+                let mut last = ray.origin;
+                for bounce in 0..1000 {
+                    let hit = world
+                        .intersect(&ray, f64::INFINITY)
+                        .unwrap_or_else(|| panic!("escaped at bounce {bounce} from {ray:?}"));
+                    assert!(hit.t > 1e-9 * h, "stuck at bounce {bounce}: t = {}", hit.t);
+                    assert!(inside.contains(hit.point), "outside at bounce {bounce}: {hit:?}");
+                    assert!((hit.point - last).length() > 0.0);
+                    last = hit.point;
+                    ray = hit.spawn_ray(reflect(ray.direction, hit.geometric_normal));
+                    assert!(inside.contains(ray.origin));
+                }
+            }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Torus
+
+#[test]
+fn torus_known_rays_hole_axis_and_equator() {
+    for c in [DVec3::ZERO, v(3e4, -1e4, 2e4)] {
+        let (big, small) = (2.0, 0.5);
+        let t: Shape = Torus::new(c, v(0.0, 1.0, 0.0), big, small).unwrap().into();
+        // Along the axis (through the hole): miss.
+        assert!(t.intersect(&Ray::new(c + v(0.0, 10.0, 0.0), v(0.0, -1.0, 0.0)), 1e9).is_none());
+        // Through the hole, slanted but never touching the tube: miss.
+        let ray = Ray::new(c + v(-1.0, 5.0, 0.3), v(0.25, -1.0, -0.05));
+        assert!(t.intersect(&ray, 1e9).is_none());
+        // In the equatorial plane through the centre: hits at distance d - R - r, then the inner
+        // wall at d - (R - r), etc.
+        let d = 10.0;
+        let ray = Ray::new(c + v(-d, 0.0, 0.0), v(1.0, 0.0, 0.0));
+        let expect = [d - big - small, d - big + small, d + big - small, d + big + small];
+        let mut ray2 = ray;
+        let mut travelled = 0.0;
+        for (i, e) in expect.iter().enumerate() {
+            let h = t.intersect(&ray2, 1e9).unwrap_or_else(|| panic!("root {i} missing"));
+            travelled += h.t + (ray2.origin - ray.origin).length() - travelled;
+            let along = (h.point - ray.origin).dot(ray.direction);
+            assert!((along - e).abs() < 1e-9, "root {i}: {along} vs {e}");
+            let expected_n = if i % 2 == 0 { -ray.direction } else { ray.direction };
+            assert!((h.geometric_normal - expected_n).length() < 1e-6, "{h:?}");
+            ray2 = h.spawn_ray(ray.direction);
+        }
+        assert!(t.intersect(&ray2, 1e9).is_none());
+        // Tangent on top of the tube at y = r: hit or miss, never NaN; just below it always hits.
+        let top = Ray::new(c + v(-d, small, 2.0), v(1.0, 0.0, 0.0));
+        if let Some(h) = t.intersect(&top, 1e9) {
+            assert!(h.point.is_finite() && (h.point.y - c.y - small).abs() < 1e-4);
+        }
+        let below = Ray::new(c + v(-d, small - 1e-7, 0.0), v(1.0, 0.0, 0.0));
+        let h = t.intersect(&below, 1e9).unwrap();
+        assert!((h.point.x - c.x + big).abs() < 1e-2);
+    }
+}
+
+#[test]
+fn torus_hits_are_the_first_sign_change_of_the_implicit_function() {
+    let (c, axis, big, small) = (v(0.5, -0.2, 0.1), v(0.3, 1.0, -0.2).normalize(), 1.0, 0.35);
+    let t: Shape = Torus::new(c, axis, big, small).unwrap().into();
+    // Signed distance to the tube, written independently.
+    let sdf = |p: DVec3| {
+        let q = p - c;
+        let z = q.dot(axis);
+        let rho = (q - axis * z).length();
+        (rho - big).hypot(z) - small
+    };
+    let mut r = rng(7);
+    let mut hits = 0;
+    for _ in 0..3000 {
+        let origin = c + unit(&mut r) * 3.0;
+        let target = c + unit(&mut r) * 1.2;
+        let ray = Ray::new(origin, target - origin);
+        let first_crossing = {
+            let n = 20_000;
+            let tmax = 6.0;
+            (1..=n).map(|i| tmax * i as f64 / n as f64).find(|&s| sdf(ray.at(s)) < 0.0)
+        };
+        match t.intersect(&ray, f64::INFINITY) {
+            Some(h) => {
+                hits += 1;
+                assert!(sdf(h.point).abs() < 1e-12, "{}", sdf(h.point));
+                // No crossing found noticeably before the reported hit.
+                if let Some(s) = first_crossing {
+                    assert!(s > h.t - 1e-3, "missed an earlier root: {s} < {}", h.t);
+                }
+            }
+            None => assert!(first_crossing.is_none(), "missed a hit at {first_crossing:?}"),
+        }
+    }
+    assert!(hits > 1000);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Cylinder, disk, prism
+
+#[test]
+fn cylinder_open_hits_from_outside_and_inside_and_misses_along_axis() {
+    let cyl: Shape = Cylinder::new(v(0.0, 0.0, 0.0), v(0.0, 1.0, 0.0), 2.0, 1.0).unwrap().into();
+    let h = cyl.intersect(&Ray::new(v(-5.0, 1.0, 0.0), v(1.0, 0.0, 0.0)), 1e9).unwrap();
+    assert!((h.t - 4.0).abs() < 1e-12 && (h.geometric_normal - v(-1.0, 0.0, 0.0)).length() < 1e-12);
+    assert!((h.uv.y - 0.5).abs() < 1e-12);
+    let h = cyl.intersect(&Ray::new(v(0.0, 1.0, 0.0), v(0.0, 0.0, 1.0)), 1e9).unwrap();
+    assert!((h.t - 1.0).abs() < 1e-12 && (h.geometric_normal - v(0.0, 0.0, 1.0)).length() < 1e-12);
+    assert!(cyl.intersect(&Ray::new(v(0.0, -5.0, 0.0), v(0.0, 1.0, 0.0)), 1e9).is_none());
+    assert!(cyl.intersect(&Ray::new(v(-5.0, 2.5, 0.0), v(1.0, 0.0, 0.0)), 1e9).is_none());
+    // Open: a ray through the top opening hits the inside of the wall at the bottom? no, exits.
+    assert!(cyl.intersect(&Ray::new(v(0.0, 5.0, 0.0), v(0.0, -1.0, 0.0)), 1e9).is_none());
+}
+
+#[test]
+fn disk_hits_inside_radius_only() {
+    let d: Shape =
+        shape(r#"{"type": "Disk", "center": [1, 2, 3], "normal": [0, 0, 2], "radius": 0.5}"#);
+    let h = d.intersect(&Ray::new(v(1.2, 2.2, 10.0), v(0.0, 0.0, -1.0)), 1e9).unwrap();
+    assert!((h.t - 7.0).abs() < 1e-12 && h.geometric_normal == v(0.0, 0.0, 1.0));
+    assert!(d.intersect(&Ray::new(v(1.4, 2.4, 10.0), v(0.0, 0.0, -1.0)), 1e9).is_none());
+}
+
+#[test]
+fn prism_is_closed_with_outward_normals() {
+    let p: Shape = shape(
+        r#"{"type": "Prism", "center": [0, 0.5, 0], "side": 0.3, "length": 0.5,
+            "transform": {"rotate": {"axis": [0, 1, 0], "degrees": 30}}}"#,
+    );
+    assert_eq!(p.primitive_count(), 8);
+    let world = World::new(vec![p]).unwrap();
+    let c = world.bounds().center();
+    let mut r = rng(8);
+    for _ in 0..2000 {
+        let origin = c + unit(&mut r) * 2.0;
+        let h = world.intersect(&Ray::new(origin, c - origin), 1e9).unwrap();
+        assert!(h.geometric_normal.dot(c - origin) < 0.0, "normal not outward: {h:?}");
+        // From inside, every direction hits a face from behind.
+        let inner = world.intersect(&Ray::new(c, unit(&mut r)), 1e9).unwrap();
+        assert!(inner.geometric_normal.dot(inner.point - c) > 0.0);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Transforms
+
+#[test]
+fn transform_from_rows_is_row_major_and_matches_glam() {
+    let rows =
+        [[1.0, 2.0, 3.0, 4.0], [0.0, 1.0, 5.0, 6.0], [0.0, 0.0, 2.0, 7.0], [0.0, 0.0, 0.0, 1.0]];
+    let t = Transform::from_rows(rows).unwrap();
+    let m = DMat4::from_cols_array_2d(&rows).transpose();
+    assert_eq!(t.matrix(), m);
+    assert_eq!(t.point(DVec3::ZERO), v(4.0, 6.0, 7.0));
+    assert_eq!(t.point(v(1.0, 1.0, 1.0)), v(10.0, 12.0, 9.0));
+    assert_eq!(t.to_rows(), rows);
+    let json: Transform =
+        serde_json::from_str(r#"{"matrix": [[1,2,3,4],[0,1,5,6],[0,0,2,7],[0,0,0,1]]}"#).unwrap();
+    assert_eq!(json, t);
+}
+
+#[test]
+fn transform_parts_apply_scale_then_rotate_then_translate() {
+    let t: Transform = serde_json::from_str(
+        r#"{"translate": [10, 0, 0], "rotate": {"axis": [0, 0, 1], "degrees": 90}, "scale": [2, 1, 1]}"#,
+    )
+    .unwrap();
+    // (1, 0, 0) -> scale (2, 0, 0) -> rotate (0, 2, 0) -> translate (10, 2, 0).
+    assert!((t.point(v(1.0, 0.0, 0.0)) - v(10.0, 2.0, 0.0)).length() < 1e-12);
+    let u: Transform = serde_json::from_str(r#"{"scale": 3}"#).unwrap();
+    assert!((u.point(v(1.0, 1.0, 1.0)) - v(3.0, 3.0, 3.0)).length() < 1e-15);
+    let composed = Transform::scale(v(2.0, 1.0, 1.0))
+        .unwrap()
+        .then(&Transform::rotate(v(0.0, 0.0, 1.0), 90.0).unwrap())
+        .then(&Transform::translate(v(10.0, 0.0, 0.0)).unwrap());
+    assert!((composed.matrix() - t.matrix()).abs().to_cols_array().iter().all(|x| *x < 1e-12));
+}
+
+#[test]
+fn transform_normals_stay_perpendicular_under_non_uniform_scale() {
+    let t = Transform::scale(v(5.0, 0.2, 1.0))
+        .unwrap()
+        .then(&Transform::rotate(v(1.0, 1.0, 0.0), 33.0).unwrap())
+        .then(&Transform::translate(v(1.0, 2.0, 3.0)).unwrap());
+    let mut r = rng(9);
+    for _ in 0..1000 {
+        let n = unit(&mut r);
+        let tangent = n.cross(unit(&mut r)).normalize();
+        let (nt, tt) = (t.normal(n).normalize(), t.vector(tangent).normalize());
+        assert!(nt.dot(tt).abs() < 1e-12, "{}", nt.dot(tt));
+        // The naive transform is generally not perpendicular.
+    }
+    let naive = t.vector(v(1.0, 1.0, 0.0).normalize()).normalize();
+    assert!(naive.dot(t.vector(v(1.0, -1.0, 0.0)).normalize()).abs() > 1e-3);
+}
+
+#[test]
+fn transform_inverse_round_trips() {
+    let t = Transform::from_rows([
+        [2.0, 0.5, 0.0, 1.0],
+        [0.0, 3.0, 1.0, -2.0],
+        [1.0, 0.0, 0.5, 3.0],
+        [0.0, 0.0, 0.0, 1.0],
+    ])
+    .unwrap();
+    let mut r = rng(10);
+    for _ in 0..1000 {
+        let p = unit(&mut r) * r.random_range(0.0..100.0);
+        assert!((t.inverse().point(t.point(p)) - p).length() < 1e-12 * (1.0 + p.length()));
+        assert!((t.point(t.inverse().point(p)) - p).length() < 1e-12 * (1.0 + p.length()));
+    }
+    let id = t.then(&t.inverse()).matrix();
+    assert!((id - DMat4::IDENTITY).abs().to_cols_array().iter().all(|x| *x < 1e-12));
+}
+
+#[test]
+fn transform_rejects_singular_non_affine_and_non_finite_naming_the_field() {
+    let e = Transform::from_rows([
+        [1.0, 0.0, 0.0, 0.0],
+        [2.0, 0.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0, 0.0],
+        [0.0, 0.0, 0.0, 1.0],
+    ])
+    .unwrap_err();
+    assert!(
+        e.to_string().contains("Transform.matrix") && e.to_string().contains("singular"),
+        "{e}"
+    );
+    let e = Transform::from_rows([
+        [1.0, 0.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0, 0.0],
+        [0.0, 0.5, 0.0, 1.0],
+    ])
+    .unwrap_err();
+    assert!(e.to_string().contains("affine"), "{e}");
+    let e = Transform::translate(v(f64::NAN, 0.0, 0.0)).unwrap_err();
+    assert!(e.to_string().contains("Transform.translate"), "{e}");
+    assert!(Transform::scale(v(1.0, 0.0, 1.0)).unwrap_err().to_string().contains("scale"));
+    let e = serde_json::from_str::<Transform>(r#"{"rotate": {"axis": [0, 0, 0], "degrees": 3}}"#)
+        .unwrap_err();
+    assert!(e.to_string().contains("rotate.axis"), "{e}");
+    let e = serde_json::from_str::<Transform>(
+        r#"{"matrix": [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]], "scale": 2}"#,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("not both"), "{e}");
+    // Analytic curved shapes accept only similarities.
+    let e = shape_err(
+        r#"{"type": "Sphere", "center": [0,0,0], "radius": 1, "transform": {"scale": [1, 2, 1]}}"#,
+    );
+    assert!(e.contains("Sphere.transform") && e.contains("similarity"), "{e}");
+}
+
+#[test]
+fn transformed_shapes_land_where_the_transform_says() {
+    let s = shape(
+        r#"{"type": "Sphere", "center": [1, 0, 0], "radius": 1,
+        "transform": {"scale": 2, "rotate": {"axis": [0, 0, 1], "degrees": 90}, "translate": [0, 0, 5]}}"#,
+    );
+    // Centre (1,0,0) -> (2,0,0) -> (0,2,0) -> (0,2,5); radius 2.
+    let h = s.intersect(&Ray::new(v(0.0, 2.0, 20.0), v(0.0, 0.0, -1.0)), 1e9).unwrap();
+    assert!((h.t - 13.0).abs() < 1e-12, "{}", h.t);
+    // A mesh under a mirroring transform keeps outward normals.
+    let m = World::new(vec![box_mesh(DVec3::ZERO, 1.0)]).unwrap();
+    let mirrored = match &m.shapes()[0] {
+        Shape::Mesh(mesh) => {
+            mesh.transformed(&Transform::scale(v(-1.0, 1.0, 2.0)).unwrap()).unwrap()
+        }
+        _ => unreachable!(),
+    };
+    let w = World::new(vec![mirrored.into()]).unwrap();
+    let h = w.intersect(&Ray::new(v(0.1, 0.2, 9.0), v(0.0, 0.0, -1.0)), 1e9).unwrap();
+    assert!((h.t - 7.0).abs() < 1e-12 && h.geometric_normal.z > 0.99, "{h:?}");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Scene-file validation
+
+#[test]
+fn every_shape_parses_from_its_documented_json() {
+    let shapes: Vec<Shape> = serde_json::from_str(
+        r#"[
+        {"type": "Sphere", "center": [0, 1, 0], "radius": 0.5},
+        {"type": "Rectangle", "corner": [-1, 0, -1], "edge_u": [0, 0, 2], "edge_v": [2, 0, 0]},
+        {"type": "Disk", "center": [0, 0, 0], "normal": [0, 1, 0], "radius": 2},
+        {"type": "Cylinder", "center": [0, 0, 0], "axis": [0, 0.1, 0], "radius": 1},
+        {"type": "Cylinder", "center": [0, 0, 0], "axis": [0, 1, 0], "height": 0.1, "radius": 1},
+        {"type": "Torus", "center": [0, 1, 0], "axis": [0, 1, 0], "major_radius": 1, "minor_radius": 0.25},
+        {"type": "Mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "triangles": [[0, 1, 2]]},
+        {"type": "Prism", "side": 0.3, "length": 0.5}
+    ]"#,
+    )
+    .unwrap();
+    let world = World::new(shapes.clone()).unwrap();
+    assert_eq!(world.primitive_count(), 7 + 8);
+    // The rectangle faces +y.
+    let h = shapes[1].intersect(&Ray::new(v(0.5, 3.0, 0.5), v(0.0, -1.0, 0.0)), 1e9).unwrap();
+    assert_eq!(h.geometric_normal, v(0.0, 1.0, 0.0));
+    // Round trip.
+    let json = serde_json::to_string(&shapes).unwrap();
+    let again: Vec<Shape> = serde_json::from_str(&json).unwrap();
+    assert_eq!(again, shapes);
+}
+
+#[test]
+fn invalid_shapes_are_rejected_naming_the_field() {
+    let cases = [
+        (r#"{"type": "Sphere", "center": [0, 0, 0], "radius": 0}"#, "Sphere.radius"),
+        (r#"{"type": "Sphere", "center": [0, 0, 0], "radius": -1}"#, "Sphere.radius"),
+        (r#"{"type": "Sphere", "center": [0, 0, 0], "radius": 1, "colour": 3}"#, "colour"),
+        (
+            r#"{"type": "Rectangle", "corner": [0, 0, 0], "edge_u": [1, 0, 0], "edge_v": [2, 0, 0]}"#,
+            "Rectangle.edge_v",
+        ),
+        (
+            r#"{"type": "Disk", "center": [0, 0, 0], "normal": [0, 0, 0], "radius": 1}"#,
+            "Disk.normal",
+        ),
+        (
+            r#"{"type": "Cylinder", "center": [0, 0, 0], "axis": [0, 0, 0], "radius": 1}"#,
+            "Cylinder.axis",
+        ),
+        (
+            r#"{"type": "Torus", "center": [0, 0, 0], "axis": [0, 1, 0], "major_radius": 1, "minor_radius": 1}"#,
+            "Torus.minor_radius",
+        ),
+        (
+            r#"{"type": "Mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "triangles": [[0, 1, 7]]}"#,
+            "index 7",
+        ),
+        (r#"{"type": "Mesh", "positions": [[0, 0, 0]]}"#, "Mesh.triangles"),
+        (
+            r#"{"type": "Mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "triangles": []}"#,
+            "Mesh.triangles",
+        ),
+        (
+            r#"{"type": "Prism", "apex_angle_degrees": 180, "side": 1, "length": 1}"#,
+            "Prism.apex_angle_degrees",
+        ),
+        (r#"{"type": "Prism", "side": 1, "length": 0}"#, "Prism.length"),
+        (r#"{"type": "Blob", "radius": 1}"#, "Blob"),
+    ];
+    for (json, field) in cases {
+        let e = shape_err(json);
+        assert!(e.contains(field), "{json}: {e}");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// OBJ
+
+#[test]
+fn obj_file_loads_relative_to_the_base_directory() {
+    let dir = std::env::temp_dir().join(format!("spectrace-geometry-obj-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("models")).unwrap();
+    let obj = "# unit cube, quads\n\
+        v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n\
+        f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n";
+    std::fs::write(dir.join("models/cube.obj"), obj).unwrap();
+    let shapes: Vec<Shape> = serde_json::from_str(
+        r#"[{"type": "Mesh", "obj": "models/cube.obj", "transform": {"translate": [0, 0, -5]}}]"#,
+    )
+    .unwrap();
+    let e = World::new(shapes.clone()).unwrap_err();
+    assert!(matches!(e, GeometryError::UnloadedMesh { index: 0, .. }), "{e}");
+    let world = World::with_base_dir(shapes.clone(), &dir).unwrap();
+    assert_eq!(world.primitive_count(), 12);
+    let h = world.intersect(&Ray::new(v(0.2, 0.3, 0.0), v(0.0, 0.0, -1.0)), 1e9).unwrap();
+    assert!((h.t - 4.0).abs() < 1e-12 && h.geometric_normal == v(0.0, 0.0, 1.0), "{h:?}");
+    assert!(world.bounds().contains(v(1.0, 1.0, -6.0)));
+    let missing = World::with_base_dir(shapes, &dir.join("nowhere")).unwrap_err();
+    assert!(matches!(missing, GeometryError::Obj { .. }), "{missing}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+// ---------------------------------------------------------------------------------------------
+// BVH
+
+/// A random scene of every shape type; `far` moves it away from the origin.
+fn random_scene(r: &mut Pcg64, far: DVec3) -> Vec<Shape> {
+    let mut shapes: Vec<Shape> = Vec::new();
+    let p = |r: &mut Pcg64| {
+        far + v(r.random_range(-5.0..5.0), r.random_range(-5.0..5.0), r.random_range(-5.0..5.0))
+    };
+    for _ in 0..6 {
+        shapes.push(Sphere::new(p(r), r.random_range(0.1..1.0)).unwrap().into());
+        shapes.push(Rectangle::new(p(r), unit(r), unit(r)).unwrap().into());
+        shapes.push(Disk::new(p(r), unit(r), r.random_range(0.1..1.0)).unwrap().into());
+        shapes.push(Cylinder::new(p(r), unit(r), 1.0, 0.3).unwrap().into());
+        shapes.push(Torus::new(p(r), unit(r), 0.8, 0.2).unwrap().into());
+    }
+    let positions: Vec<DVec3> = (0..200).map(|_| p(r)).collect();
+    let triangles: Vec<[u32; 3]> = (0..150)
+        .map(|_| [r.random_range(0..200u32), r.random_range(0..200u32), r.random_range(0..200u32)])
+        .collect();
+    shapes.push(Mesh::from_triangles(positions, triangles).unwrap().into());
+    shapes.push(Prism::new(p(r), 45.0, 1.0, 2.0).unwrap().into());
+    shapes
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    #[test]
+    fn bvh_results_equal_brute_force(seed in any::<u64>(), far_exponent in 0.0f64..5.0) {
+        let mut r = rng(seed);
+        let far = unit(&mut r) * 10f64.powf(far_exponent);
+        let world = World::new(random_scene(&mut r, far)).unwrap();
+        for _ in 0..400 {
+            let origin = far + unit(&mut r) * r.random_range(0.0..12.0);
+            let ray = Ray::new(origin, unit(&mut r));
+            let t_max = if r.random_bool(0.2) { r.random_range(0.0..10.0) } else { f64::INFINITY };
+            let a = world.intersect(&ray, t_max);
+            let b = world.intersect_brute_force(&ray, t_max);
+            prop_assert_eq!(a.map(|h| h.t), b.map(|h| h.t), "{:?}", ray);
+            // Ties (a ray through a vertex shared by two triangles) may pick either primitive.
+            if let (Some(a), Some(b)) = (a, b)
+                && (a.primitive, a.triangle) == (b.primitive, b.triangle)
+            {
+                prop_assert_eq!(a, b);
+            }
+            prop_assert_eq!(world.occluded(&ray, t_max), b.is_some());
+        }
+    }
+}
+
+#[test]
+fn empty_world_hits_nothing() {
+    let w = World::new(Vec::new()).unwrap();
+    assert!(w.intersect(&Ray::new(DVec3::ZERO, v(1.0, 0.0, 0.0)), f64::INFINITY).is_none());
+    assert!(!w.occluded(&Ray::new(DVec3::ZERO, v(1.0, 0.0, 0.0)), f64::INFINITY));
+    assert!(w.bounds().is_empty());
+}
+
+#[test]
+fn shadow_ray_to_a_point_on_another_surface_is_unoccluded() {
+    let floor = Rectangle::new(v(-5.0, 0.0, -5.0), v(0.0, 0.0, 10.0), v(10.0, 0.0, 0.0)).unwrap();
+    let ball = Sphere::new(v(0.0, 2.0, 0.0), 0.5).unwrap();
+    let world = World::new(vec![floor.into(), ball.into()]).unwrap();
+    let h = world.intersect(&Ray::new(v(3.0, 5.0, 1.0), v(0.0, -1.0, 0.0)), 1e9).unwrap();
+    assert_eq!(h.primitive, 0);
+    let (ray, dist) = h.spawn_ray_to(v(3.0, 4.0, 1.0));
+    assert!(!world.occluded(&ray, dist));
+    let (ray, dist) = h.spawn_ray_to(v(-3.0, 4.0, -1.0));
+    assert!(world.occluded(&ray, dist), "the ball is in the way");
+}

@@ -1,0 +1,80 @@
+//! [`Diffuse`]: a Lambertian surface with a spectral reflectance.
+//!
+//! | field | unit | default | meaning |
+//! |---|---|---|---|
+//! | `reflectance` | fraction in `[0, 1]`, a number or `{"nm": [...], "values": [...]}` | required | the albedo `R(lambda)`: the fraction of a beam's power scattered |
+//!
+//! ```json
+//! {"type": "Diffuse", "reflectance": {"nm": [400, 500, 600, 700], "values": [0.05, 0.1, 0.6, 0.8]}}
+//! ```
+//!
+//! `f = R(lambda) / pi` for directions on the same side; the outgoing direction is
+//! cosine-distributed, so the weight is exactly `R(lambda)`. The surface is **two-sided**: a beam
+//! arriving from behind the normal is scattered back to its own side as if the normal were
+//! flipped to face it; light never passes through.
+
+use std::f64::consts::FRAC_1_PI;
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+use spectrace_spectrum::Reflectance;
+
+use crate::frame::{cosine_hemisphere, facing, unit_uniform};
+use crate::{Incoming, Material, ScatterKind, Scattered};
+
+/// A Lambertian (ideal diffuse) reflector, two-sided.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Diffuse {
+    /// The spectral albedo `R(lambda)`.
+    pub reflectance: Reflectance,
+}
+
+impl Diffuse {
+    /// A Lambertian surface with albedo `reflectance`.
+    pub fn new(reflectance: Reflectance) -> Self {
+        Self { reflectance }
+    }
+}
+
+/// `true` if `wi` and `wo` lie strictly on the same side of the surface.
+#[inline]
+fn same_side(wi: DVec3, wo: DVec3, normal: DVec3) -> bool {
+    wi.dot(normal) * wo.dot(normal) > 0.0
+}
+
+#[typetag::serde]
+impl Material for Diffuse {
+    /// Cosine-distributed around the normal turned to face the beam, from `u[1]`, `u[2]`;
+    /// weight `R(lambda)`; `None` where `R(lambda) = 0`.
+    fn scatter(&self, incoming: &Incoming, u: [f64; 3]) -> Option<Scattered> {
+        let albedo = self.reflectance.value(incoming.lambda);
+        if !(albedo > 0.0) {
+            return None;
+        }
+        let n = facing(incoming.direction, incoming.normal);
+        let (direction, cos_theta) = cosine_hemisphere(n, unit_uniform(u[1]), unit_uniform(u[2]));
+        Some(Scattered {
+            direction,
+            weight: albedo,
+            kind: ScatterKind::Diffuse,
+            pdf: cos_theta * FRAC_1_PI,
+        })
+    }
+
+    fn eval(&self, wi: DVec3, wo: DVec3, normal: DVec3, lambda: f64) -> f64 {
+        if same_side(wi, wo, normal) { self.reflectance.value(lambda) * FRAC_1_PI } else { 0.0 }
+    }
+
+    fn pdf(&self, wi: DVec3, wo: DVec3, normal: DVec3, _lambda: f64) -> f64 {
+        if same_side(wi, wo, normal) { wo.dot(normal).abs() * FRAC_1_PI } else { 0.0 }
+    }
+
+    fn is_specular(&self) -> bool {
+        false
+    }
+
+    fn is_dispersive(&self) -> bool {
+        false
+    }
+}

@@ -1,0 +1,114 @@
+//! The [`Material`] trait (the seed's material function, section 3.5) and the records it takes
+//! and returns: [`Incoming`], [`Scattered`], [`ScatterKind`], [`Transport`].
+
+use std::fmt::Debug;
+
+use glam::DVec3;
+
+/// A beam arriving at a surface, as the material sees it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Incoming {
+    /// Unit direction of travel of the beam, *towards* the surface.
+    pub direction: DVec3,
+    /// Unit shading normal, on the side the geometry defines as outside (for a [`Dielectric`]
+    /// the side where the index is 1; the beam is entering when `direction . normal < 0`).
+    ///
+    /// [`Dielectric`]: crate::Dielectric
+    pub normal: DVec3,
+    /// Wavelength of the beam (nm).
+    pub lambda: f64,
+}
+
+/// Which kind of lobe produced a [`Scattered`] beam.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ScatterKind {
+    /// A lobe with a density: the direction was importance-sampled, `pdf > 0`.
+    Diffuse,
+    /// A Dirac delta lobe (mirror reflection, Fresnel reflection or refraction): `pdf` is 0 and
+    /// [`Material::eval`] is 0 for every pair of directions.
+    Specular,
+}
+
+/// What a path carries, which decides how refraction scales the weight (see
+/// [`Material::scatter_with`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Transport {
+    /// Flux (power) from a light, or importance: the light tracer. Refraction does not rescale
+    /// the weight. The default, and what [`Material::scatter`] does.
+    #[default]
+    Importance,
+    /// Radiance, on a path traced from the camera: refraction from index `n_i` into `n_t`
+    /// (as the *path* travels) multiplies the weight by `(n_i / n_t)^2`, the change of radiance
+    /// across the boundary (radiance over n^2 is what is conserved).
+    Radiance,
+}
+
+/// A beam leaving a surface: the outgoing half of the seed's material function.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scattered {
+    /// Unit direction of the outgoing beam, away from the surface.
+    pub direction: DVec3,
+    /// Multiply the beam's `scale` by this: `f |cos| / pdf` of the sampled direction (the
+    /// reflectance for a Lambertian or a mirror; 1 for the chosen branch of a dielectric, times
+    /// its transmittance on refraction). Finite and >= 0.
+    pub weight: f64,
+    /// Which kind of lobe was sampled.
+    pub kind: ScatterKind,
+    /// Solid-angle density of `direction` (sr^-1); 0 for a delta lobe.
+    pub pdf: f64,
+}
+
+/// What a surface does to a beam (seed 3.5): scatter it into a new direction with an updated
+/// weight, or absorb it.
+///
+/// # Conventions
+/// * [`scatter`](Self::scatter) follows the beam: [`Incoming::direction`] travels *towards* the
+///   surface, [`Scattered::direction`] *away* from it.
+/// * [`eval`](Self::eval) and [`pdf`](Self::pdf) use pbrt's convention: both directions point
+///   *away* from the surface, `wi` towards where the light came from, `wo` towards where it goes
+///   (the viewer). A beam that arrived along `d` has `wi = -d`. All vectors are unit.
+/// * Uniforms `u` are in `[0, 1)`; values outside (or NaN) are clamped, never a panic.
+/// * Nothing here applies Russian roulette: an absorbing surface returns its weight, and `None`
+///   only when the weight would be exactly 0.
+///
+/// The trait is typetag-serialisable: a scene file names a material by its type,
+/// `{"type": "Diffuse", "reflectance": 0.8}`, and another crate can add material types.
+#[typetag::serde(tag = "type")]
+pub trait Material: Send + Sync + Debug {
+    /// The seed's material function for a path that carries flux from a light
+    /// ([`Transport::Importance`]): the outgoing beam, or `None` if the beam is absorbed.
+    /// `u` are three uniforms in `[0, 1)` (lobe choice first, then two for the direction).
+    fn scatter(&self, incoming: &Incoming, u: [f64; 3]) -> Option<Scattered>;
+
+    /// [`scatter`](Self::scatter) for a path carrying `transport`. Only refraction differs
+    /// (see [`Transport::Radiance`]); the default ignores `transport`, which is right for every
+    /// material that does not refract.
+    fn scatter_with(
+        &self,
+        incoming: &Incoming,
+        u: [f64; 3],
+        transport: Transport,
+    ) -> Option<Scattered> {
+        let _ = transport;
+        self.scatter(incoming, u)
+    }
+
+    /// The BSDF `f(wi, wo)` (sr^-1) for light arriving from `wi` and leaving towards `wo` (both
+    /// unit, pointing away from the surface), at wavelength `lambda` (nm); 0 for delta lobes.
+    /// A light tracer that connects a hit to the camera adds `weight * f * |wo . normal|`
+    /// times the camera's importance.
+    fn eval(&self, wi: DVec3, wo: DVec3, normal: DVec3, lambda: f64) -> f64;
+
+    /// Solid-angle density (sr^-1) with which [`scatter`](Self::scatter), given a beam arriving
+    /// from `wi` (`Incoming::direction = -wi`), returns `wo`; 0 for delta lobes. The density of
+    /// the reverse choice is `pdf(wo, wi, ...)`.
+    fn pdf(&self, wi: DVec3, wo: DVec3, normal: DVec3, lambda: f64) -> f64;
+
+    /// `true` if every lobe is a Dirac delta (mirror, dielectric): [`eval`](Self::eval) and
+    /// [`pdf`](Self::pdf) are then 0 everywhere and a connection through the surface is useless.
+    fn is_specular(&self) -> bool;
+
+    /// `true` if the directions this material scatters into depend on the wavelength (a
+    /// dispersive index of refraction): paths through it cannot be shared between wavelengths.
+    fn is_dispersive(&self) -> bool;
+}

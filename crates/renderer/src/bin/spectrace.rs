@@ -1,0 +1,120 @@
+//! The `spectrace` command: render a scene file, or merge the partial films of a sharded render.
+//!
+//! ```sh
+//! spectrace render scenes/prism.json --beams 2000000 --out out/ --threads 2 --seed 7
+//! spectrace render scenes/prism.json --shard 0/4 --out parts/      # one of four machines
+//! spectrace merge parts/*.bin --out out/                           # the same image, bit for bit
+//! ```
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use spectrace_renderer::{RenderOptions, merge_parts, render_file};
+use spectrace_tracer::EffectsMode;
+
+/// Spectrace: a spectral Monte Carlo renderer built around light sources as beam generators.
+#[derive(Debug, Parser)]
+#[command(version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Render a scene file to EXR (linear), PNG (sRGB) and a JSON sidecar.
+    Render {
+        /// The scene file (JSON; see scenes/README.md).
+        scene: PathBuf,
+        /// Beams for the whole image (overrides settings.beams).
+        #[arg(long, conflicts_with = "time")]
+        beams: Option<u64>,
+        /// Render for this many seconds instead of a fixed number of beams.
+        #[arg(long)]
+        time: Option<f64>,
+        /// Output directory.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        /// Worker threads (0: one per core; overrides settings.threads).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Seed of every random stream (overrides settings.seed).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Render only the work chunks whose index is K mod N and write a partial film (K/N).
+        #[arg(long, value_parser = parse_shard)]
+        shard: Option<(u64, u64)>,
+        /// Effects analysis: auto, off or direct_only (overrides effects.mode).
+        #[arg(long, value_parser = parse_effects)]
+        effects: Option<EffectsMode>,
+        /// No progress bar or effects line.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Merge partial films (from `render --shard`) into the final outputs.
+    Merge {
+        /// The partial films (.bin).
+        #[arg(required = true)]
+        parts: Vec<PathBuf>,
+        /// Output directory.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+    },
+}
+
+fn parse_shard(s: &str) -> Result<(u64, u64), String> {
+    let (k, n) = s.split_once('/').ok_or_else(|| format!("`{s}`: expected K/N, e.g. 0/4"))?;
+    let k: u64 = k.trim().parse().map_err(|_| format!("`{s}`: K is not a number"))?;
+    let n: u64 = n.trim().parse().map_err(|_| format!("`{s}`: N is not a number"))?;
+    if n == 0 || k >= n {
+        return Err(format!("`{s}`: need 0 <= K < N"));
+    }
+    Ok((k, n))
+}
+
+fn parse_effects(s: &str) -> Result<EffectsMode, String> {
+    match s {
+        "auto" => Ok(EffectsMode::Auto),
+        "off" => Ok(EffectsMode::Off),
+        "direct_only" | "direct-only" => Ok(EffectsMode::DirectOnly),
+        _ => Err(format!("`{s}`: expected auto, off or direct_only")),
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Render { scene, beams, time, out, threads, seed, shard, effects, quiet } => {
+            let options = RenderOptions {
+                beams,
+                time,
+                threads,
+                seed,
+                shard,
+                effects,
+                out_dir: out,
+                verbose: !quiet,
+            };
+            render_file(&scene, &options)
+        }
+        Command::Merge { parts, out } => merge_parts(&parts, &out),
+    };
+    match result {
+        Ok(report) => {
+            println!(
+                "{} beams in {:.2} s ({:.3e} beams/s), {} rejected contributions; wrote {}",
+                report.beams,
+                report.wall_seconds,
+                report.beams_per_second,
+                report.rejected_contributions,
+                report.outputs.join(", ")
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}

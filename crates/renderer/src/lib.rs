@@ -1,0 +1,454 @@
+//! Spectrace's renderer: a scene file goes in, a validated scene is assembled, the light tracer
+//! renders it, and a linear EXR, an sRGB PNG and a JSON sidecar come out.
+//!
+//! This crate is thin glue over the others (DESIGN.md's data flow): [`Scene`] reads and validates
+//! the JSON (errors name the file, line, column and field path), [`render_scene`] runs the effects
+//! analysis, checks that light can reach the camera, renders on threads with a progress bar and
+//! writes the outputs, and [`merge_parts`] turns the partial films of a sharded render into the
+//! same image a single machine would make, bit for bit. The `spectrace` binary exposes both; the
+//! xtask's `render` subcommand calls it. Nothing but `xtask` and the tests depend on this crate.
+
+mod output;
+mod scene;
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+use spectrace_lights::LightSource;
+use spectrace_tracer::{
+    Effects, EffectsMode, Film, LightTracerScene, RenderOutput, RenderPlan, TraceStats,
+    image_scale, render, trace_chunk,
+};
+
+pub use output::{PARTIAL_VERSION, PartialFilm, linear_srgb, write_exr, write_png};
+pub use scene::{EffectsSettings, Object, OutputSettings, Scene, SceneError, SceneFile, Settings};
+
+/// Command-line overrides of a scene's settings.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RenderOptions {
+    /// Beams for the whole image (overrides `settings.beams`).
+    pub beams: Option<u64>,
+    /// Time budget in seconds (overrides `settings.time_seconds`).
+    pub time: Option<f64>,
+    /// Threads (overrides `settings.threads`; 0 = one per core).
+    pub threads: Option<usize>,
+    /// Seed (overrides `settings.seed`).
+    pub seed: Option<u64>,
+    /// Render only chunks `k` mod `n` and write a partial film.
+    pub shard: Option<(u64, u64)>,
+    /// Effects mode (overrides `effects.mode`).
+    pub effects: Option<EffectsMode>,
+    /// Where the outputs go.
+    pub out_dir: PathBuf,
+    /// Show a progress bar and print the effects decision.
+    pub verbose: bool,
+}
+
+/// Why a render failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RenderError {
+    /// The scene is invalid (or cannot produce light at the camera).
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// An option is invalid.
+    #[error("{0}")]
+    Options(String),
+    /// Writing or reading a file failed.
+    #[error("{path}: {message}")]
+    File {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+/// What a render did: the JSON sidecar's contents.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RenderReport {
+    /// The scene file.
+    pub scene: String,
+    /// Image size.
+    pub width: u32,
+    /// Image size.
+    pub height: u32,
+    /// The plan after overrides (beams, chunk size, seed, threads, shard, time budget).
+    pub plan: RenderPlan,
+    /// The effects analysis' decision.
+    pub effects: Effects,
+    /// The decision in words.
+    pub effects_summary: String,
+    /// Beams traced.
+    pub beams: u64,
+    /// Wall time (s).
+    pub wall_seconds: f64,
+    /// Beams per second.
+    pub beams_per_second: f64,
+    /// Contributions rejected by the film as non-finite or out of range (0 on every shipped
+    /// scene).
+    pub rejected_contributions: u64,
+    /// Tracer counters.
+    pub stats: TraceStats,
+    /// Total power of the lights (W).
+    pub light_power: f64,
+    /// Files written.
+    pub outputs: Vec<String>,
+    /// Spectrace version.
+    pub version: String,
+}
+
+/// Beams traced to check that light can reach the camera before rendering.
+pub const PROBE_BEAMS: u64 = 20_000;
+
+/// The tracer's view of a scene.
+pub fn tracer_scene(scene: &Scene) -> LightTracerScene<'_> {
+    LightTracerScene::new(&scene.world, &scene.materials, &scene.lights, &scene.camera)
+}
+
+/// The effects decision for a scene (with an optional override).
+pub fn decide_effects(scene: &Scene, mode: Option<EffectsMode>) -> Effects {
+    let features = tracer_scene(scene).features(&scene.non_convex);
+    Effects::decide(features, mode.unwrap_or(scene.effects.mode))
+}
+
+/// The plan after command-line overrides.
+///
+/// # Errors
+/// [`RenderError::Options`] for zero beams, a non-positive time, or an invalid shard.
+pub fn plan_for(scene: &Scene, options: &RenderOptions) -> Result<RenderPlan, RenderError> {
+    let mut plan = scene.plan();
+    if let Some(b) = options.beams {
+        plan.beams = b;
+        plan.time_budget = None;
+    }
+    if let Some(t) = options.time {
+        if !(t > 0.0 && t.is_finite()) {
+            return Err(RenderError::Options(format!(
+                "--time {t}: must be a positive number of seconds"
+            )));
+        }
+        plan.time_budget = Some(t);
+        if options.beams.is_none() {
+            plan.beams = u64::MAX / 2;
+        }
+    }
+    if plan.beams == 0 {
+        return Err(RenderError::Options("--beams must be at least 1".to_owned()));
+    }
+    if let Some(s) = options.seed {
+        plan.seed = s;
+    }
+    if let Some(t) = options.threads {
+        plan.threads = t;
+    }
+    if plan.threads == 0 {
+        plan.threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    }
+    if let Some((k, n)) = options.shard {
+        if n == 0 || k >= n {
+            return Err(RenderError::Options(format!("--shard {k}/{n}: need 0 <= K < N")));
+        }
+        plan.shard = Some((k, n));
+    }
+    Ok(plan)
+}
+
+/// Checks that some light reaches the camera: traces [`PROBE_BEAMS`] beams (on their own random
+/// streams) and fails if none is seen.
+///
+/// # Errors
+/// [`SceneError::Scene`] explaining that the image would be black.
+pub fn probe(scene: &Scene, effects: &Effects) -> Result<(), SceneError> {
+    let mut film =
+        Film::new(scene.camera.width(), scene.camera.height()).map_err(|e| SceneError::Scene {
+            path: scene.path.clone(),
+            field: "camera".to_owned(),
+            message: e.to_string(),
+        })?;
+    let stats = trace_chunk(
+        &tracer_scene(scene),
+        &scene.tracer_settings(),
+        effects,
+        u64::MAX,
+        0,
+        PROBE_BEAMS,
+        &mut film,
+    );
+    scene.lights.reset_count();
+    if stats.splats == 0 {
+        return Err(SceneError::Scene {
+            path: scene.path.clone(),
+            field: "lights".to_owned(),
+            message: format!(
+                "no light can reach the camera: none of {PROBE_BEAMS} probe beams lit a point the camera sees \
+                 ({} hit a surface). Check that the lights face the objects, that some surface is not a mirror or \
+                 glass, and that the camera looks at the lit objects.",
+                stats.hits
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Renders a scene file with overrides and writes its outputs (or, with a shard, its partial film).
+///
+/// # Errors
+/// [`RenderError`] for an invalid scene or options, or a file that cannot be written.
+pub fn render_file(path: &Path, options: &RenderOptions) -> Result<RenderReport, RenderError> {
+    let scene = Scene::load(path)?;
+    render_scene(&scene, options)
+}
+
+/// Renders a loaded scene with overrides and writes its outputs.
+///
+/// # Errors
+/// As [`render_file`].
+pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderReport, RenderError> {
+    let plan = plan_for(scene, options)?;
+    let effects = decide_effects(scene, options.effects);
+    if options.verbose {
+        eprintln!("{}", effects.summary());
+    }
+    probe(scene, &effects)?;
+    let bar = progress_bar(&plan, options.verbose);
+    let started = Instant::now();
+    let update = |done: u64| bar.set_position(done.min(bar.length().unwrap_or(u64::MAX)));
+    let output = render(&tracer_scene(scene), &scene.tracer_settings(), &effects, &plan, &update)
+        .map_err(|e| RenderError::Options(e.to_string()))?;
+    bar.finish_and_clear();
+    let wall = started.elapsed().as_secs_f64();
+    std::fs::create_dir_all(&options.out_dir)
+        .map_err(|e| RenderError::File { path: options.out_dir.clone(), message: e.to_string() })?;
+    let name = scene.output_name();
+    if let Some((k, n)) = plan.shard {
+        let part = PartialFilm {
+            version: PARTIAL_VERSION,
+            scene_fingerprint: scene.fingerprint(),
+            scene_path: scene.path.display().to_string(),
+            plan: RenderPlan { shard: None, threads: 0, ..plan },
+            light_power: scene.lights.power(),
+            effects,
+            output_settings: scene.output.clone(),
+            name: name.clone(),
+            output: output.clone(),
+        };
+        let path = options.out_dir.join(format!("{name}.part-{k}-of-{n}.bin"));
+        let bytes = bincode::serde::encode_to_vec(&part, bincode::config::standard())
+            .map_err(|e| RenderError::File { path: path.clone(), message: e.to_string() })?;
+        std::fs::write(&path, bytes)
+            .map_err(|e| RenderError::File { path: path.clone(), message: e.to_string() })?;
+        return Ok(report(
+            scene.path.display().to_string(),
+            &scene.camera,
+            plan,
+            effects,
+            &output,
+            wall,
+            scene.lights.power(),
+            vec![path.display().to_string()],
+        ));
+    }
+    let outputs =
+        write_outputs(&options.out_dir, &name, &scene.output, scene.lights.power(), &output)?;
+    let report = report(
+        scene.path.display().to_string(),
+        &scene.camera,
+        plan,
+        effects,
+        &output,
+        wall,
+        scene.lights.power(),
+        outputs,
+    );
+    write_sidecar(&options.out_dir, &name, &report)?;
+    Ok(report)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn report(
+    scene: String,
+    camera: &spectrace_tracer::PinholeCamera,
+    plan: RenderPlan,
+    effects: Effects,
+    output: &RenderOutput,
+    wall: f64,
+    light_power: f64,
+    outputs: Vec<String>,
+) -> RenderReport {
+    RenderReport {
+        scene,
+        width: camera.width(),
+        height: camera.height(),
+        plan,
+        effects,
+        effects_summary: effects.summary(),
+        beams: output.beams,
+        wall_seconds: wall,
+        beams_per_second: if wall > 0.0 { output.beams as f64 / wall } else { 0.0 },
+        rejected_contributions: output.film.rejected(),
+        stats: output.stats,
+        light_power,
+        outputs,
+        version: env!("CARGO_PKG_VERSION").to_owned(),
+    }
+}
+
+fn progress_bar(plan: &RenderPlan, visible: bool) -> indicatif::ProgressBar {
+    if !visible {
+        return indicatif::ProgressBar::hidden();
+    }
+    let shard_beams: u64 = plan.my_chunks().iter().map(|&c| plan.beams_in_chunk(c)).sum();
+    let bar = indicatif::ProgressBar::new(shard_beams);
+    let template = if plan.time_budget.is_some() {
+        "{spinner} {elapsed_precise} {pos} beams ({per_sec})"
+    } else {
+        "{bar:40} {percent:>3}% {pos}/{len} beams, {per_sec}, ETA {eta}"
+    };
+    if let Ok(style) = indicatif::ProgressStyle::with_template(template) {
+        bar.set_style(style);
+    }
+    bar
+}
+
+/// The final image of a render: XYZ per pixel in film units.
+pub fn image(output: &RenderOutput, light_power: f64) -> Vec<spectrace_spectrum::Xyz> {
+    output.film.to_xyz(image_scale(light_power, output.beams))
+}
+
+/// Writes the EXR and PNG of a finished render; returns their paths.
+///
+/// # Errors
+/// [`RenderError::File`] if a file cannot be written.
+pub fn write_outputs(
+    dir: &Path,
+    name: &str,
+    settings: &OutputSettings,
+    light_power: f64,
+    output: &RenderOutput,
+) -> Result<Vec<String>, RenderError> {
+    let (w, h) = (output.film.width(), output.film.height());
+    let rgb = linear_srgb(&image(output, light_power));
+    let mut written = Vec::new();
+    if settings.exr {
+        let path = dir.join(format!("{name}.exr"));
+        write_exr(&path, w, h, &rgb)
+            .map_err(|message| RenderError::File { path: path.clone(), message })?;
+        written.push(path.display().to_string());
+    }
+    if settings.png {
+        let path = dir.join(format!("{name}.png"));
+        write_png(&path, w, h, &rgb, settings.exposure)
+            .map_err(|message| RenderError::File { path: path.clone(), message })?;
+        written.push(path.display().to_string());
+    }
+    Ok(written)
+}
+
+fn write_sidecar(dir: &Path, name: &str, report: &RenderReport) -> Result<(), RenderError> {
+    let path = dir.join(format!("{name}.json"));
+    let text = serde_json::to_string_pretty(report)
+        .map_err(|e| RenderError::File { path: path.clone(), message: e.to_string() })?;
+    std::fs::write(&path, text).map_err(|e| RenderError::File { path, message: e.to_string() })
+}
+
+/// Merges the partial films of a sharded render into the final outputs, bit-identical to a
+/// one-machine render with the same seed.
+///
+/// # Errors
+/// [`RenderError::File`] for unreadable parts; [`RenderError::Options`] when the parts do not
+/// belong together (different scene, plan or size), overlap, or miss chunks.
+pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, RenderError> {
+    let started = Instant::now();
+    let mut loaded: Vec<PartialFilm> = Vec::new();
+    for path in parts {
+        let bytes = std::fs::read(path)
+            .map_err(|e| RenderError::File { path: path.clone(), message: e.to_string() })?;
+        let (part, _): (PartialFilm, usize) =
+            bincode::serde::decode_from_slice(&bytes, bincode::config::standard()).map_err(
+                |e| RenderError::File {
+                    path: path.clone(),
+                    message: format!("not a Spectrace partial film: {e}"),
+                },
+            )?;
+        if part.version != PARTIAL_VERSION {
+            return Err(RenderError::File {
+                path: path.clone(),
+                message: format!(
+                    "partial film version {} (expected {PARTIAL_VERSION})",
+                    part.version
+                ),
+            });
+        }
+        loaded.push(part);
+    }
+    let Some(first) = loaded.first().cloned() else {
+        return Err(RenderError::Options("merge needs at least one partial film".to_owned()));
+    };
+    let mut merged = RenderOutput {
+        film: Film::new(first.output.film.width(), first.output.film.height())
+            .map_err(|e| RenderError::Options(e.to_string()))?,
+        stats: TraceStats::default(),
+        chunks: Vec::new(),
+        beams: 0,
+        seconds: 0.0,
+    };
+    for (part, path) in loaded.iter().zip(parts) {
+        if part.scene_fingerprint != first.scene_fingerprint || part.plan != first.plan {
+            return Err(RenderError::Options(format!(
+                "{}: belongs to another render (scene or settings differ from {})",
+                path.display(),
+                parts[0].display()
+            )));
+        }
+        if part.output.chunks.iter().any(|c| merged.chunks.binary_search(c).is_ok()) {
+            return Err(RenderError::Options(format!(
+                "{}: overlaps chunks already merged (the same shard twice?)",
+                path.display()
+            )));
+        }
+        merged
+            .merge(&part.output)
+            .map_err(|e| RenderError::Options(format!("{}: {e}", path.display())))?;
+    }
+    if first.plan.time_budget.is_none() {
+        let expected = first.plan.chunks();
+        if merged.chunks.len() as u64 != expected {
+            let missing = (0..expected)
+                .filter(|c| merged.chunks.binary_search(c).is_err())
+                .take(10)
+                .collect::<Vec<_>>();
+            return Err(RenderError::Options(format!(
+                "the parts cover {} of {expected} chunks; missing e.g. {missing:?}",
+                merged.chunks.len()
+            )));
+        }
+    }
+    std::fs::create_dir_all(out_dir)
+        .map_err(|e| RenderError::File { path: out_dir.to_owned(), message: e.to_string() })?;
+    let outputs =
+        write_outputs(out_dir, &first.name, &first.output_settings, first.light_power, &merged)?;
+    let mut report = RenderReport {
+        scene: first.scene_path.clone(),
+        width: merged.film.width(),
+        height: merged.film.height(),
+        plan: first.plan,
+        effects: first.effects,
+        effects_summary: first.effects.summary(),
+        beams: merged.beams,
+        wall_seconds: loaded.iter().map(|p| p.output.seconds).fold(0.0, f64::max),
+        beams_per_second: 0.0,
+        rejected_contributions: merged.film.rejected(),
+        stats: merged.stats,
+        light_power: first.light_power,
+        outputs,
+        version: env!("CARGO_PKG_VERSION").to_owned(),
+    };
+    let total_seconds: f64 = loaded.iter().map(|p| p.output.seconds).sum();
+    report.beams_per_second =
+        if total_seconds > 0.0 { merged.beams as f64 / total_seconds } else { 0.0 };
+    let _ = started;
+    write_sidecar(out_dir, &first.name, &report)?;
+    Ok(report)
+}

@@ -1,0 +1,329 @@
+//! The scene file: its JSON form, loading with errors that name the file, line, column and field,
+//! and assembly into what the tracer needs.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use serde::{Deserialize, Serialize};
+use spectrace_geometry::{Shape, World};
+use spectrace_lights::{LightSet, LightSource};
+use spectrace_materials::Material;
+use spectrace_tracer::{
+    DEFAULT_CHUNK_BEAMS, EffectsMode, LightTracerSettings, PinholeCamera, RenderPlan,
+};
+
+/// A scene file, as written (see `scenes/README.md` for every field).
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// The camera.
+    pub camera: PinholeCamera,
+    /// The objects: a shape and its material each.
+    pub objects: Vec<Object>,
+    /// The light sources (any `LightSource` type, including third-party ones).
+    pub lights: Vec<Box<dyn LightSource>>,
+    /// How much to render and how.
+    #[serde(default)]
+    pub settings: Settings,
+    /// The effects analysis (see the tracer's `effects` module).
+    #[serde(default)]
+    pub effects: EffectsSettings,
+    /// What to write.
+    #[serde(default)]
+    pub output: OutputSettings,
+}
+
+/// One object: a shape and what its surface does.
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Object {
+    /// A name for messages (optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// The shape (`{"type": "Sphere", ...}`).
+    pub shape: Shape,
+    /// The material (`{"type": "Diffuse", ...}`).
+    pub material: Box<dyn Material>,
+}
+
+/// Render settings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Settings {
+    /// Beams for the whole image (the upper limit when `time_seconds` is set).
+    pub beams: u64,
+    /// Optional time budget (s): stop starting new work after this long.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_seconds: Option<f64>,
+    /// Seed of every random stream.
+    pub seed: u64,
+    /// Worker threads; 0 means one per available core.
+    pub threads: usize,
+    /// Most bounces per beam.
+    pub max_depth: u32,
+    /// Bounces after which Russian roulette applies.
+    pub rr_depth: u32,
+    /// Beams per work chunk (the unit of random streams and of sharding).
+    pub chunk_beams: u64,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            beams: 1_000_000,
+            time_seconds: None,
+            seed: 1,
+            threads: 0,
+            max_depth: 64,
+            rr_depth: 4,
+            chunk_beams: DEFAULT_CHUNK_BEAMS,
+        }
+    }
+}
+
+/// The effects analysis' setting.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct EffectsSettings {
+    /// `"auto"` (decide from the scene), `"off"` (simulate everything the general way) or
+    /// `"direct_only"` (end beams at their first non-specular hit: a quick preview).
+    pub mode: EffectsMode,
+}
+
+/// Output settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct OutputSettings {
+    /// Base name of the files (default: the scene file's name without extension).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Exposure of the PNG in stops (the PNG shows `linear * 2^exposure`); the EXR is unscaled.
+    pub exposure: f64,
+    /// Write the sRGB PNG.
+    pub png: bool,
+    /// Write the linear EXR.
+    pub exr: bool,
+}
+
+impl Default for OutputSettings {
+    fn default() -> Self {
+        Self { name: None, exposure: 0.0, png: true, exr: true }
+    }
+}
+
+/// Why a scene could not be loaded. Every message starts with `file:line:column:` where the file
+/// has a position, and names the field (`objects[3].material.ior`).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SceneError {
+    /// The file cannot be read.
+    #[error("{path}: cannot read the scene: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The file is not valid JSON.
+    #[error("{path}:{line}:{column}: syntax error: {message}")]
+    Syntax {
+        /// The file.
+        path: PathBuf,
+        /// Line (1-based).
+        line: usize,
+        /// Column (1-based).
+        column: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A value is missing, of the wrong type, unknown or out of range.
+    #[error("{path}:{line}:{column}: {field}: {message}")]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// Line (1-based).
+        line: usize,
+        /// Column (1-based).
+        column: usize,
+        /// The field path, e.g. `objects[3].material.ior`.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// The scene is well-formed but cannot be rendered as it is.
+    #[error("{path}: {field}: {message}")]
+    Scene {
+        /// The file.
+        path: PathBuf,
+        /// The field concerned.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// A scene ready for the tracer.
+#[derive(Debug)]
+pub struct Scene {
+    /// The scene file it came from.
+    pub path: PathBuf,
+    /// The file's contents, canonicalised (for fingerprints and the sidecar).
+    pub canonical_json: String,
+    /// The camera.
+    pub camera: PinholeCamera,
+    /// All shapes in one BVH.
+    pub world: World,
+    /// One material per shape.
+    pub materials: Vec<Arc<dyn Material>>,
+    /// Whether each shape can see itself (for the effects analysis).
+    pub non_convex: Vec<bool>,
+    /// The lights.
+    pub lights: LightSet,
+    /// Render settings.
+    pub settings: Settings,
+    /// Effects setting.
+    pub effects: EffectsSettings,
+    /// Output settings.
+    pub output: OutputSettings,
+}
+
+impl Scene {
+    /// Reads and validates a scene file.
+    ///
+    /// # Errors
+    /// [`SceneError`] with the file, line, column and field of the first problem.
+    pub fn load(path: &Path) -> Result<Self, SceneError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| SceneError::Io { path: path.to_owned(), source })?;
+        Self::from_json(&text, path)
+    }
+
+    /// Validates a scene given as JSON text; `path` names it in errors and resolves relative
+    /// files (OBJ meshes).
+    ///
+    /// # Errors
+    /// [`SceneError`] with the line, column and field of the first problem.
+    pub fn from_json(text: &str, path: &Path) -> Result<Self, SceneError> {
+        // Syntax first, so syntax errors are reported as such with their position.
+        let value: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| SceneError::Syntax {
+                path: path.to_owned(),
+                line: e.line(),
+                column: e.column(),
+                message: strip_position(&e.to_string()),
+            })?;
+        let mut de = serde_json::Deserializer::from_str(text);
+        let file: SceneFile = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+            let field = e.path().to_string();
+            let inner = e.into_inner();
+            SceneError::Invalid {
+                path: path.to_owned(),
+                line: inner.line(),
+                column: inner.column(),
+                field: if field.is_empty() || field == "." { "(scene)".to_owned() } else { field },
+                message: strip_position(&inner.to_string()),
+            }
+        })?;
+        let scene_error = |field: &str, message: String| SceneError::Scene {
+            path: path.to_owned(),
+            field: field.to_owned(),
+            message,
+        };
+        if file.objects.is_empty() {
+            return Err(scene_error(
+                "objects",
+                "the scene has no objects: nothing can reflect light to the camera".to_owned(),
+            ));
+        }
+        let s = &file.settings;
+        if s.beams == 0 {
+            return Err(scene_error("settings.beams", "must be at least 1".to_owned()));
+        }
+        if s.chunk_beams == 0 {
+            return Err(scene_error("settings.chunk_beams", "must be at least 1".to_owned()));
+        }
+        if let Some(t) = s.time_seconds
+            && !(t > 0.0 && t.is_finite())
+        {
+            return Err(scene_error(
+                "settings.time_seconds",
+                format!("{t}: must be a positive number of seconds"),
+            ));
+        }
+        if !file.output.exposure.is_finite() {
+            return Err(scene_error("output.exposure", "must be finite".to_owned()));
+        }
+        let mut shapes = Vec::with_capacity(file.objects.len());
+        let mut materials = Vec::with_capacity(file.objects.len());
+        let mut non_convex = Vec::with_capacity(file.objects.len());
+        for object in file.objects {
+            non_convex.push(matches!(
+                object.shape,
+                Shape::Mesh(_) | Shape::Cylinder(_) | Shape::Torus(_)
+            ));
+            shapes.push(object.shape);
+            materials.push(Arc::from(object.material));
+        }
+        let base = path.parent().unwrap_or_else(|| Path::new("."));
+        let world = World::with_base_dir(shapes, base)
+            .map_err(|e| scene_error("objects", e.to_string()))?;
+        let lights =
+            LightSet::new(file.lights).map_err(|e| scene_error("lights", e.to_string()))?;
+        let canonical_json = serde_json::to_string(&value).unwrap_or_default();
+        Ok(Self {
+            path: path.to_owned(),
+            canonical_json,
+            camera: file.camera,
+            world,
+            materials,
+            non_convex,
+            lights,
+            settings: file.settings,
+            effects: file.effects,
+            output: file.output,
+        })
+    }
+
+    /// The tracer settings.
+    pub fn tracer_settings(&self) -> LightTracerSettings {
+        LightTracerSettings { max_depth: self.settings.max_depth, rr_depth: self.settings.rr_depth }
+    }
+
+    /// The render plan from the settings, before command-line overrides.
+    pub fn plan(&self) -> RenderPlan {
+        RenderPlan {
+            beams: self.settings.beams,
+            chunk_beams: self.settings.chunk_beams,
+            seed: self.settings.seed,
+            threads: self.settings.threads,
+            shard: None,
+            time_budget: self.settings.time_seconds,
+        }
+    }
+
+    /// The base name of the output files.
+    pub fn output_name(&self) -> String {
+        self.output.name.clone().unwrap_or_else(|| {
+            self.path
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "image".to_owned())
+        })
+    }
+
+    /// A 64-bit FNV-1a fingerprint of the canonical scene, to check that partial films belong
+    /// together.
+    pub fn fingerprint(&self) -> u64 {
+        self.canonical_json
+            .bytes()
+            .fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
+    }
+}
+
+/// serde_json appends " at line L column C"; the position is reported separately.
+fn strip_position(message: &str) -> String {
+    match message.rfind(" at line ") {
+        Some(i) => message[..i].to_owned(),
+        None => message.to_owned(),
+    }
+}

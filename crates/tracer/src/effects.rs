@@ -1,0 +1,132 @@
+//! Effects analysis: which optical effects a scene can produce, and what the tracer may skip.
+//!
+//! Before rendering, the tracer inspects the scene's materials and shapes:
+//!
+//! | effect | detected when | what the tracer does |
+//! |---|---|---|
+//! | dispersion | a material's index depends on wavelength | each beam carries one wavelength |
+//! | no dispersion | no such material | paths are wavelength-independent: one traced path carries a *bundle* of `BUNDLE` wavelengths (the same directions, a weight per wavelength), so colour noise falls `BUNDLE` times faster per traced path |
+//! | specular surfaces | a mirror or glass exists | specular chains are followed (caustics) |
+//! | diffuse interreflection | a second bounce can reach a non-specular surface: more than one non-specular shape, a non-convex one, or any specular shape | beams continue after a diffuse hit; otherwise they end there (the light of later bounces can never reach the film) |
+//!
+//! The decision is printed by the renderer and stored in its output metadata; a scene can
+//! override it (`"effects": {"mode": "off"}` simulates everything the general way, `"direct_only"`
+//! ends every beam at its first non-specular hit, for quick previews).
+
+use serde::{Deserialize, Serialize};
+
+/// Wavelengths per traced path when no material is dispersive.
+pub const BUNDLE: usize = 4;
+
+/// What the scene contains, as the analysis sees it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct SceneFeatures {
+    /// Some material's index of refraction depends on wavelength.
+    pub dispersive: bool,
+    /// Some material is purely specular (mirror, glass).
+    pub specular: bool,
+    /// Number of shapes with a non-specular material.
+    pub non_specular_shapes: usize,
+    /// Some non-specular shape can see itself (non-convex: mesh, torus, open cylinder).
+    pub non_convex_non_specular: bool,
+}
+
+/// How the scene asks the analysis to behave.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EffectsMode {
+    /// Decide from the scene (the default).
+    #[default]
+    Auto,
+    /// Simulate everything the general way: one wavelength per path, beams continue after
+    /// diffuse hits.
+    Off,
+    /// Direct light only (plus specular chains before the first diffuse hit): a quick preview.
+    DirectOnly,
+}
+
+/// The analysis' decision: what the tracer does for this scene.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Effects {
+    /// The mode that produced this decision.
+    pub mode: EffectsMode,
+    /// What was found in the scene.
+    pub features: SceneFeatures,
+    /// Wavelengths carried by one traced path (1, or [`BUNDLE`] without dispersion).
+    pub wavelengths_per_path: usize,
+    /// Whether beams continue after their first non-specular hit.
+    pub continue_after_diffuse: bool,
+}
+
+impl Effects {
+    /// Decides from the scene's features and the requested mode.
+    pub fn decide(features: SceneFeatures, mode: EffectsMode) -> Self {
+        let interreflection = features.non_specular_shapes > 1
+            || features.non_convex_non_specular
+            || features.specular;
+        match mode {
+            EffectsMode::Auto => Self {
+                mode,
+                features,
+                wavelengths_per_path: if features.dispersive { 1 } else { BUNDLE },
+                continue_after_diffuse: interreflection,
+            },
+            EffectsMode::Off => {
+                Self { mode, features, wavelengths_per_path: 1, continue_after_diffuse: true }
+            }
+            EffectsMode::DirectOnly => Self {
+                mode,
+                features,
+                wavelengths_per_path: if features.dispersive { 1 } else { BUNDLE },
+                continue_after_diffuse: false,
+            },
+        }
+    }
+
+    /// One line for people: what was found and what the tracer does.
+    pub fn summary(&self) -> String {
+        let f = &self.features;
+        format!(
+            "effects ({mode:?}): dispersion {}, specular surfaces {}, {} non-specular shape(s){}; \
+             {} wavelength(s) per path, beams {} after a diffuse hit",
+            if f.dispersive { "yes" } else { "no" },
+            if f.specular { "yes" } else { "no" },
+            f.non_specular_shapes,
+            if f.non_convex_non_specular { " (some non-convex)" } else { "" },
+            self.wavelengths_per_path,
+            if self.continue_after_diffuse { "continue" } else { "stop" },
+            mode = self.mode,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decisions_follow_the_features() {
+        let plane_only = SceneFeatures { non_specular_shapes: 1, ..Default::default() };
+        let e = Effects::decide(plane_only, EffectsMode::Auto);
+        assert_eq!((e.wavelengths_per_path, e.continue_after_diffuse), (BUNDLE, false));
+        let prism = SceneFeatures {
+            dispersive: true,
+            specular: true,
+            non_specular_shapes: 1,
+            ..Default::default()
+        };
+        let e = Effects::decide(prism, EffectsMode::Auto);
+        assert_eq!((e.wavelengths_per_path, e.continue_after_diffuse), (1, true));
+        let torus = SceneFeatures {
+            non_specular_shapes: 2,
+            non_convex_non_specular: true,
+            ..Default::default()
+        };
+        assert!(Effects::decide(torus, EffectsMode::Auto).continue_after_diffuse);
+        let off = Effects::decide(plane_only, EffectsMode::Off);
+        assert_eq!((off.wavelengths_per_path, off.continue_after_diffuse), (1, true));
+        let preview = Effects::decide(torus, EffectsMode::DirectOnly);
+        assert!(!preview.continue_after_diffuse);
+        assert!(preview.summary().contains("stop after a diffuse hit"));
+    }
+}

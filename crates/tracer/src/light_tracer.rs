@@ -1,0 +1,292 @@
+//! The light tracer (seed section 2.4.4): beams from the lights, followed through the scene, every
+//! non-specular hit connected to the camera.
+//!
+//! # Estimator
+//! A beam of power `P_b = Phi / N * scale` (the light's power over the beams of the whole render)
+//! that reaches a non-specular surface point `x` from direction `wi` adds, to the pixel `x`
+//! projects into, the estimate `P_b * f(wi, wo) * cos(theta_x) * importance` of the pixel's mean
+//! spectral radiance (see [`crate::PinholeCamera`] for `importance`), weighted by the CIE 1931
+//! functions at the beam's wavelength and divided by the integral of `ybar`: the film's XYZ, in
+//! which a constant spectral radiance of 1 W m^-2 sr^-1 nm^-1 gives `Y = 1`. The beam then
+//! continues by sampling the material (its weight multiplied by `f cos / pdf`); mirrors and glass
+//! reflect and refract it, so caustics and dispersion appear. After `rr_depth` bounces Russian
+//! roulette ends a beam with probability `1 - min(1, weight)` and divides survivors by the
+//! survival probability, which keeps the estimator unbiased.
+//!
+//! The film accumulates the contributions without the factor `Phi / N`; [`image_scale`] gives it.
+//!
+//! # Determinism
+//! Work comes in chunks of beams; chunk `c` draws all its random numbers from a generator seeded
+//! by `(seed, c)`, and the film adds in exact fixed point, so an image depends only on the seed
+//! and the chunks rendered, never on thread count or order.
+
+use std::sync::Arc;
+
+use glam::DVec3;
+use rand::SeedableRng;
+use rand_pcg::Pcg64;
+use serde::{Deserialize, Serialize};
+use spectrace_geometry::{Ray, World};
+use spectrace_lights::{LightSet, LightSource, uniform};
+use spectrace_materials::{Incoming, Material};
+use spectrace_spectrum::{CIE_Y_INTEGRAL, SpectralPowerDistribution, cmf};
+
+use crate::{Effects, Film, PinholeCamera, SceneFeatures};
+
+/// Settings of the light tracer.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightTracerSettings {
+    /// Most bounces a beam may make (0: only direct illumination of the first surface hit).
+    pub max_depth: u32,
+    /// Bounces after which Russian roulette may end a beam.
+    pub rr_depth: u32,
+}
+
+impl Default for LightTracerSettings {
+    fn default() -> Self {
+        Self { max_depth: 64, rr_depth: 4 }
+    }
+}
+
+/// What a light tracer traces: geometry, one material per shape, the lights and the camera.
+#[derive(Debug, Clone)]
+pub struct LightTracerScene<'a> {
+    /// All shapes, in one BVH.
+    pub world: &'a World,
+    /// The material of each shape, indexed like the shapes given to the world.
+    pub materials: &'a [Arc<dyn Material>],
+    /// The lights the beams come from.
+    pub lights: &'a LightSet,
+    /// The camera that receives the connections.
+    pub camera: &'a PinholeCamera,
+    /// The spectrum of each light of the set, cached (bundled wavelengths are drawn from the
+    /// spectrum of the beam's own light).
+    spds: Vec<Arc<dyn SpectralPowerDistribution>>,
+}
+
+impl<'a> LightTracerScene<'a> {
+    /// Assembles a scene.
+    pub fn new(
+        world: &'a World,
+        materials: &'a [Arc<dyn Material>],
+        lights: &'a LightSet,
+        camera: &'a PinholeCamera,
+    ) -> Self {
+        let spds = lights.lights().iter().map(|l| l.spd()).collect();
+        Self { world, materials, lights, camera, spds }
+    }
+
+    /// What the scene contains, for the effects analysis.
+    pub fn features(&self, shapes_non_convex: &[bool]) -> SceneFeatures {
+        let mut f = SceneFeatures::default();
+        for (i, m) in self.materials.iter().enumerate() {
+            f.dispersive |= m.is_dispersive();
+            if m.is_specular() {
+                f.specular = true;
+            } else {
+                f.non_specular_shapes += 1;
+                f.non_convex_non_specular |= shapes_non_convex.get(i).copied().unwrap_or(true);
+            }
+        }
+        f
+    }
+}
+
+/// Counters of one chunk (or a whole render, summed).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct TraceStats {
+    /// Beams emitted.
+    pub beams: u64,
+    /// Surface hits.
+    pub hits: u64,
+    /// Connections to the camera that reached the film.
+    pub splats: u64,
+    /// Beams ended by Russian roulette.
+    pub roulette_kills: u64,
+    /// Beams that reached `max_depth`.
+    pub depth_limited: u64,
+}
+
+impl TraceStats {
+    /// Adds another chunk's counters.
+    pub fn merge(&mut self, o: &TraceStats) {
+        self.beams += o.beams;
+        self.hits += o.hits;
+        self.splats += o.splats;
+        self.roulette_kills += o.roulette_kills;
+        self.depth_limited += o.depth_limited;
+    }
+}
+
+/// The generator of chunk `chunk` of a render with seed `seed` (SplitMix64 of both, so nearby
+/// seeds and chunks give unrelated streams).
+pub fn chunk_rng(seed: u64, chunk: u64) -> Pcg64 {
+    let mut z = seed ^ chunk.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    Pcg64::seed_from_u64(z ^ (z >> 31))
+}
+
+/// The factor that turns film sums into the image: the lights' power over the beams of the
+/// whole render.
+pub fn image_scale(light_power: f64, total_beams: u64) -> f64 {
+    if total_beams == 0 { 0.0 } else { light_power / total_beams as f64 }
+}
+
+/// Traces `beams` beams of chunk `chunk` into `film`, following `effects`.
+pub fn trace_chunk(
+    scene: &LightTracerScene<'_>,
+    settings: &LightTracerSettings,
+    effects: &Effects,
+    seed: u64,
+    chunk: u64,
+    beams: u64,
+    film: &mut Film,
+) -> TraceStats {
+    let mut rng = chunk_rng(seed, chunk);
+    let mut stats = TraceStats::default();
+    let inv_y = 1.0 / *CIE_Y_INTEGRAL;
+    let k = effects.wavelengths_per_path.clamp(1, MAX_BUNDLE);
+    let light: &dyn LightSource = scene.lights;
+    for _ in 0..beams {
+        let beam = light.next_beam(&mut rng);
+        stats.beams += 1;
+        // The bundle: the beam's own wavelength and weight, plus k - 1 wavelengths drawn from the
+        // spectrum of the beam's light, each an independent estimate; all share the path.
+        let mut lambdas = [beam.lambda; MAX_BUNDLE];
+        let mut weights = [0.0; MAX_BUNDLE];
+        weights[0] = beam.scale / k as f64;
+        if k > 1 {
+            let spd = &scene.spds[beam.parent.0 as usize];
+            for j in 1..k {
+                // Stratified: one uniform per stratum of [0, 1).
+                let u = ((j - 1) as f64 + uniform(&mut rng)) / (k - 1) as f64;
+                lambdas[j] = spd.sample_lambda(u.min(spectrace_sampling::ONE_MINUS_EPSILON));
+                weights[j] = 1.0 / k as f64;
+            }
+        }
+        // Lights seen directly: connect the emission point to the camera.
+        if let Some((x, y, value)) = connect_emission(scene, &beam) {
+            let mut xyz = spectrace_spectrum::Xyz::default();
+            for j in 0..k {
+                xyz += cmf(lambdas[j]) * (weights[j] * value * inv_y);
+            }
+            if film.add(x, y, xyz) {
+                stats.splats += 1;
+            }
+        }
+        let mut ray = Ray { origin: beam.origin, direction: beam.direction };
+        let mut depth = 0u32;
+        while let Some(hit) = scene.world.intersect(&ray, f64::INFINITY) {
+            stats.hits += 1;
+            let Some(material) = scene.materials.get(hit.primitive as usize) else { break };
+            let specular = material.is_specular();
+            if !specular {
+                if let Some((x, y, value)) =
+                    connect_to_camera(scene, material.as_ref(), &hit, ray.direction, &lambdas[..k])
+                {
+                    let mut xyz = spectrace_spectrum::Xyz::default();
+                    for j in 0..k {
+                        xyz += cmf(lambdas[j]) * (weights[j] * value[j] * inv_y);
+                    }
+                    if film.add(x, y, xyz) {
+                        stats.splats += 1;
+                    }
+                }
+                if !effects.continue_after_diffuse {
+                    break;
+                }
+            }
+            if depth >= settings.max_depth {
+                stats.depth_limited += 1;
+                break;
+            }
+            let u = [uniform(&mut rng), uniform(&mut rng), uniform(&mut rng)];
+            let incoming = Incoming {
+                direction: ray.direction,
+                normal: hit.shading_normal,
+                lambda: lambdas[0],
+            };
+            let Some(scattered) = material.scatter(&incoming, u) else { break };
+            weights[0] *= scattered.weight;
+            // The other wavelengths take the same direction (no dispersion: the same uniforms
+            // give the same direction) with their own weights.
+            for j in 1..k {
+                let other = Incoming { lambda: lambdas[j], ..incoming };
+                weights[j] *= match material.scatter(&other, u) {
+                    Some(s) if (s.direction - scattered.direction).length_squared() < 1e-20 => {
+                        s.weight
+                    }
+                    _ => 0.0,
+                };
+            }
+            depth += 1;
+            if depth > settings.rr_depth {
+                // The bundle's weights sum to the path's throughput relative to its start.
+                let survive = weights[..k].iter().sum::<f64>().min(1.0);
+                if !(uniform(&mut rng) < survive) {
+                    stats.roulette_kills += 1;
+                    break;
+                }
+                for w in &mut weights[..k] {
+                    *w /= survive;
+                }
+            }
+            if weights[..k].iter().all(|&w| w <= 0.0) {
+                break;
+            }
+            ray = hit.spawn_ray(scattered.direction);
+        }
+    }
+    stats
+}
+
+/// Largest wavelength bundle a path can carry.
+const MAX_BUNDLE: usize = 8;
+
+/// The connection of an emission point to the camera: pixel and `density * importance`, or
+/// `None` when the light does not emit that way, the point is outside the image, or occluded.
+fn connect_emission(
+    scene: &LightTracerScene<'_>,
+    beam: &spectrace_lights::Beam,
+) -> Option<(u32, u32, f64)> {
+    let light = scene.lights.light(beam.parent)?;
+    let projection = scene.camera.project(beam.origin)?;
+    let density = light.emission_density(beam.origin, projection.to_camera);
+    if !(density > 0.0) {
+        return None;
+    }
+    let shadow = Ray { origin: beam.origin, direction: projection.to_camera };
+    if scene.world.occluded(&shadow, projection.distance) {
+        return None;
+    }
+    Some((projection.x, projection.y, density * projection.importance))
+}
+
+/// The connection of a surface hit to the camera: pixel and `f * cos * importance` per
+/// wavelength, or `None` when the point is outside the image or occluded.
+fn connect_to_camera(
+    scene: &LightTracerScene<'_>,
+    material: &dyn Material,
+    hit: &spectrace_geometry::Hit,
+    arriving: DVec3,
+    lambdas: &[f64],
+) -> Option<(u32, u32, [f64; MAX_BUNDLE])> {
+    let projection = scene.camera.project(hit.point)?;
+    let (shadow, distance) = hit.spawn_ray_to(scene.camera.position());
+    if scene.world.occluded(&shadow, distance) {
+        return None;
+    }
+    let cos = projection.to_camera.dot(hit.shading_normal).abs();
+    let mut values = [0.0; MAX_BUNDLE];
+    let mut any = false;
+    for (v, &lambda) in values.iter_mut().zip(lambdas) {
+        let f = material.eval(-arriving, projection.to_camera, hit.shading_normal, lambda);
+        if f > 0.0 {
+            *v = f * cos * projection.importance;
+            any = true;
+        }
+    }
+    any.then_some((projection.x, projection.y, values))
+}

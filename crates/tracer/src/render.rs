@@ -1,0 +1,156 @@
+//! Running the light tracer over work chunks on several threads (and, with shards, machines).
+
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
+
+use serde::{Deserialize, Serialize};
+
+use crate::light_tracer::{LightTracerScene, LightTracerSettings, TraceStats, trace_chunk};
+use crate::{Effects, Film, FilmError};
+
+/// Beams per work chunk by default: small enough to balance threads, large enough that the
+/// per-chunk cost (a generator, a film merge) is negligible.
+pub const DEFAULT_CHUNK_BEAMS: u64 = 1 << 14;
+
+/// How much to render and how to split it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RenderPlan {
+    /// Beams in the whole image (all shards together); with a time budget, the upper limit.
+    pub beams: u64,
+    /// Beams per chunk (the unit of work, of random streams, and of sharding).
+    pub chunk_beams: u64,
+    /// Seed of every random stream.
+    pub seed: u64,
+    /// Worker threads (at least 1).
+    pub threads: usize,
+    /// Render only the chunks whose index is `k` mod `n` (`(k, n)`), for one machine of many.
+    pub shard: Option<(u64, u64)>,
+    /// Stop claiming new chunks after this many seconds (the chunks already claimed finish).
+    pub time_budget: Option<f64>,
+}
+
+impl RenderPlan {
+    /// Number of chunks in the whole image.
+    pub fn chunks(&self) -> u64 {
+        self.beams.div_ceil(self.chunk_beams.max(1))
+    }
+
+    /// Beams in chunk `c` (the last chunk may be short).
+    pub fn beams_in_chunk(&self, c: u64) -> u64 {
+        let size = self.chunk_beams.max(1);
+        self.beams.saturating_sub(c * size).min(size)
+    }
+
+    /// The chunk indices this shard renders, in order.
+    pub fn my_chunks(&self) -> Vec<u64> {
+        let (k, n) = self.shard.unwrap_or((0, 1));
+        (0..self.chunks()).filter(|c| c % n == k).collect()
+    }
+}
+
+/// The result of a render (or of one shard).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RenderOutput {
+    /// The film: exact sums, not yet scaled by the light's power over the beams.
+    pub film: Film,
+    /// Counters.
+    pub stats: TraceStats,
+    /// The chunks that were rendered, sorted.
+    pub chunks: Vec<u64>,
+    /// Beams in those chunks.
+    pub beams: u64,
+    /// Wall time (s).
+    pub seconds: f64,
+}
+
+impl RenderOutput {
+    /// Adds another shard's output (same film size); chunks must not overlap.
+    ///
+    /// # Errors
+    /// [`FilmError::SizeMismatch`] when the films differ in size.
+    pub fn merge(&mut self, other: &RenderOutput) -> Result<(), FilmError> {
+        self.film.merge(&other.film)?;
+        self.stats.merge(&other.stats);
+        self.chunks.extend(&other.chunks);
+        self.chunks.sort_unstable();
+        self.beams += other.beams;
+        self.seconds = self.seconds.max(other.seconds);
+        Ok(())
+    }
+}
+
+/// Renders the plan's chunks on `plan.threads` threads; `progress(beams_done)` is called after
+/// every chunk (from worker threads).
+///
+/// # Errors
+/// [`FilmError::InvalidSize`] for a camera whose resolution cannot be allocated.
+pub fn render(
+    scene: &LightTracerScene<'_>,
+    settings: &LightTracerSettings,
+    effects: &Effects,
+    plan: &RenderPlan,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<RenderOutput, FilmError> {
+    let started = Instant::now();
+    let (w, h) = (scene.camera.width(), scene.camera.height());
+    let chunks = plan.my_chunks();
+    let next = AtomicU64::new(0);
+    let done = AtomicU64::new(0);
+    let deadline = plan.time_budget.map(|s| started + Duration::from_secs_f64(s.max(0.0)));
+    let results: Mutex<Vec<(Film, TraceStats, Vec<u64>)>> = Mutex::new(Vec::new());
+    let mut first_error = None;
+    std::thread::scope(|scope| {
+        let mut handles = Vec::new();
+        for _ in 0..plan.threads.max(1) {
+            handles.push(scope.spawn(|| -> Result<(), FilmError> {
+                let mut film = Film::new(w, h)?;
+                let mut stats = TraceStats::default();
+                let mut mine = Vec::new();
+                loop {
+                    if deadline.is_some_and(|d| Instant::now() >= d) {
+                        break;
+                    }
+                    let i = next.fetch_add(1, Ordering::Relaxed) as usize;
+                    let Some(&c) = chunks.get(i) else { break };
+                    let n = plan.beams_in_chunk(c);
+                    let s = trace_chunk(scene, settings, effects, plan.seed, c, n, &mut film);
+                    stats.merge(&s);
+                    mine.push(c);
+                    progress(done.fetch_add(n, Ordering::Relaxed) + n);
+                }
+                if let Ok(mut r) = results.lock() {
+                    r.push((film, stats, mine));
+                }
+                Ok(())
+            }));
+        }
+        for handle in handles {
+            if let Ok(Err(e)) = handle.join() {
+                first_error.get_or_insert(e);
+            }
+        }
+    });
+    if let Some(e) = first_error {
+        return Err(e);
+    }
+    let mut film = Film::new(w, h)?;
+    let mut stats = TraceStats::default();
+    let mut rendered = Vec::new();
+    for (f, s, c) in results.into_inner().unwrap_or_default() {
+        film.merge(&f)?;
+        stats.merge(&s);
+        rendered.extend(c);
+    }
+    rendered.sort_unstable();
+    // With a time budget, chunks are claimed in order, but a late claim may finish while an
+    // earlier one was never claimed; the rendered set is what the output reports.
+    let beams = rendered.iter().map(|&c| plan.beams_in_chunk(c)).sum();
+    Ok(RenderOutput {
+        film,
+        stats,
+        chunks: rendered,
+        beams,
+        seconds: started.elapsed().as_secs_f64(),
+    })
+}
