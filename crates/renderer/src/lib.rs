@@ -8,6 +8,7 @@
 //! same image a single machine would make, bit for bit. The `spectrace` binary exposes both; the
 //! xtask's `render` subcommand calls it. Nothing but `xtask` and the tests depend on this crate.
 
+pub mod accuracy;
 mod output;
 mod scene;
 
