@@ -1,6 +1,8 @@
 //! Cross-crate tests: contracts between the Spectrace crates that no single crate can check.
 #![allow(clippy::unwrap_used)]
 
+mod rendering;
+
 use rand::SeedableRng;
 use rand_pcg::Pcg64;
 use serde::{Deserialize, Serialize};

@@ -5,8 +5,9 @@
 //! - `cargo xtask` / `cargo xtask status`: what Spectrace contains so far and how to use it.
 //! - `cargo xtask bench`: runs every crate's benchmarks in release mode.
 //! - `cargo xtask ci`: runs the same checks as `.ci/run` (tests, rustfmt, clippy).
-//!
-//! `cargo xtask render` arrives with the renderer (issue 5) and becomes the main command.
+//! - `cargo xtask render [SCENE] [options]`: builds the renderer in release mode and renders a
+//!   scene (default `scenes/showcase.json`); options go to `spectrace render`.
+//! - `cargo xtask accuracy [SCENES]`: the error-against-time report, `docs/accuracy.md`.
 
 use std::process::{Command, ExitCode};
 
@@ -56,18 +57,67 @@ fn main() -> ExitCode {
             print_help();
             ExitCode::SUCCESS
         }
-        "render" => {
-            eprintln!(
-                "cargo xtask render: the renderer does not exist yet (it is issue 5: geometry, \
-                 materials, light tracer). Today Spectrace is its sampling and spectrum layers; run \
-                 `cargo xtask status` to see them."
-            );
-            ExitCode::from(2)
-        }
+        "render" => render(&args[1..]),
+        "accuracy" => accuracy(&args[1..]),
         other => {
             eprintln!("unknown command `{other}`\n");
             print_help();
             ExitCode::from(2)
+        }
+    }
+}
+
+/// The default scene of `cargo xtask render`.
+const SHOWCASE: &str = "scenes/showcase.json";
+
+/// `cargo xtask render [SCENE] [options]`: builds the renderer in release mode and renders the
+/// scene (the showcase scene by default); options pass through to `spectrace render`.
+fn render(args: &[String]) -> ExitCode {
+    let (scene, rest) = match args.first() {
+        Some(first) if !first.starts_with('-') => (first.clone(), &args[1..]),
+        _ => (SHOWCASE.to_owned(), args),
+    };
+    let mut command: Vec<String> = vec!["render".into(), scene];
+    command.extend(rest.iter().cloned());
+    run_spectrace(&command)
+}
+
+/// `cargo xtask accuracy [SCENES] [options]`: the error-against-time report (docs/accuracy.md).
+fn accuracy(args: &[String]) -> ExitCode {
+    let mut command: Vec<String> = vec!["accuracy".into()];
+    command.extend(args.iter().cloned());
+    run_spectrace(&command)
+}
+
+/// Builds `spectrace` in release mode, then runs it with `args`.
+fn run_spectrace(args: &[String]) -> ExitCode {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
+    eprintln!("$ cargo build --release -p spectrace-renderer --bin spectrace");
+    match Command::new(&cargo)
+        .args(["build", "--release", "-p", "spectrace-renderer", "--bin", "spectrace"])
+        .status()
+    {
+        Ok(s) if s.success() => {}
+        Ok(s) => {
+            eprintln!("building the renderer failed ({s})");
+            return ExitCode::FAILURE;
+        }
+        Err(e) => {
+            eprintln!("could not run cargo: {e}");
+            return ExitCode::FAILURE;
+        }
+    }
+    let target = std::env::var("CARGO_TARGET_DIR").unwrap_or_else(|_| "target".to_owned());
+    let binary = std::path::Path::new(&target)
+        .join("release")
+        .join(format!("spectrace{}", std::env::consts::EXE_SUFFIX));
+    eprintln!("$ {} {}", binary.display(), args.join(" "));
+    match Command::new(&binary).args(args).status() {
+        Ok(s) if s.success() => ExitCode::SUCCESS,
+        Ok(s) => ExitCode::from(s.code().unwrap_or(1).clamp(1, 255) as u8),
+        Err(e) => {
+            eprintln!("could not run {}: {e}", binary.display());
+            ExitCode::FAILURE
         }
     }
 }
@@ -77,6 +127,9 @@ fn print_help() {
         "usage: cargo xtask [COMMAND]\n\n\
          commands:\n  \
          status   what Spectrace contains so far (default)\n  \
+         render [SCENE] [--beams N | --time SECS] [--out DIR] [--threads N] [--seed S] [--shard K/N]\n           \
+                  build in release and render SCENE (default scenes/showcase.json)\n  \
+         accuracy [SCENES]  error against time for every accuracy knob (docs/accuracy.md)\n  \
          bench    run every crate's benchmarks (release)\n  \
          ci       run the checks CI runs: tests, rustfmt, clippy -D warnings\n  \
          help     this text"

@@ -53,7 +53,6 @@ pub struct Settings {
     /// Beams for the whole image (the upper limit when `time_seconds` is set).
     pub beams: u64,
     /// Optional time budget (s): stop starting new work after this long.
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub time_seconds: Option<f64>,
     /// Seed of every random stream.
     pub seed: u64,
@@ -95,7 +94,6 @@ pub struct EffectsSettings {
 #[serde(deny_unknown_fields, default)]
 pub struct OutputSettings {
     /// Base name of the files (default: the scene file's name without extension).
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
     /// Exposure of the PNG in stops (the PNG shows `linear * 2^exposure`); the EXR is unscaled.
     pub exposure: f64,
@@ -175,7 +173,8 @@ pub struct Scene {
     pub world: World,
     /// One material per shape.
     pub materials: Vec<Arc<dyn Material>>,
-    /// Whether each shape can see itself (for the effects analysis).
+    /// Whether each shape can send light to itself (every shape but a flat one), for the
+    /// effects analysis.
     pub non_convex: Vec<bool>,
     /// The lights.
     pub lights: LightSet,
@@ -257,10 +256,8 @@ impl Scene {
         let mut materials = Vec::with_capacity(file.objects.len());
         let mut non_convex = Vec::with_capacity(file.objects.len());
         for object in file.objects {
-            non_convex.push(matches!(
-                object.shape,
-                Shape::Mesh(_) | Shape::Cylinder(_) | Shape::Torus(_)
-            ));
+            // Only flat shapes can never send light to themselves; a sphere sees its own inside.
+            non_convex.push(!matches!(object.shape, Shape::Rectangle(_) | Shape::Disk(_)));
             shapes.push(object.shape);
             materials.push(Arc::from(object.material));
         }

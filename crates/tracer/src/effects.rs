@@ -7,7 +7,7 @@
 //! | dispersion | a material's index depends on wavelength | each beam carries one wavelength |
 //! | no dispersion | no such material | paths are wavelength-independent: one traced path carries a *bundle* of `BUNDLE` wavelengths (the same directions, a weight per wavelength), so colour noise falls `BUNDLE` times faster per traced path |
 //! | specular surfaces | a mirror or glass exists | specular chains are followed (caustics) |
-//! | diffuse interreflection | a second bounce can reach a non-specular surface: more than one non-specular shape, a non-convex one, or any specular shape | beams continue after a diffuse hit; otherwise they end there (the light of later bounces can never reach the film) |
+//! | diffuse interreflection | a second bounce can reach a non-specular surface: more than one non-specular shape, a non-flat one, or any specular shape | beams continue after a diffuse hit; otherwise they end there (the light of later bounces can never reach the film) |
 //!
 //! The decision is printed by the renderer and stored in its output metadata; a scene can
 //! override it (`"effects": {"mode": "off"}` simulates everything the general way, `"direct_only"`
@@ -27,7 +27,8 @@ pub struct SceneFeatures {
     pub specular: bool,
     /// Number of shapes with a non-specular material.
     pub non_specular_shapes: usize,
-    /// Some non-specular shape can see itself (non-convex: mesh, torus, open cylinder).
+    /// Some non-specular shape can send light to itself (anything but a flat shape: a sphere
+    /// seen from inside, a torus, a mesh, an open cylinder).
     pub non_convex_non_specular: bool,
 }
 
