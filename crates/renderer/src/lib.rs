@@ -453,3 +453,64 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
     write_sidecar(out_dir, &first.name, &report)?;
     Ok(report)
 }
+
+/// One row of the effects benchmark: the same scene and beams rendered with the effects
+/// analysis' decision and with everything simulated the general way.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EffectsBenchmarkRow {
+    /// The scene file.
+    pub scene: String,
+    /// The decision in words.
+    pub effects: String,
+    /// Beams per render.
+    pub beams: u64,
+    /// Wall time with the analysis' decision (s).
+    pub auto_seconds: f64,
+    /// Wall time with `effects: off` (s).
+    pub off_seconds: f64,
+    /// Wavelength samples that reached the film per second, with the decision.
+    pub auto_spectral_samples_per_second: f64,
+    /// The same with `effects: off`.
+    pub off_spectral_samples_per_second: f64,
+}
+
+/// Renders `scene` twice with the same beams and seed, with the effects analysis' decision and
+/// with `off`, and measures both (the effects benchmark behind `spectrace bench`).
+///
+/// # Errors
+/// As [`render_scene`].
+pub fn effects_benchmark(
+    scene: &Scene,
+    beams: u64,
+    threads: usize,
+) -> Result<EffectsBenchmarkRow, RenderError> {
+    let options = RenderOptions {
+        beams: Some(beams),
+        threads: Some(threads),
+        seed: Some(1),
+        ..RenderOptions::default()
+    };
+    let plan = plan_for(scene, &options)?;
+    let measure = |mode: EffectsMode| -> Result<(f64, f64, Effects), RenderError> {
+        let effects = decide_effects(scene, Some(mode));
+        let started = Instant::now();
+        let out = render(&tracer_scene(scene), &scene.tracer_settings(), &effects, &plan, &|_| {})
+            .map_err(|e| RenderError::Options(e.to_string()))?;
+        let seconds = started.elapsed().as_secs_f64();
+        scene.lights.reset_count();
+        // Every splat carries `wavelengths_per_path` spectral samples.
+        let samples = out.stats.splats as f64 * effects.wavelengths_per_path as f64;
+        Ok((seconds, samples / seconds.max(1e-9), effects))
+    };
+    let (auto_seconds, auto_rate, effects) = measure(EffectsMode::Auto)?;
+    let (off_seconds, off_rate, _) = measure(EffectsMode::Off)?;
+    Ok(EffectsBenchmarkRow {
+        scene: scene.path.display().to_string(),
+        effects: effects.summary(),
+        beams,
+        auto_seconds,
+        off_seconds,
+        auto_spectral_samples_per_second: auto_rate,
+        off_spectral_samples_per_second: off_rate,
+    })
+}

@@ -52,6 +52,18 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Measure beams/s of scenes, and what the effects analysis saves (auto against off).
+    Bench {
+        /// Scene files.
+        #[arg(required = true)]
+        scenes: Vec<PathBuf>,
+        /// Beams per render.
+        #[arg(long, default_value_t = 1_000_000)]
+        beams: u64,
+        /// Worker threads (0: one per core).
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+    },
     /// Merge partial films (from `render --shard`) into the final outputs.
     Merge {
         /// The partial films (.bin).
@@ -82,6 +94,35 @@ fn parse_effects(s: &str) -> Result<EffectsMode, String> {
     }
 }
 
+/// `spectrace bench`: a Markdown table of beams/s per scene with and without the effects
+/// analysis.
+fn bench(scenes: &[PathBuf], beams: u64, threads: usize) -> ExitCode {
+    println!(
+        "| scene | effects decision | beams/s (auto) | beams/s (off) | spectral samples on film per s, auto / off |"
+    );
+    println!("|---|---|---|---|---|");
+    for path in scenes {
+        let row = spectrace_renderer::Scene::load(path)
+            .map_err(spectrace_renderer::RenderError::from)
+            .and_then(|scene| spectrace_renderer::effects_benchmark(&scene, beams, threads));
+        match row {
+            Ok(r) => println!(
+                "| {} | {} | {:.3e} | {:.3e} | {:.2}x |",
+                r.scene,
+                r.effects,
+                r.beams as f64 / r.auto_seconds,
+                r.beams as f64 / r.off_seconds,
+                r.auto_spectral_samples_per_second / r.off_spectral_samples_per_second.max(1e-300)
+            ),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::from(2);
+            }
+        }
+    }
+    ExitCode::SUCCESS
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
@@ -99,6 +140,7 @@ fn main() -> ExitCode {
             render_file(&scene, &options)
         }
         Command::Merge { parts, out } => merge_parts(&parts, &out),
+        Command::Bench { scenes, beams, threads } => return bench(&scenes, beams, threads),
     };
     match result {
         Ok(report) => {
