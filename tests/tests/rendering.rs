@@ -344,3 +344,47 @@ fn every_shipped_scene_renders_without_rejected_contributions() {
     }
     assert!(count >= 1, "no scenes found in {}", scenes_dir.display());
 }
+
+#[test]
+fn closed_white_box_loses_no_power() {
+    // Reflectance 1 everywhere and no way out: every beam must bounce until the depth limit, never
+    // escape through a seam, and never be ended by Russian roulette (its weight stays 1).
+    let wall = |corner: [f64; 3], u: [f64; 3], v: [f64; 3]| {
+        format!(
+            r#"{{"shape": {{"type": "Rectangle", "corner": {corner:?}, "edge_u": {u:?}, "edge_v": {v:?}}}, "material": {{"type": "Diffuse", "reflectance": 1.0}}}}"#
+        )
+    };
+    let walls = [
+        wall([-1.0, -1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 0.0, 2.0]),
+        wall([-1.0, 1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 0.0, 2.0]),
+        wall([-1.0, -1.0, -1.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]),
+        wall([1.0, -1.0, -1.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]),
+        wall([-1.0, -1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]),
+        wall([-1.0, -1.0, 1.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]),
+    ];
+    let json = format!(
+        r#"{{"camera": {{"position": [0, 0, 0.5], "look_at": [0, 0, -1], "fov": 90, "width": 8, "height": 8}},
+            "objects": [{}],
+            "lights": [{{"type": "PointLight", "position": [0.3, 0.2, -0.1], "power": 1, "spd": {{"type": "Uniform"}}}}],
+            "settings": {{"max_depth": 40, "rr_depth": 2}}}}"#,
+        walls.join(",")
+    );
+    let s = scene(&json);
+    let effects = decide_effects(&s, None);
+    assert!(effects.continue_after_diffuse);
+    let mut film = spectrace_tracer::Film::new(8, 8).unwrap();
+    let beams = 5_000;
+    let stats = spectrace_tracer::trace_chunk(
+        &tracer_scene(&s),
+        &s.tracer_settings(),
+        &effects,
+        3,
+        0,
+        beams,
+        &mut film,
+    );
+    assert_eq!(stats.roulette_kills, 0);
+    assert_eq!(stats.depth_limited, beams, "a beam escaped or was absorbed");
+    assert_eq!(stats.hits, beams * 41);
+    assert_eq!(film.rejected(), 0);
+}
