@@ -1,10 +1,17 @@
-//! Camera, spectral film and integrators of Spectrace (issue 5, in progress).
+//! Camera, spectral film and integrators of Spectrace; today the light tracer (seed 2.4.4).
 //!
-//! Today this crate holds the film: [`Film`] accumulates CIE XYZ per pixel from spectral
-//! contributions in exact fixed-point sums ([`ExactSum`]), so an image is bit-identical whatever
-//! the order in which work chunks, threads or machines add to it. [`PinholeCamera`] defines the
-//! film units (mean spectral radiance over a pixel's area) and projects scene points into the
-//! film with the importance a light-tracing connection needs. The light tracer joins them next.
+//! This crate sits on all the others (sampling, spectrum, lights, geometry, materials) and under
+//! the renderer. Beams come from a [`spectrace_lights::LightSet`], travel through a
+//! [`spectrace_geometry::World`], scatter by each shape's [`spectrace_materials::Material`], and
+//! every non-specular hit (and every emission point) is connected to the [`PinholeCamera`] and
+//! splatted into the [`Film`] (see [`light_tracer`](trace_chunk) for the estimator).
+//!
+//! The key design decisions: the film adds contributions in exact fixed point ([`ExactSum`]), so
+//! an image is bit-identical whatever the thread count, chunk order or number of machines
+//! ([`render`] splits work into chunks with their own random streams; sharded renders merge
+//! exactly); and an [`Effects`] analysis decides, before rendering, what the scene needs (a bundle
+//! of wavelengths per path when nothing is dispersive; beams that stop at the first diffuse hit
+//! when no interreflection is possible), reports it, and can be overridden.
 
 mod camera;
 mod effects;
