@@ -1,1 +1,1330 @@
-//! What accuracy costs in time: error-against-time sweeps of every accuracy knob (being written).
+//! What accuracy costs in time: error-against-time sweeps of every accuracy knob.
+//!
+//! [`run`] renders, for each scene, a *reference* image once at high effort (the scene as written,
+//! effects analysis on; cached on disk with the settings that made it), then sweeps the number of
+//! beams (doubling from [`AccuracyOptions::start_beams`]) for each [`Configuration`]:
+//!
+//! | configuration | what changes |
+//! |---|---|
+//! | `baseline` | nothing: the scene as written, effects analysis `auto` |
+//! | `equal_wavelengths` | every light draws its wavelengths uniformly with weights (`"wavelength_sampling": "equal_wavelengths"`) instead of by importance |
+//! | `piecewise_constant_spd` | every `Tabulated` SPD of the lights (and every tabulated `CieIlluminant`) becomes the seed's "choppy" `Binned` SPD: bins centred on the table's nodes, the same values |
+//! | `effects_off` | the effects analysis off (one wavelength per path, beams continue after diffuse hits) |
+//!
+//! Each point records the wall time of the render alone and the relative RMSE of the XYZ image
+//! against the reference, `sqrt(sum |xyz - ref|^2 / sum |ref|^2)` over all pixels. Monte Carlo
+//! error falls as `time^(-1/2)`; the report fits the slope of log error against log time per
+//! configuration and puts it beside -1/2 (a flatter slope means bias, as with a changed spectrum,
+//! or fixed costs that do not scale with beams).
+//!
+//! Outputs: `accuracy.md` (a table per scene, the slopes, and which configuration reaches a given
+//! error fastest) and `accuracy.svg` (log-log plot of error against time, one line per scene and
+//! configuration, with a dashed line of slope -1/2), both in [`AccuracyOptions::out_dir`].
+//!
+//! To keep the default run short, [`AccuracyOptions::max_width`] scales the camera resolution down
+//! (editing the scene JSON's `camera.width`/`camera.height` before it is parsed, keeping the aspect
+//! ratio); the field of view is unchanged, so the image shows the same view with fewer pixels.
+//!
+//! Later integrators join the same report as further [`Configuration`]s.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+use serde_json::{Map, Value};
+use spectrace_lights::LightSource;
+use spectrace_spectrum::{CieIlluminant, SpectralPowerDistribution, Xyz};
+use spectrace_tracer::{EffectsMode, render};
+
+use crate::{RenderOptions, Scene, decide_effects, image, plan_for, tracer_scene};
+
+/// Settings of an accuracy run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AccuracyOptions {
+    /// The scene files.
+    pub scenes: Vec<PathBuf>,
+    /// Where `accuracy.md` and `accuracy.svg` go (default `docs`).
+    pub out_dir: PathBuf,
+    /// Where reference images are cached (default `target/accuracy-cache`).
+    pub cache_dir: PathBuf,
+    /// Beams of the reference image (default 2^25; keep it at least 16 times the largest sweep
+    /// point, so the reference's own noise adds at most ~3% to the measured errors).
+    pub reference_beams: u64,
+    /// Beams of the first sweep point (default 2^14).
+    pub start_beams: u64,
+    /// Sweep points per configuration: `start_beams * 2^k` for `k < steps` (default 8).
+    pub steps: u32,
+    /// Worker threads (0: one per core, the default).
+    pub threads: usize,
+    /// Seed of the reference; the sweep points use seeds derived from it (never equal to it).
+    pub seed: u64,
+    /// Scale the camera down to at most this many pixels wide, keeping the aspect ratio (default
+    /// `Some(240)`; `None` renders at the scene's own resolution).
+    pub max_width: Option<u32>,
+}
+
+impl Default for AccuracyOptions {
+    /// Settings measured to finish in about a minute per small scene on 2 shared cores
+    /// (`scenes/fading_spot.json`: see `docs/accuracy.md`), so 2-3 scenes stay under 10 minutes.
+    fn default() -> Self {
+        Self {
+            scenes: default_scenes(),
+            out_dir: PathBuf::from("docs"),
+            cache_dir: PathBuf::from("target/accuracy-cache"),
+            reference_beams: 1 << 25,
+            start_beams: 1 << 14,
+            steps: 8,
+            threads: 0,
+            seed: 0x5EED_ACC0,
+            max_width: Some(240),
+        }
+    }
+}
+
+/// The scenes of the default report: those of `scenes/fading_spot.json`, `scenes/cornell.json`
+/// and `scenes/prism.json` that exist (paths relative to the working directory).
+pub fn default_scenes() -> Vec<PathBuf> {
+    ["scenes/fading_spot.json", "scenes/cornell.json", "scenes/prism.json"]
+        .iter()
+        .map(PathBuf::from)
+        .filter(|p| p.is_file())
+        .collect()
+}
+
+/// One accuracy knob setting the sweep renders.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Configuration {
+    /// The scene as written, effects analysis `auto`.
+    Baseline,
+    /// Every light samples wavelengths uniformly with weights.
+    EqualWavelengths,
+    /// Every tabulated SPD of the lights becomes piecewise constant (the seed's `Binned`).
+    PiecewiseConstantSpd,
+    /// The effects analysis off.
+    EffectsOff,
+}
+
+impl Configuration {
+    /// Every configuration, in report order.
+    pub const ALL: [Configuration; 4] = [
+        Configuration::Baseline,
+        Configuration::EqualWavelengths,
+        Configuration::PiecewiseConstantSpd,
+        Configuration::EffectsOff,
+    ];
+
+    /// The name used in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Configuration::Baseline => "baseline",
+            Configuration::EqualWavelengths => "equal_wavelengths",
+            Configuration::PiecewiseConstantSpd => "piecewise_constant_spd",
+            Configuration::EffectsOff => "effects_off",
+        }
+    }
+
+    /// What the configuration changes, in words.
+    pub fn description(self) -> &'static str {
+        match self {
+            Configuration::Baseline => {
+                "the scene as written: wavelengths by importance, SPDs as given, effects analysis auto"
+            }
+            Configuration::EqualWavelengths => {
+                "every light draws wavelengths uniformly over its SPD's range, weighted by the SPD \
+                 (lights whose SPD has delta lines keep importance sampling)"
+            }
+            Configuration::PiecewiseConstantSpd => {
+                "every Tabulated SPD of the lights (and every tabulated CieIlluminant) replaced by a \
+                 Binned SPD with bins centred on the table's nodes and the same values: the seed's \
+                 choppy generator instead of piecewise linear"
+            }
+            Configuration::EffectsOff => {
+                "effects analysis off: one wavelength per path, beams continue after diffuse hits"
+            }
+        }
+    }
+
+    fn effects_mode(self) -> EffectsMode {
+        match self {
+            Configuration::EffectsOff => EffectsMode::Off,
+            _ => EffectsMode::Auto,
+        }
+    }
+}
+
+/// One rendered sweep point.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct AccuracyPoint {
+    /// Beams traced.
+    pub beams: u64,
+    /// Seed of the render.
+    pub seed: u64,
+    /// Wall time of the render alone (s).
+    pub seconds: f64,
+    /// Relative RMSE of XYZ against the reference.
+    pub relative_rmse: f64,
+}
+
+/// The sweep of one configuration on one scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ConfigurationResult {
+    /// Which configuration.
+    pub configuration: Configuration,
+    /// What the rewrite changed in this scene (e.g. "2 lights"), empty for none.
+    pub changed: String,
+    /// Why the configuration does not apply to this scene (then `points` is empty).
+    pub not_applicable: Option<String>,
+    /// The sweep, by increasing beams.
+    pub points: Vec<AccuracyPoint>,
+    /// Least-squares slope of log error against log time (-1/2 for plain Monte Carlo).
+    pub slope_vs_time: Option<f64>,
+    /// Least-squares slope of log error against log beams (-1/2 for plain Monte Carlo).
+    pub slope_vs_beams: Option<f64>,
+}
+
+/// The reference image of a scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ReferenceInfo {
+    /// Beams.
+    pub beams: u64,
+    /// Seed.
+    pub seed: u64,
+    /// Wall time of its render (s), as recorded when it was made.
+    pub seconds: f64,
+    /// Whether it was read from the cache.
+    pub cached: bool,
+    /// The cache file.
+    pub file: String,
+}
+
+/// The results of one scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SceneResult {
+    /// The scene file, as given.
+    pub scene: String,
+    /// A short name (the file stem).
+    pub name: String,
+    /// Image width used (after [`AccuracyOptions::max_width`]).
+    pub width: u32,
+    /// Image height used.
+    pub height: u32,
+    /// The baseline's effects decision.
+    pub effects_summary: String,
+    /// The reference.
+    pub reference: ReferenceInfo,
+    /// One sweep per configuration.
+    pub configurations: Vec<ConfigurationResult>,
+}
+
+/// Everything an accuracy run measured.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AccuracyReport {
+    /// Worker threads used.
+    pub threads: usize,
+    /// The options of the run.
+    pub options: AccuracyOptions,
+    /// One entry per scene.
+    pub scenes: Vec<SceneResult>,
+    /// Wall time of the whole run (s).
+    pub total_seconds: f64,
+    /// Files written.
+    pub files: Vec<String>,
+}
+
+/// The Monte Carlo expectation for the slope of log error against log time.
+pub const EXPECTED_SLOPE: f64 = -0.5;
+
+/// A round error target the report also names the fastest configuration for (10%: reached within
+/// the default sweep on the small scenes, so the answer is interpolated, not extrapolated).
+pub const ROUND_TARGET: f64 = 0.10;
+
+/// Times within this factor of the fastest are reported as a tie: single timings on a shared
+/// machine vary by about this much.
+pub const TIE_FACTOR: f64 = 1.15;
+
+/// Runs the sweeps, writes `accuracy.md` and `accuracy.svg` into `options.out_dir`, and returns
+/// the measurements. Progress goes to stderr.
+///
+/// # Errors
+/// A message for invalid options, a scene that cannot be loaded or renders black, or a file
+/// that cannot be written.
+pub fn run(options: &AccuracyOptions) -> Result<AccuracyReport, String> {
+    let started = Instant::now();
+    if options.scenes.is_empty() {
+        return Err("accuracy: no scenes given (and none of the default scenes exists)".to_owned());
+    }
+    if options.start_beams == 0 || options.steps == 0 || options.reference_beams == 0 {
+        return Err(
+            "accuracy: reference_beams, start_beams and steps must be at least 1".to_owned()
+        );
+    }
+    let largest = options
+        .start_beams
+        .checked_mul(1u64 << (options.steps - 1).min(62))
+        .filter(|_| options.steps <= 63)
+        .ok_or("accuracy: start_beams * 2^(steps - 1) overflows")?;
+    if largest >= options.reference_beams {
+        eprintln!(
+            "accuracy: warning: the largest sweep point ({largest} beams) is not below the \
+             reference ({} beams); errors will be dominated by the reference's own noise",
+            options.reference_beams
+        );
+    }
+    let threads = if options.threads == 0 {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    } else {
+        options.threads
+    };
+    let mut scenes = Vec::new();
+    for path in &options.scenes {
+        scenes.push(run_scene(path, options, threads)?);
+    }
+    std::fs::create_dir_all(&options.out_dir)
+        .map_err(|e| format!("{}: {e}", options.out_dir.display()))?;
+    let md_path = options.out_dir.join("accuracy.md");
+    let svg_path = options.out_dir.join("accuracy.svg");
+    let mut report = AccuracyReport {
+        threads,
+        options: options.clone(),
+        scenes,
+        total_seconds: 0.0,
+        files: vec![md_path.display().to_string(), svg_path.display().to_string()],
+    };
+    write_plot(&report, &svg_path)?;
+    report.total_seconds = started.elapsed().as_secs_f64();
+    std::fs::write(&md_path, markdown(&report))
+        .map_err(|e| format!("{}: {e}", md_path.display()))?;
+    eprintln!(
+        "accuracy: wrote {} and {} in {:.1} s",
+        md_path.display(),
+        svg_path.display(),
+        report.total_seconds
+    );
+    Ok(report)
+}
+
+/// A configuration's scene, ready to render, or why it does not apply.
+struct Prepared {
+    configuration: Configuration,
+    changed: String,
+    scene: Result<Scene, String>,
+}
+
+fn run_scene(
+    path: &Path,
+    options: &AccuracyOptions,
+    threads: usize,
+) -> Result<SceneResult, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+    let mut json: Value = serde_json::from_str(&text)
+        .map_err(|e| format!("{}: not valid JSON: {e}", path.display()))?;
+    if let Some(max_width) = options.max_width {
+        limit_resolution(&mut json, max_width);
+    }
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene".to_owned());
+    let baseline = parse(&json, path).map_err(|e| format!("accuracy: {e}"))?;
+    let (width, height) = (baseline.camera.width(), baseline.camera.height());
+    let effects_summary = decide_effects(&baseline, Some(EffectsMode::Auto)).summary();
+    eprintln!("accuracy: {name}: {width}x{height} pixels; {effects_summary}");
+
+    // Warm-up (page faults, thread start-up) so the first timed point is not penalised.
+    render_xyz(&baseline, EffectsMode::Auto, options.start_beams, options.seed ^ 0xFFFF, threads)?;
+
+    let key = cache_key(&text, options.reference_beams, options.seed, width, height);
+    let cache_file = options.cache_dir.join(format!("{name}-{key:016x}.xyz"));
+    let (reference, reference_seconds, cached) = match read_reference(&cache_file, width, height) {
+        Some((image, seconds)) => {
+            eprintln!(
+                "accuracy: {name}: reference {} beams from the cache ({})",
+                options.reference_beams,
+                cache_file.display()
+            );
+            (image, seconds, true)
+        }
+        None => {
+            eprintln!(
+                "accuracy: {name}: rendering the reference, {} beams...",
+                options.reference_beams
+            );
+            let (image, seconds) = render_xyz(
+                &baseline,
+                EffectsMode::Auto,
+                options.reference_beams,
+                options.seed,
+                threads,
+            )?;
+            eprintln!("accuracy: {name}: reference took {seconds:.1} s");
+            write_reference(&cache_file, width, height, options.reference_beams, seconds, &image)?;
+            (image, seconds, false)
+        }
+    };
+    if reference.iter().all(|p| p.x == 0.0 && p.y == 0.0 && p.z == 0.0) {
+        return Err(format!(
+            "accuracy: {}: the reference image is black; no light reaches the camera",
+            path.display()
+        ));
+    }
+
+    let mut prepared = vec![Prepared {
+        configuration: Configuration::Baseline,
+        changed: String::new(),
+        scene: Ok(baseline),
+    }];
+    for configuration in Configuration::ALL.into_iter().skip(1) {
+        let (changed, scene) = match rewrite(configuration, &json) {
+            Ok((changed, rewritten)) => (
+                changed,
+                parse(&rewritten, path)
+                    .map_err(|e| format!("the rewritten scene is rejected: {e}")),
+            ),
+            Err(reason) => (String::new(), Err(reason)),
+        };
+        if let Err(reason) = &scene {
+            eprintln!("accuracy: {name}: {} not applicable: {reason}", configuration.name());
+        }
+        prepared.push(Prepared { configuration, changed, scene });
+    }
+
+    // Beam counts in the outer loop, configurations inside: slow drifts of a shared machine's
+    // speed then spread over every configuration instead of biasing one.
+    let mut points: Vec<Vec<AccuracyPoint>> = vec![Vec::new(); prepared.len()];
+    for k in 0..options.steps {
+        let beams = options.start_beams << k;
+        for (c, p) in prepared.iter().enumerate() {
+            let Ok(scene) = &p.scene else { continue };
+            let seed = sweep_seed(options.seed, c as u64, u64::from(k));
+            let (xyz, seconds) =
+                render_xyz(scene, p.configuration.effects_mode(), beams, seed, threads)?;
+            let relative_rmse = relative_rmse(&xyz, &reference)?;
+            eprintln!(
+                "accuracy: {name}: {:<22} {beams:>10} beams {seconds:>8.3} s  error {:.3}%",
+                p.configuration.name(),
+                relative_rmse * 100.0
+            );
+            points[c].push(AccuracyPoint { beams, seed, seconds, relative_rmse });
+        }
+    }
+    let configurations = prepared
+        .into_iter()
+        .zip(points)
+        .map(|(p, points)| {
+            let log = |f: fn(&AccuracyPoint) -> f64| -> Vec<(f64, f64)> {
+                points.iter().map(|q| (f(q).ln(), q.relative_rmse.ln())).collect()
+            };
+            ConfigurationResult {
+                configuration: p.configuration,
+                changed: p.changed,
+                not_applicable: p.scene.err(),
+                slope_vs_time: fit_slope(&log(|q| q.seconds)),
+                slope_vs_beams: fit_slope(&log(|q| q.beams as f64)),
+                points,
+            }
+        })
+        .collect();
+    Ok(SceneResult {
+        scene: path.display().to_string(),
+        name,
+        width,
+        height,
+        effects_summary,
+        reference: ReferenceInfo {
+            beams: options.reference_beams,
+            seed: options.seed,
+            seconds: reference_seconds,
+            cached,
+            file: cache_file.display().to_string(),
+        },
+        configurations,
+    })
+}
+
+fn parse(json: &Value, path: &Path) -> Result<Scene, String> {
+    let text = serde_json::to_string(json).map_err(|e| e.to_string())?;
+    Scene::from_json(&text, path).map_err(|e| e.to_string())
+}
+
+/// Renders `beams` beams and returns the XYZ image and the wall time of the render alone.
+fn render_xyz(
+    scene: &Scene,
+    mode: EffectsMode,
+    beams: u64,
+    seed: u64,
+    threads: usize,
+) -> Result<(Vec<Xyz>, f64), String> {
+    let options = RenderOptions {
+        beams: Some(beams),
+        seed: Some(seed),
+        threads: Some(threads),
+        effects: Some(mode),
+        ..RenderOptions::default()
+    };
+    let mut plan = plan_for(scene, &options).map_err(|e| e.to_string())?;
+    // At least ~16 chunks per render, so small sweep points use every thread too; the chunk size
+    // depends on the beams alone, so a cached reference stays valid whatever the thread count.
+    plan.chunk_beams = (beams / 16).clamp(1, plan.chunk_beams.max(1024)).min(plan.chunk_beams);
+    let effects = decide_effects(scene, Some(mode));
+    let tracer = tracer_scene(scene);
+    let settings = scene.tracer_settings();
+    scene.lights.reset_count();
+    let started = Instant::now();
+    let output = render(&tracer, &settings, &effects, &plan, &|_| {}).map_err(|e| e.to_string())?;
+    let seconds = started.elapsed().as_secs_f64();
+    scene.lights.reset_count();
+    Ok((image(&output, scene.lights.power()), seconds))
+}
+
+/// Relative RMSE of an XYZ image against a reference:
+/// `sqrt(sum |xyz - ref|^2 / sum |ref|^2)` over all pixels and the three channels.
+///
+/// # Errors
+/// A message when the sizes differ or the reference is black.
+pub fn relative_rmse(image: &[Xyz], reference: &[Xyz]) -> Result<f64, String> {
+    if image.len() != reference.len() {
+        return Err(format!(
+            "image of {} pixels against a reference of {}",
+            image.len(),
+            reference.len()
+        ));
+    }
+    let (mut diff, mut norm) = (0.0, 0.0);
+    for (a, r) in image.iter().zip(reference) {
+        diff += (a.x - r.x).powi(2) + (a.y - r.y).powi(2) + (a.z - r.z).powi(2);
+        norm += r.x * r.x + r.y * r.y + r.z * r.z;
+    }
+    if !(norm > 0.0) {
+        return Err("the reference image is black".to_owned());
+    }
+    Ok((diff / norm).sqrt())
+}
+
+/// Least-squares slope of `y` against `x` (`None` for fewer than two distinct `x` or
+/// non-finite values).
+fn fit_slope(points: &[(f64, f64)]) -> Option<f64> {
+    if points.len() < 2 || points.iter().any(|(x, y)| !x.is_finite() || !y.is_finite()) {
+        return None;
+    }
+    let n = points.len() as f64;
+    let mx = points.iter().map(|p| p.0).sum::<f64>() / n;
+    let my = points.iter().map(|p| p.1).sum::<f64>() / n;
+    let sxx: f64 = points.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let sxy: f64 = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
+/// splitmix64's finaliser.
+fn mix(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// The seed of sweep point `k` of configuration `c`: derived from the reference seed, never
+/// equal to it.
+fn sweep_seed(seed: u64, c: u64, k: u64) -> u64 {
+    let s = mix(seed ^ mix(0x9E37_79B9_7F4A_7C15 ^ (c << 32) ^ k));
+    if s == seed { s ^ 1 } else { s }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Scene rewrites on the JSON.
+
+/// Scales `camera.width`/`camera.height` so the width is at most `max_width`, keeping the aspect
+/// ratio. Returns whether it changed anything.
+fn limit_resolution(json: &mut Value, max_width: u32) -> bool {
+    let Some(camera) = json.get_mut("camera").and_then(Value::as_object_mut) else {
+        return false;
+    };
+    let (Some(w), Some(h)) =
+        (camera.get("width").and_then(Value::as_u64), camera.get("height").and_then(Value::as_u64))
+    else {
+        return false;
+    };
+    let max = u64::from(max_width.max(1));
+    if w <= max {
+        return false;
+    }
+    let new_h = ((h as f64 * max as f64 / w as f64).round() as u64).max(1);
+    camera.insert("width".to_owned(), Value::from(max));
+    camera.insert("height".to_owned(), Value::from(new_h));
+    true
+}
+
+/// Calls `f` on every light object, recursing into `LightSet`s.
+fn for_each_light(json: &mut Value, f: &mut dyn FnMut(&mut Map<String, Value>)) {
+    fn visit(light: &mut Value, f: &mut dyn FnMut(&mut Map<String, Value>)) {
+        let Value::Object(map) = light else { return };
+        if map.get("type").and_then(Value::as_str) == Some("LightSet") {
+            if let Some(Value::Array(inner)) = map.get_mut("lights") {
+                for l in inner {
+                    visit(l, f);
+                }
+            }
+        } else {
+            f(map);
+        }
+    }
+    if let Some(Value::Array(lights)) = json.get_mut("lights") {
+        for l in lights {
+            visit(l, f);
+        }
+    }
+}
+
+/// Whether an SPD's JSON contains a delta line (`Monochromatic`, also inside a `Mixture`).
+fn spd_has_delta(spd: &Value) -> bool {
+    match spd.get("type").and_then(Value::as_str) {
+        Some("Monochromatic") => true,
+        Some("Mixture") => spd
+            .get("components")
+            .and_then(Value::as_array)
+            .is_some_and(|c| c.iter().any(|c| c.get("spd").is_some_and(spd_has_delta))),
+        _ => false,
+    }
+}
+
+/// Sets `"wavelength_sampling": "equal_wavelengths"` on every light without delta lines.
+/// Returns (lights changed, lights skipped for delta lines).
+fn set_equal_wavelengths(json: &mut Value) -> (usize, usize) {
+    let (mut changed, mut skipped) = (0, 0);
+    for_each_light(json, &mut |light| {
+        if light.get("spd").is_some_and(spd_has_delta) {
+            skipped += 1;
+        } else if light.get("wavelength_sampling").and_then(Value::as_str)
+            != Some("equal_wavelengths")
+        {
+            light.insert("wavelength_sampling".to_owned(), Value::from("equal_wavelengths"));
+            changed += 1;
+        }
+    });
+    (changed, skipped)
+}
+
+/// A piecewise-constant `Binned` SPD with bins centred on `nm` and the given values.
+fn binned_from_nodes(nm: &[f64], values: &[f64]) -> Option<Value> {
+    let n = nm.len();
+    if n < 2 || values.len() != n {
+        return None;
+    }
+    let mut edges = Vec::with_capacity(n + 1);
+    let first = nm[0] - 0.5 * (nm[1] - nm[0]);
+    edges.push(if first > 0.0 { first } else { nm[0] });
+    edges.extend(nm.windows(2).map(|w| 0.5 * (w[0] + w[1])));
+    edges.push(nm[n - 1] + 0.5 * (nm[n - 1] - nm[n - 2]));
+    let mut map = Map::new();
+    map.insert("type".to_owned(), Value::from("Binned"));
+    map.insert("edges_nm".to_owned(), Value::from(edges));
+    map.insert("values".to_owned(), Value::from(values.to_vec()));
+    Some(Value::Object(map))
+}
+
+fn numbers(v: Option<&Value>) -> Option<Vec<f64>> {
+    v?.as_array()?.iter().map(Value::as_f64).collect()
+}
+
+/// Rewrites tabulated SPDs (recursing into mixtures) into `Binned` ones; returns how many.
+fn binned_spd(spd: &mut Value) -> usize {
+    match spd.get("type").and_then(Value::as_str) {
+        Some("Tabulated") => {
+            let nm = numbers(spd.get("nm"));
+            let values = numbers(spd.get("values"));
+            match nm.zip(values).and_then(|(nm, values)| binned_from_nodes(&nm, &values)) {
+                Some(binned) => {
+                    *spd = binned;
+                    1
+                }
+                None => 0,
+            }
+        }
+        Some("CieIlluminant") => {
+            // The tabulated illuminants (D series, F series) are piecewise linear between their
+            // nodes; A (a formula) and E (constant) have no table and stay as they are.
+            let Some(name) = spd.get("name").and_then(Value::as_str) else { return 0 };
+            let Ok(illuminant) = CieIlluminant::new(name) else { return 0 };
+            let nodes = illuminant.breakpoints();
+            if nodes.len() < 3 {
+                return 0;
+            }
+            let values: Vec<f64> = nodes.iter().map(|&l| illuminant.value(l)).collect();
+            match binned_from_nodes(&nodes, &values) {
+                Some(binned) => {
+                    *spd = binned;
+                    1
+                }
+                None => 0,
+            }
+        }
+        Some("Mixture") => {
+            spd.get_mut("components").and_then(Value::as_array_mut).map_or(0, |components| {
+                components.iter_mut().filter_map(|c| c.get_mut("spd")).map(binned_spd).sum()
+            })
+        }
+        _ => 0,
+    }
+}
+
+/// Rewrites every tabulated SPD of the lights as `Binned`; returns (SPDs rewritten, lights
+/// touched).
+fn set_piecewise_constant(json: &mut Value) -> (usize, usize) {
+    let (mut spds, mut lights) = (0, 0);
+    for_each_light(json, &mut |light| {
+        if let Some(spd) = light.get_mut("spd") {
+            let n = binned_spd(spd);
+            spds += n;
+            lights += usize::from(n > 0);
+        }
+    });
+    (spds, lights)
+}
+
+/// The scene JSON of a configuration and what changed, or why it does not apply.
+fn rewrite(configuration: Configuration, json: &Value) -> Result<(String, Value), String> {
+    let mut out = json.clone();
+    match configuration {
+        Configuration::Baseline | Configuration::EffectsOff => Ok((String::new(), out)),
+        Configuration::EqualWavelengths => match set_equal_wavelengths(&mut out) {
+            (0, 0) => Err("every light already samples equal wavelengths".to_owned()),
+            (0, _) => {
+                Err("every light's SPD contains delta lines (no density to weight by)".to_owned())
+            }
+            (changed, 0) => Ok((format!("{changed} light(s)"), out)),
+            (changed, skipped) => Ok((
+                format!("{changed} light(s); {skipped} with delta lines left on importance"),
+                out,
+            )),
+        },
+        Configuration::PiecewiseConstantSpd => match set_piecewise_constant(&mut out) {
+            (0, _) => {
+                Err("no light has a Tabulated SPD or a tabulated CieIlluminant (nothing piecewise \
+                 linear to make piecewise constant)"
+                    .to_owned())
+            }
+            (spds, lights) => Ok((format!("{spds} SPD(s) in {lights} light(s)"), out)),
+        },
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The reference cache.
+
+const CACHE_MAGIC: &[u8; 8] = b"SPXYZREF";
+const CACHE_VERSION: u32 = 1;
+const CACHE_HEADER: usize = 8 + 4 + 4 + 4 + 8 + 8;
+
+/// FNV-1a over the scene file and the reference's settings (and the crate version, so a changed
+/// tracer renders a new reference).
+fn cache_key(scene_text: &str, beams: u64, seed: u64, width: u32, height: u32) -> u64 {
+    let settings = format!(
+        "|beams={beams}|seed={seed}|{width}x{height}|v{}|cache{CACHE_VERSION}",
+        env!("CARGO_PKG_VERSION")
+    );
+    scene_text
+        .bytes()
+        .chain(settings.bytes())
+        .fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
+}
+
+/// Layout (little-endian): magic, version u32, width u32, height u32, beams u64, seconds f64,
+/// then x, y, z f64 per pixel, row-major.
+fn write_reference(
+    path: &Path,
+    width: u32,
+    height: u32,
+    beams: u64,
+    seconds: f64,
+    image: &[Xyz],
+) -> Result<(), String> {
+    let mut bytes = Vec::with_capacity(CACHE_HEADER + image.len() * 24);
+    bytes.extend_from_slice(CACHE_MAGIC);
+    bytes.extend_from_slice(&CACHE_VERSION.to_le_bytes());
+    bytes.extend_from_slice(&width.to_le_bytes());
+    bytes.extend_from_slice(&height.to_le_bytes());
+    bytes.extend_from_slice(&beams.to_le_bytes());
+    bytes.extend_from_slice(&seconds.to_le_bytes());
+    for p in image {
+        for v in [p.x, p.y, p.z] {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    }
+    std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// The cached image and its render time, if the file exists and matches the size.
+fn read_reference(path: &Path, width: u32, height: u32) -> Option<(Vec<Xyz>, f64)> {
+    let bytes = std::fs::read(path).ok()?;
+    let pixels = width as usize * height as usize;
+    if bytes.len() != CACHE_HEADER + pixels * 24 || &bytes[..8] != CACHE_MAGIC {
+        return None;
+    }
+    let u32_at = |i: usize| bytes.get(i..i + 4)?.try_into().ok().map(u32::from_le_bytes);
+    let f64_at = |i: usize| bytes.get(i..i + 8)?.try_into().ok().map(f64::from_le_bytes);
+    if u32_at(8)? != CACHE_VERSION || u32_at(12)? != width || u32_at(16)? != height {
+        return None;
+    }
+    let seconds = f64_at(28)?;
+    let image = (0..pixels)
+        .map(|i| {
+            let at = CACHE_HEADER + i * 24;
+            Some(Xyz::new(f64_at(at)?, f64_at(at + 8)?, f64_at(at + 16)?))
+        })
+        .collect::<Option<Vec<_>>>()?;
+    Some((image, seconds))
+}
+
+// ---------------------------------------------------------------------------------------------
+// Analysis and the report.
+
+/// How long a configuration takes to reach an error.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Reach {
+    /// Interpolated between two sweep points (log-log).
+    Interpolated(f64),
+    /// Already below the target at the first point: at most this long.
+    AtMost(f64),
+    /// Beyond the sweep, extrapolated along the fitted slope.
+    Extrapolated(f64),
+    /// Not reached, and the error does not fall clearly enough to extrapolate.
+    NotReached,
+}
+
+impl Reach {
+    fn seconds(self) -> Option<f64> {
+        match self {
+            Reach::Interpolated(t) | Reach::AtMost(t) | Reach::Extrapolated(t) => Some(t),
+            Reach::NotReached => None,
+        }
+    }
+
+    fn describe(self) -> String {
+        match self {
+            Reach::Interpolated(t) => format!("{} s", sig(t)),
+            Reach::AtMost(t) => format!("<= {} s (first point)", sig(t)),
+            Reach::Extrapolated(t) => format!("~{} s (extrapolated)", sig(t)),
+            Reach::NotReached => "not reached (error stops falling)".to_owned(),
+        }
+    }
+}
+
+fn time_to_reach(result: &ConfigurationResult, target: f64) -> Reach {
+    let pts = &result.points;
+    let Some(first) = pts.first() else { return Reach::NotReached };
+    if first.relative_rmse <= target {
+        return Reach::AtMost(first.seconds);
+    }
+    for w in pts.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if b.relative_rmse <= target {
+            let (la, lb) = (a.relative_rmse.ln(), b.relative_rmse.ln());
+            let f = if la > lb { (la - target.ln()) / (la - lb) } else { 1.0 };
+            let lt = a.seconds.ln() + f * (b.seconds.ln() - a.seconds.ln());
+            return Reach::Interpolated(lt.exp());
+        }
+    }
+    match (pts.last(), result.slope_vs_time) {
+        (Some(last), Some(slope)) if slope < -0.3 => {
+            Reach::Extrapolated(last.seconds * (target / last.relative_rmse).powf(1.0 / slope))
+        }
+        _ => Reach::NotReached,
+    }
+}
+
+/// Three significant digits.
+fn sig(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let digits = (2 - v.abs().log10().floor() as i32).max(0) as usize;
+    format!("{v:.digits$}")
+}
+
+fn percent(v: f64) -> String {
+    format!("{}%", sig(v * 100.0))
+}
+
+fn beams_text(beams: u64) -> String {
+    if beams.is_power_of_two() {
+        format!("2^{}", beams.trailing_zeros())
+    } else {
+        beams.to_string()
+    }
+}
+
+fn slope_text(slope: Option<f64>) -> String {
+    slope.map_or_else(|| "-".to_owned(), |s| format!("{s:.3}"))
+}
+
+/// The report as Markdown (what `accuracy.md` holds).
+pub fn markdown(report: &AccuracyReport) -> String {
+    let o = &report.options;
+    let mut md = String::new();
+    let _ = writeln!(md, "# What accuracy costs in time\n");
+    let _ = writeln!(
+        md,
+        "Generated by `cargo xtask accuracy` (`spectrace_renderer::accuracy::run`) on {} thread(s) \
+         in {:.0} s; do not edit by hand. Reference: the scene as written (effects analysis \
+         `auto`) at {} beams, seed {}, cached in `{}`. Sweep: {} to {} beams (doubling), every \
+         point with its own seed. Images are scaled to at most {} pixels wide. Error: relative RMSE \
+         of XYZ over all pixels, `sqrt(sum |xyz - ref|^2 / sum |ref|^2)`; time: wall time of the \
+         render alone (not loading). Plain Monte Carlo error falls as time^(-1/2): a flatter \
+         slope means bias (the configuration converges to another image) or costs that do not \
+         grow with the beams.\n",
+        report.threads,
+        report.total_seconds,
+        beams_text(o.reference_beams),
+        o.seed,
+        o.cache_dir.display(),
+        beams_text(o.start_beams),
+        beams_text(o.start_beams << (o.steps.saturating_sub(1)).min(62)),
+        o.max_width.map_or_else(|| "(unlimited)".to_owned(), |w| w.to_string()),
+    );
+    let _ = writeln!(md, "Configurations:\n");
+    for c in Configuration::ALL {
+        let _ = writeln!(md, "- `{}`: {}.", c.name(), c.description());
+    }
+    let _ = writeln!(
+        md,
+        "\n![relative RMSE against wall time, log-log](accuracy.svg)\n\n\
+         *Relative RMSE of XYZ against wall time (log-log), one line per scene and configuration; \
+         dashed: slope -1/2.*\n"
+    );
+    for scene in &report.scenes {
+        scene_markdown(&mut md, scene);
+    }
+    md
+}
+
+fn scene_markdown(md: &mut String, scene: &SceneResult) {
+    let r = &scene.reference;
+    let _ = writeln!(md, "## {} (`{}`)\n", scene.name, scene.scene);
+    let _ = writeln!(
+        md,
+        "{}x{} pixels; {}. Reference: {} beams, {} s{}.\n",
+        scene.width,
+        scene.height,
+        scene.effects_summary,
+        beams_text(r.beams),
+        sig(r.seconds),
+        if r.cached { " (read from the cache)" } else { "" },
+    );
+    let baseline = scene.configurations.iter().find(|c| c.configuration == Configuration::Baseline);
+    if let Some(last) = baseline.and_then(|b| b.points.last()) {
+        // The reference carries the baseline's noise at its own beam count; it adds in quadrature
+        // to every measured error.
+        let noise = last.relative_rmse * (last.beams as f64 / r.beams as f64).sqrt();
+        let _ = writeln!(
+            md,
+            "The reference's own noise is about {} (the baseline's last error scaled to the \
+             reference's beams); errors near it are inflated by it.\n",
+            percent(noise)
+        );
+    }
+    let _ = writeln!(md, "| configuration | beams | seconds | relative RMSE |");
+    let _ = writeln!(md, "|---|---:|---:|---:|");
+    for c in &scene.configurations {
+        for p in &c.points {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} |",
+                c.configuration.name(),
+                beams_text(p.beams),
+                sig(p.seconds),
+                percent(p.relative_rmse)
+            );
+        }
+    }
+    let _ = writeln!(
+        md,
+        "\n| configuration | what changed | slope vs time | slope vs beams | expected | error x sqrt(seconds) at the last point |"
+    );
+    let _ = writeln!(md, "|---|---|---:|---:|---:|---:|");
+    for c in &scene.configurations {
+        match &c.not_applicable {
+            Some(reason) => {
+                let _ = writeln!(
+                    md,
+                    "| {} | not applicable: {} | - | - | {EXPECTED_SLOPE} | - |",
+                    c.configuration.name(),
+                    reason.replace('|', "/").replace('\n', " ")
+                );
+            }
+            None => {
+                let merit = c
+                    .points
+                    .last()
+                    .map_or_else(|| "-".to_owned(), |p| sig(p.relative_rmse * p.seconds.sqrt()));
+                let _ = writeln!(
+                    md,
+                    "| {} | {} | {} | {} | {EXPECTED_SLOPE} | {merit} |",
+                    c.configuration.name(),
+                    if c.changed.is_empty() { "-" } else { &c.changed },
+                    slope_text(c.slope_vs_time),
+                    slope_text(c.slope_vs_beams),
+                );
+            }
+        }
+    }
+    let _ = writeln!(md);
+    let mut targets = Vec::new();
+    if let Some(last) = baseline.and_then(|b| b.points.last()) {
+        targets.push((last.relative_rmse, "the smallest error the baseline reached"));
+    }
+    targets.push((ROUND_TARGET, "a round target"));
+    for (target, what) in targets {
+        let applicable: Vec<_> =
+            scene.configurations.iter().filter(|c| c.not_applicable.is_none()).collect();
+        let reaches: Vec<_> = applicable.iter().map(|c| (c, time_to_reach(c, target))).collect();
+        let fastest = reaches
+            .iter()
+            .filter_map(|(c, r)| r.seconds().map(|t| (c, *r, t)))
+            .min_by(|a, b| a.2.total_cmp(&b.2));
+        let times = reaches
+            .iter()
+            .map(|(c, r)| format!("`{}` {}", c.configuration.name(), r.describe()))
+            .collect::<Vec<_>>()
+            .join(", ");
+        match fastest {
+            Some((c, reach, best)) => {
+                let ties: Vec<String> = reaches
+                    .iter()
+                    .filter(|(o, r)| {
+                        o.configuration != c.configuration
+                            && r.seconds().is_some_and(|t| t <= best * TIE_FACTOR)
+                    })
+                    .map(|(o, _)| format!("`{}`", o.configuration.name()))
+                    .collect();
+                let tie = if ties.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        ", tied within timing noise (less than {:.0}% slower) with {}",
+                        (TIE_FACTOR - 1.0) * 100.0,
+                        ties.join(" and ")
+                    )
+                };
+                let _ = writeln!(
+                    md,
+                    "To reach {} ({what}), **`{}`** is fastest{}{tie}: {times}.\n",
+                    percent(target),
+                    c.configuration.name(),
+                    if matches!(reach, Reach::Extrapolated(_)) {
+                        " (by extrapolation beyond the sweep)"
+                    } else {
+                        ""
+                    },
+                );
+            }
+            None => {
+                let _ = writeln!(
+                    md,
+                    "No configuration reaches {} ({what}) within the sweep: {times}.\n",
+                    percent(target)
+                );
+            }
+        }
+    }
+}
+
+/// Line colours, one per [`Configuration`] in order (colour-blind-friendly, after Okabe and Ito).
+const PLOT_COLOURS: [(u8, u8, u8); 8] = [
+    (0, 0, 0),
+    (0, 114, 178),
+    (213, 94, 0),
+    (0, 158, 115),
+    (204, 121, 167),
+    (86, 180, 233),
+    (230, 159, 0),
+    (240, 228, 66),
+];
+
+/// The marker of the `i`-th scene, as pixel offsets: circle, triangle, square, diamond, ...
+fn marker_shape(i: usize) -> Vec<(i32, i32)> {
+    let (sides, radius, turn) = match i % 4 {
+        0 => (12, 3.5, 0.0),
+        1 => (3, 5.0, -0.25),
+        2 => (4, 4.5, 0.125),
+        _ => (4, 5.0, 0.0),
+    };
+    (0..sides)
+        .map(|k| {
+            let a = std::f64::consts::TAU * (k as f64 / sides as f64 + turn);
+            ((radius * a.cos()).round() as i32, (radius * a.sin()).round() as i32)
+        })
+        .collect()
+}
+
+/// One line of the plot.
+struct PlotSeries {
+    label: String,
+    scene: usize,
+    configuration: usize,
+    points: Vec<(f64, f64)>,
+}
+
+/// Draws the log-log plot of error against time (SVG).
+///
+/// # Errors
+/// A message if the file cannot be written.
+pub fn write_plot(report: &AccuracyReport, path: &Path) -> Result<(), String> {
+    use plotters::prelude::*;
+    let err = |e: &dyn std::fmt::Display| format!("{}: plot: {e}", path.display());
+    let series: Vec<PlotSeries> = report
+        .scenes
+        .iter()
+        .enumerate()
+        .flat_map(|(si, s)| {
+            s.configurations.iter().filter(|c| !c.points.is_empty()).map(move |c| {
+                let ci = Configuration::ALL
+                    .iter()
+                    .position(|&k| k == c.configuration)
+                    .unwrap_or_default();
+                PlotSeries {
+                    label: format!("{}: {}", s.name, c.configuration.name()),
+                    scene: si,
+                    configuration: ci,
+                    points: c
+                        .points
+                        .iter()
+                        .filter(|p| p.seconds > 0.0 && p.relative_rmse > 0.0)
+                        .map(|p| (p.seconds, p.relative_rmse))
+                        .collect(),
+                }
+            })
+        })
+        .collect();
+    let all: Vec<(f64, f64)> = series.iter().flat_map(|s| s.points.iter().copied()).collect();
+    let bounds = |f: fn(&(f64, f64)) -> f64| {
+        let lo = all.iter().map(f).fold(f64::INFINITY, f64::min);
+        let hi = all.iter().map(f).fold(0.0, f64::max);
+        if lo.is_finite() && hi > lo { (lo / 1.5, hi * 1.5) } else { (1e-3, 1.0) }
+    };
+    let (x0, x1) = bounds(|p| p.0);
+    let (y0, y1) = bounds(|p| p.1);
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| err(&e))?;
+    }
+    let root = SVGBackend::new(path, (960, 640)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption("Spectrace: relative RMSE of XYZ against wall time", ("sans-serif", 22))
+        .margin(16)
+        .x_label_area_size(48)
+        .y_label_area_size(72)
+        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+        .map_err(|e| err(&e))?;
+    chart
+        .configure_mesh()
+        .x_desc("wall time of the render (s)")
+        .y_desc("relative RMSE of XYZ")
+        .light_line_style(BLACK.mix(0.05))
+        .max_light_lines(4)
+        .x_label_formatter(&|x| sig(*x))
+        .y_label_formatter(&|y| {
+            let text = sig(*y * 100.0);
+            let text = if text.contains('.') {
+                text.trim_end_matches('0').trim_end_matches('.')
+            } else {
+                &text
+            };
+            format!("{text}%")
+        })
+        .draw()
+        .map_err(|e| err(&e))?;
+    for PlotSeries { label, scene: si, configuration: ci, points } in &series {
+        // Colour by configuration, marker by scene.
+        let (r, g, b) = PLOT_COLOURS[ci % PLOT_COLOURS.len()];
+        let color = RGBColor(r, g, b);
+        let marker = marker_shape(*si);
+        let legend_marker = marker.clone();
+        chart
+            .draw_series(LineSeries::new(points.iter().copied(), color.stroke_width(2)))
+            .map_err(|e| err(&e))?
+            .label(label.clone())
+            .legend(move |(x, y)| {
+                EmptyElement::at((x + 10, y))
+                    + PathElement::new(vec![(-10, 0), (10, 0)], color.stroke_width(2))
+                    + Polygon::new(legend_marker.clone(), color.filled())
+            });
+        chart
+            .draw_series(
+                points
+                    .iter()
+                    .map(|&p| EmptyElement::at(p) + Polygon::new(marker.clone(), color.filled())),
+            )
+            .map_err(|e| err(&e))?;
+    }
+    if !all.is_empty() {
+        // Slope -1/2 through the geometric centre of the data.
+        let n = all.len() as f64;
+        let cx = (all.iter().map(|p| p.0.ln()).sum::<f64>() / n).exp();
+        let cy = (all.iter().map(|p| p.1.ln()).sum::<f64>() / n).exp();
+        let line = [x0, x1].map(|x| (x, cy * (x / cx).powf(EXPECTED_SLOPE)));
+        chart
+            .draw_series(DashedLineSeries::new(line, 8, 6, BLACK.stroke_width(1)))
+            .map_err(|e| err(&e))?
+            .label("slope -1/2 (Monte Carlo)")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(1)));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| err(&e))?;
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TINY: &str = r#"{
+      "camera": {"position": [0, 2, 3], "look_at": [0, 0, 0], "fov": 50, "width": 32, "height": 24},
+      "objects": [
+        {"shape": {"type": "Rectangle", "corner": [-2, 0, 2], "edge_u": [4, 0, 0], "edge_v": [0, 0, -4]},
+         "material": {"type": "Diffuse", "reflectance": 0.8}}
+      ],
+      "lights": [
+        {"type": "PointLight", "position": [0, 1.5, 0], "power": 40,
+         "spd": {"type": "Tabulated", "nm": [400, 500, 600, 700], "values": [0.2, 1.0, 0.6, 0.3]}}
+      ],
+      "settings": {"beams": 1000, "seed": 3}
+    }"#;
+
+    fn temp(name: &str) -> PathBuf {
+        std::env::temp_dir().join(format!("spectrace-accuracy-{}-{name}", std::process::id()))
+    }
+
+    #[test]
+    fn rewrites_produce_parseable_scenes_with_the_fields_changed() {
+        let json: Value = serde_json::from_str(TINY).unwrap();
+        let path = Path::new("tiny.json");
+
+        let (_, eq) = rewrite(Configuration::EqualWavelengths, &json).unwrap();
+        assert_eq!(eq["lights"][0]["wavelength_sampling"], "equal_wavelengths");
+        parse(&eq, path).unwrap();
+
+        let (changed, pc) = rewrite(Configuration::PiecewiseConstantSpd, &json).unwrap();
+        assert_eq!(changed, "1 SPD(s) in 1 light(s)");
+        let spd = &pc["lights"][0]["spd"];
+        assert_eq!(spd["type"], "Binned");
+        assert_eq!(spd["edges_nm"], serde_json::json!([350.0, 450.0, 550.0, 650.0, 750.0]));
+        assert_eq!(spd["values"], serde_json::json!([0.2, 1.0, 0.6, 0.3]));
+        parse(&pc, path).unwrap();
+
+        // Inside a LightSet, with a delta line skipped and a tabulated CIE illuminant rewritten.
+        let mut set = json.clone();
+        set["lights"] = serde_json::json!([{"type": "LightSet", "lights": [
+            json["lights"][0].clone(),
+            {"type": "PointLight", "position": [0, 1, 0], "power": 1,
+             "spd": {"type": "Monochromatic", "lambda_nm": 550}},
+            {"type": "PointLight", "position": [0, 1, 0], "power": 1,
+             "spd": {"type": "CieIlluminant", "name": "D65"}}
+        ]}]);
+        let (changed, eq) = rewrite(Configuration::EqualWavelengths, &set).unwrap();
+        assert_eq!(changed, "2 light(s); 1 with delta lines left on importance");
+        let inner = &eq["lights"][0]["lights"];
+        assert_eq!(inner[0]["wavelength_sampling"], "equal_wavelengths");
+        assert!(inner[1].get("wavelength_sampling").is_none());
+        parse(&eq, path).unwrap();
+        let (changed, pc) = rewrite(Configuration::PiecewiseConstantSpd, &set).unwrap();
+        assert_eq!(changed, "2 SPD(s) in 2 light(s)");
+        let d65 = &pc["lights"][0]["lights"][2]["spd"];
+        assert_eq!(d65["type"], "Binned");
+        assert_eq!(d65["values"].as_array().unwrap().len(), 97);
+        assert_eq!(d65["edges_nm"][0], 297.5);
+        parse(&pc, path).unwrap();
+
+        // Not applicable: no tabulated SPD; only delta lines.
+        let mut bb = json.clone();
+        bb["lights"][0]["spd"] = serde_json::json!({"type": "Blackbody", "kelvin": 3200});
+        assert!(rewrite(Configuration::PiecewiseConstantSpd, &bb).is_err());
+        let mut line = json.clone();
+        line["lights"][0]["spd"] = serde_json::json!({"type": "Monochromatic", "lambda_nm": 550});
+        assert!(rewrite(Configuration::EqualWavelengths, &line).is_err());
+
+        // Resolution limit keeps the aspect ratio.
+        let mut big = json.clone();
+        assert!(limit_resolution(&mut big, 16));
+        assert_eq!(
+            (big["camera"]["width"].as_u64(), big["camera"]["height"].as_u64()),
+            (Some(16), Some(12))
+        );
+        assert!(!limit_resolution(&mut big, 16));
+    }
+
+    #[test]
+    fn error_falls_with_beams_and_the_report_is_written() {
+        let dir = temp("run");
+        let scene = dir.join("tiny.json");
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(&scene, TINY).unwrap();
+        let options = AccuracyOptions {
+            scenes: vec![scene],
+            out_dir: dir.join("docs"),
+            cache_dir: dir.join("cache"),
+            reference_beams: 1 << 14,
+            start_beams: 1 << 10,
+            steps: 3,
+            threads: 2,
+            seed: 7,
+            max_width: None,
+        };
+        let report = run(&options).unwrap();
+        let scene = &report.scenes[0];
+        assert!(!scene.reference.cached);
+        let baseline = &scene.configurations[0];
+        assert_eq!(baseline.configuration, Configuration::Baseline);
+        let errors: Vec<f64> = baseline.points.iter().map(|p| p.relative_rmse).collect();
+        assert_eq!(errors.len(), 3);
+        assert!(errors.windows(2).all(|w| w[1] < w[0]), "errors {errors:?}");
+        assert!(baseline.slope_vs_beams.is_some_and(|s| s < -0.2), "{baseline:?}");
+        assert!(scene.configurations.iter().all(|c| c.not_applicable.is_none()));
+        let md = std::fs::read_to_string(dir.join("docs/accuracy.md")).unwrap();
+        assert!(md.contains("| baseline | 2^10 |"));
+        assert!(md.contains("is fastest"));
+        let svg = std::fs::read_to_string(dir.join("docs/accuracy.svg")).unwrap();
+        assert!(svg.contains("<svg") && svg.contains("slope -1/2"));
+
+        // The second run reads the reference from the cache and measures the same errors
+        // (same seeds, exact film sums).
+        let again = run(&options).unwrap();
+        assert!(again.scenes[0].reference.cached);
+        let errors_again: Vec<f64> =
+            again.scenes[0].configurations[0].points.iter().map(|p| p.relative_rmse).collect();
+        assert_eq!(errors, errors_again);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn slopes_and_reach() {
+        let pts: Vec<(f64, f64)> = (0..5).map(|k| (k as f64, 3.0 - 0.5 * k as f64)).collect();
+        assert!((fit_slope(&pts).unwrap() + 0.5).abs() < 1e-12);
+        let result = ConfigurationResult {
+            configuration: Configuration::Baseline,
+            changed: String::new(),
+            not_applicable: None,
+            points: vec![
+                AccuracyPoint { beams: 1, seed: 0, seconds: 1.0, relative_rmse: 0.2 },
+                AccuracyPoint { beams: 4, seed: 0, seconds: 4.0, relative_rmse: 0.1 },
+            ],
+            slope_vs_time: Some(-0.5),
+            slope_vs_beams: Some(-0.5),
+        };
+        let Reach::Interpolated(t) = time_to_reach(&result, 0.1 * 2f64.sqrt()) else { panic!() };
+        assert!((t - 2.0).abs() < 1e-9);
+        let Reach::Extrapolated(t) = time_to_reach(&result, 0.05) else { panic!() };
+        assert!((t - 16.0).abs() < 1e-9);
+        assert!(matches!(time_to_reach(&result, 0.3), Reach::AtMost(_)));
+        assert_ne!(sweep_seed(5, 0, 0), 5);
+    }
+}

@@ -64,6 +64,26 @@ enum Command {
         #[arg(long, default_value_t = 0)]
         threads: usize,
     },
+    /// Error against time for every accuracy knob: writes docs/accuracy.md and docs/accuracy.svg.
+    Accuracy {
+        /// Scene files (default: scenes/fading_spot.json, scenes/cornell.json, scenes/prism.json).
+        scenes: Vec<PathBuf>,
+        /// Beams of the cached reference image.
+        #[arg(long)]
+        reference_beams: Option<u64>,
+        /// Beams of the first sweep point (doubled at each step).
+        #[arg(long)]
+        start_beams: Option<u64>,
+        /// Number of sweep points.
+        #[arg(long)]
+        steps: Option<u32>,
+        /// Largest image width (scenes are scaled down to it; 0 keeps their size).
+        #[arg(long)]
+        max_width: Option<u32>,
+        /// Where accuracy.md and accuracy.svg go.
+        #[arg(long, default_value = "docs")]
+        out: PathBuf,
+    },
     /// Merge partial films (from `render --shard`) into the final outputs.
     Merge {
         /// The partial films (.bin).
@@ -141,6 +161,35 @@ fn main() -> ExitCode {
         }
         Command::Merge { parts, out } => merge_parts(&parts, &out),
         Command::Bench { scenes, beams, threads } => return bench(&scenes, beams, threads),
+        Command::Accuracy { scenes, reference_beams, start_beams, steps, max_width, out } => {
+            let mut options = spectrace_renderer::accuracy::AccuracyOptions::default();
+            if !scenes.is_empty() {
+                options.scenes = scenes;
+            }
+            if let Some(b) = reference_beams {
+                options.reference_beams = b;
+            }
+            if let Some(b) = start_beams {
+                options.start_beams = b;
+            }
+            if let Some(n) = steps {
+                options.steps = n;
+            }
+            if let Some(w) = max_width {
+                options.max_width = (w > 0).then_some(w);
+            }
+            options.out_dir = out;
+            return match spectrace_renderer::accuracy::run(&options) {
+                Ok(report) => {
+                    println!("wrote {}", report.files.join(", "));
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::from(2)
+                }
+            };
+        }
     };
     match result {
         Ok(report) => {
