@@ -388,3 +388,21 @@ fn closed_white_box_loses_no_power() {
     assert_eq!(stats.hits, beams * 41);
     assert_eq!(film.rejected(), 0);
 }
+
+#[test]
+fn object_transforms_apply_after_the_shape_transform() {
+    let json = POINT_OVER_PLANE.replace(
+        r#""material": {"type": "Diffuse", "reflectance": 0.5}}"#,
+        r#""material": {"type": "Diffuse", "reflectance": 0.5}, "transform": {"translate": [0, -0.25, 0]}}"#,
+    );
+    let s = scene(&json);
+    let b = s.world.bounds();
+    assert!((b.min.y + 0.25).abs() < 1e-12 && (b.max.y + 0.25).abs() < 1e-12, "{b:?}");
+    // A curved shape given a non-uniform scale at object level is refused with the field named.
+    let sphere = r#"{"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 40, "width": 8, "height": 8},
+      "objects": [{"shape": {"type": "Sphere", "center": [0, 0, 0], "radius": 1}, "material": {"type": "Diffuse", "reflectance": 0.5},
+                   "transform": {"scale": [1, 2, 1]}}],
+      "lights": [{"type": "PointLight", "position": [0, 3, 3], "power": 1, "spd": {"type": "Uniform"}}]}"#;
+    let e = Scene::from_json(sphere, Path::new("s.json")).unwrap_err().to_string();
+    assert!(e.contains("objects[0].transform"), "{e}");
+}

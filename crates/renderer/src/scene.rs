@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
-use spectrace_geometry::{Shape, World};
+use spectrace_geometry::{Shape, Transform, World};
 use spectrace_lights::{LightSet, LightSource};
 use spectrace_materials::Material;
 use spectrace_tracer::{
@@ -44,6 +44,10 @@ pub struct Object {
     pub shape: Shape,
     /// The material (`{"type": "Diffuse", ...}`).
     pub material: Box<dyn Material>,
+    /// An optional transform of the whole object, applied after the shape's own `transform`
+    /// (same forms: `{"matrix": [...]}` row-major, or `translate`/`rotate`/`scale`).
+    #[serde(default, skip_serializing)]
+    pub transform: Option<Transform>,
 }
 
 /// Render settings.
@@ -255,7 +259,12 @@ impl Scene {
         let mut shapes = Vec::with_capacity(file.objects.len());
         let mut materials = Vec::with_capacity(file.objects.len());
         let mut non_convex = Vec::with_capacity(file.objects.len());
-        for object in file.objects {
+        for (index, mut object) in file.objects.into_iter().enumerate() {
+            if let Some(t) = object.transform.take() {
+                object.shape = apply_transform(object.shape, &t).map_err(|message| {
+                    scene_error(&format!("objects[{index}].transform"), message)
+                })?;
+            }
             // Only flat shapes can never send light to themselves; a sphere sees its own inside.
             non_convex.push(!matches!(object.shape, Shape::Rectangle(_) | Shape::Disk(_)));
             shapes.push(object.shape);
@@ -315,6 +324,27 @@ impl Scene {
             .bytes()
             .fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
     }
+}
+
+/// The shape with `t` applied after its own transform (re-validated, since a curved shape only
+/// accepts similarities).
+fn apply_transform(shape: Shape, t: &Transform) -> Result<Shape, String> {
+    let mut value = serde_json::to_value(&shape).map_err(|e| e.to_string())?;
+    let own: Option<Transform> = match value.get("transform") {
+        Some(v) if !v.is_null() => {
+            Some(serde_json::from_value(v.clone()).map_err(|e| e.to_string())?)
+        }
+        _ => None,
+    };
+    let combined = match own {
+        Some(own) => own.then(t),
+        None => *t,
+    };
+    let rows = combined.to_rows();
+    if let Some(map) = value.as_object_mut() {
+        map.insert("transform".to_owned(), serde_json::json!({ "matrix": rows }));
+    }
+    serde_json::from_value(value).map_err(|e| e.to_string())
 }
 
 /// serde_json appends " at line L column C"; the position is reported separately.
