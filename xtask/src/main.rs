@@ -1,5 +1,6 @@
 //! Spectrace's project automation, run as `cargo xtask <command>` (a cargo alias in
-//! `.cargo/config.toml`). It has no dependencies and one function per subcommand.
+//! `.cargo/config.toml`). It has no dependencies and one function per subcommand; rendering
+//! commands build the `spectrace` binary in release mode and run it.
 //!
 //! Commands today:
 //! - `cargo xtask` / `cargo xtask status`: what Spectrace contains so far and how to use it.
@@ -36,6 +37,27 @@ const CRATES: &[CrateInfo] = &[
         path: "crates/lights",
         what: "LightSource trait, Beam, Laser, Sky, uniform/fading spots, point, rectangle and disk \
                lights, LightSet; third-party lights by typetag",
+    },
+    CrateInfo {
+        package: "spectrace-geometry",
+        path: "crates/geometry",
+        what: "rays, shapes (mesh/OBJ, sphere, rectangle, disk, cylinder, torus, prism), transforms, \
+               obvhs BVH, robust intersection",
+    },
+    CrateInfo {
+        package: "spectrace-materials",
+        path: "crates/materials",
+        what: "diffuse, mirror, dispersive dielectric (Sellmeier, Cauchy, tables, glass catalog)",
+    },
+    CrateInfo {
+        package: "spectrace-tracer",
+        path: "crates/tracer",
+        what: "pinhole camera, exact XYZ film, light tracer, effects analysis, threaded chunks",
+    },
+    CrateInfo {
+        package: "spectrace-renderer",
+        path: "crates/renderer",
+        what: "scene files, EXR/PNG/JSON outputs, sharding and merge, accuracy report; `spectrace`",
     },
 ];
 
@@ -145,12 +167,12 @@ fn status() -> ExitCode {
         println!("  {:<20} {:<17} {}", c.package, c.path, c.what);
     }
     println!(
-        "\nNot built yet: geometry, materials, the light tracer, the renderer and `cargo xtask \
-         render` (issue 5).\n\n\
-         Run every test:         cargo test --workspace\n\
-         Run the benchmarks:     cargo xtask bench\n\
-         Examples:               cargo run --release -p spectrace-spectrum --example chromaticity\n\
-         \x20                       cargo run -p spectrace-lights --example beams -- '<light JSON>'"
+        "\nRender the showcase scene:  cargo xtask render\n\
+         Render any scene:           cargo xtask render scenes/NAME.json [--beams N | --time SECS] [--out DIR] [--threads N] [--seed S]\n\
+         Accuracy against time:      cargo xtask accuracy [SCENES]\n\
+         Run every test:             cargo test --workspace\n\
+         Run the benchmarks:         cargo xtask bench\n\n\
+         Not built yet: path tracing and bidirectional path tracing with MIS."
     );
     ExitCode::SUCCESS
 }
