@@ -406,3 +406,19 @@ fn object_transforms_apply_after_the_shape_transform() {
     let e = Scene::from_json(sphere, Path::new("s.json")).unwrap_err().to_string();
     assert!(e.contains("objects[0].transform"), "{e}");
 }
+
+#[test]
+fn a_time_budget_stops_the_render() {
+    let s = scene(POINT_OVER_PLANE);
+    let options = RenderOptions {
+        time: Some(0.3),
+        threads: Some(2),
+        out_dir: temp_dir("time"),
+        ..RenderOptions::default()
+    };
+    let started = std::time::Instant::now();
+    let report = render_scene(&s, &options).unwrap();
+    assert!(started.elapsed().as_secs_f64() < 30.0);
+    assert!(report.beams > 0 && report.beams < u64::MAX / 4, "{}", report.beams);
+    assert_eq!(report.rejected_contributions, 0);
+}

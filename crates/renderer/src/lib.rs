@@ -300,8 +300,7 @@ fn progress_bar(plan: &RenderPlan, visible: bool) -> indicatif::ProgressBar {
     if !visible {
         return indicatif::ProgressBar::hidden();
     }
-    let shard_beams: u64 = plan.my_chunks().iter().map(|&c| plan.beams_in_chunk(c)).sum();
-    let bar = indicatif::ProgressBar::new(shard_beams);
+    let bar = indicatif::ProgressBar::new(plan.shard_beams());
     let template = if plan.time_budget.is_some() {
         "{spinner} {elapsed_precise} {pos} beams ({per_sec})"
     } else {

@@ -42,10 +42,30 @@ impl RenderPlan {
         self.beams.saturating_sub(c * size).min(size)
     }
 
-    /// The chunk indices this shard renders, in order.
-    pub fn my_chunks(&self) -> Vec<u64> {
+    /// How many chunks this shard renders (all of them without a shard).
+    pub fn shard_chunk_count(&self) -> u64 {
         let (k, n) = self.shard.unwrap_or((0, 1));
-        (0..self.chunks()).filter(|c| c % n == k).collect()
+        let total = self.chunks();
+        if k >= total { 0 } else { (total - k).div_ceil(n.max(1)) }
+    }
+
+    /// The `i`-th chunk this shard renders (`k + i n`), if there is one.
+    pub fn shard_chunk(&self, i: u64) -> Option<u64> {
+        let (k, n) = self.shard.unwrap_or((0, 1));
+        (i < self.shard_chunk_count()).then(|| k + i * n.max(1))
+    }
+
+    /// Beams in this shard's chunks (without materialising the list: with a time budget the
+    /// plan may hold ~10^14 chunks).
+    pub fn shard_beams(&self) -> u64 {
+        let count = self.shard_chunk_count();
+        if count == 0 {
+            return 0;
+        }
+        let last = self.shard_chunk(count - 1).unwrap_or(0);
+        (count - 1)
+            .saturating_mul(self.chunk_beams.max(1))
+            .saturating_add(self.beams_in_chunk(last))
     }
 }
 
@@ -94,7 +114,6 @@ pub fn render(
 ) -> Result<RenderOutput, FilmError> {
     let started = Instant::now();
     let (w, h) = (scene.camera.width(), scene.camera.height());
-    let chunks = plan.my_chunks();
     let next = AtomicU64::new(0);
     let done = AtomicU64::new(0);
     let deadline = plan.time_budget.map(|s| started + Duration::from_secs_f64(s.max(0.0)));
@@ -111,8 +130,8 @@ pub fn render(
                     if deadline.is_some_and(|d| Instant::now() >= d) {
                         break;
                     }
-                    let i = next.fetch_add(1, Ordering::Relaxed) as usize;
-                    let Some(&c) = chunks.get(i) else { break };
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(c) = plan.shard_chunk(i) else { break };
                     let n = plan.beams_in_chunk(c);
                     let s = trace_chunk(scene, settings, effects, plan.seed, c, n, &mut film);
                     stats.merge(&s);
@@ -143,8 +162,8 @@ pub fn render(
         rendered.extend(c);
     }
     rendered.sort_unstable();
-    // With a time budget, chunks are claimed in order, but a late claim may finish while an
-    // earlier one was never claimed; the rendered set is what the output reports.
+    // With a time budget, chunks are claimed in order and every claimed chunk finishes, so the
+    // rendered set is a prefix of the shard's chunks; the output reports exactly that set.
     let beams = rendered.iter().map(|&c| plan.beams_in_chunk(c)).sum();
     Ok(RenderOutput {
         film,
@@ -153,4 +172,39 @@ pub fn render(
         beams,
         seconds: started.elapsed().as_secs_f64(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plan(beams: u64, chunk_beams: u64, shard: Option<(u64, u64)>) -> RenderPlan {
+        RenderPlan { beams, chunk_beams, seed: 1, threads: 1, shard, time_budget: None }
+    }
+
+    #[test]
+    fn shards_partition_the_chunks() {
+        let p = plan(10_500, 1000, None);
+        assert_eq!(p.chunks(), 11);
+        assert_eq!(p.beams_in_chunk(10), 500);
+        assert_eq!(p.shard_beams(), 10_500);
+        let mut seen = Vec::new();
+        let mut beams = 0;
+        for k in 0..3 {
+            let s = plan(10_500, 1000, Some((k, 3)));
+            for i in 0..s.shard_chunk_count() {
+                seen.push(s.shard_chunk(i).unwrap());
+            }
+            assert_eq!(s.shard_chunk(s.shard_chunk_count()), None);
+            beams += s.shard_beams();
+        }
+        seen.sort_unstable();
+        assert_eq!(seen, (0..11).collect::<Vec<_>>());
+        assert_eq!(beams, 10_500);
+        assert_eq!(plan(500, 1000, Some((3, 4))).shard_chunk_count(), 0);
+        // A time-budget plan with ~10^14 chunks costs nothing to describe.
+        let huge = plan(u64::MAX / 2, 1 << 14, Some((1, 2)));
+        assert!(huge.shard_chunk_count() > 1 << 40);
+        assert_eq!(huge.shard_chunk(5), Some(11));
+    }
 }
