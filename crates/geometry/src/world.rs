@@ -141,7 +141,7 @@ impl World {
         }
         let inv = ray.direction.recip();
         let mut t_max = t_max;
-        let mut stack: Vec<u32> = Vec::with_capacity(64);
+        let mut stack = NodeStack::new();
         stack.push(0);
         while let Some(i) = stack.pop() {
             let node = &self.bvh.nodes[i as usize];
@@ -163,9 +163,11 @@ impl World {
                 match (tl, tr) {
                     (Some(a), Some(b)) => {
                         if a.0 <= b.0 {
-                            stack.extend([r, l]);
+                            stack.push(r);
+                            stack.push(l);
                         } else {
-                            stack.extend([l, r]);
+                            stack.push(l);
+                            stack.push(r);
                         }
                     }
                     (Some(_), None) => stack.push(l),
@@ -211,5 +213,41 @@ impl World {
             }
         }
         best
+    }
+}
+
+/// The traversal stack: a fixed array on the call stack, spilling to the heap only for trees
+/// deeper than it (so a ray costs no allocation).
+struct NodeStack {
+    inline: [u32; 96],
+    len: usize,
+    spill: Vec<u32>,
+}
+
+impl NodeStack {
+    fn new() -> Self {
+        Self { inline: [0; 96], len: 0, spill: Vec::new() }
+    }
+
+    #[inline]
+    fn push(&mut self, node: u32) {
+        if self.len < self.inline.len() {
+            self.inline[self.len] = node;
+            self.len += 1;
+        } else {
+            self.spill.push(node);
+        }
+    }
+
+    #[inline]
+    fn pop(&mut self) -> Option<u32> {
+        if let Some(node) = self.spill.pop() {
+            return Some(node);
+        }
+        if self.len == 0 {
+            return None;
+        }
+        self.len -= 1;
+        Some(self.inline[self.len])
     }
 }
