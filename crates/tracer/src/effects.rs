@@ -88,15 +88,19 @@ impl Effects {
     pub fn summary(&self) -> String {
         let f = &self.features;
         format!(
-            "effects ({mode:?}): dispersion {}, specular surfaces {}, {} non-specular shape(s){}; \
+            "effects ({mode}): dispersion {}, specular surfaces {}, {} non-specular shape(s){}; \
              {} wavelength(s) per path, beams {} after a diffuse hit",
             if f.dispersive { "yes" } else { "no" },
             if f.specular { "yes" } else { "no" },
             f.non_specular_shapes,
-            if f.non_convex_non_specular { " (some non-convex)" } else { "" },
+            if f.non_convex_non_specular { " (some can light themselves)" } else { "" },
             self.wavelengths_per_path,
             if self.continue_after_diffuse { "continue" } else { "stop" },
-            mode = self.mode,
+            mode = match self.mode {
+                EffectsMode::Auto => "auto",
+                EffectsMode::Off => "off",
+                EffectsMode::DirectOnly => "direct_only",
+            },
         )
     }
 }

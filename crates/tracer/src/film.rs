@@ -72,7 +72,9 @@ pub enum FilmError {
     #[error("film sizes differ: {0}x{1} vs {2}x{3}")]
     SizeMismatch(u32, u32, u32, u32),
     /// A width or height of zero, or a pixel count that does not fit in memory.
-    #[error("film size {0}x{1} is invalid: both must be at least 1 and their product at most 2^28")]
+    #[error(
+        "film size {0}x{1} is invalid: both must be at least 1 and their product at most 2^25 (33.5 million pixels)"
+    )]
     InvalidSize(u32, u32),
 }
 
@@ -93,10 +95,11 @@ impl Film {
     /// An empty film.
     ///
     /// # Errors
-    /// [`FilmError::InvalidSize`] for a zero dimension or more than 2^28 pixels.
+    /// [`FilmError::InvalidSize`] for a zero dimension or more than 2^25 pixels (each pixel takes
+    /// 48 bytes, and every render thread keeps a film).
     pub fn new(width: u32, height: u32) -> Result<Self, FilmError> {
         let n = u64::from(width) * u64::from(height);
-        if width == 0 || height == 0 || n > 1 << 28 {
+        if width == 0 || height == 0 || n > 1 << 25 {
             return Err(FilmError::InvalidSize(width, height));
         }
         Ok(Self {
