@@ -93,13 +93,14 @@ const POINT_OVER_PLANE: &str = r#"{
 #[test]
 fn point_light_over_a_diffuse_plane_matches_the_closed_form() {
     // Radiance of a Lambertian plane lit by a point light: L = rho / pi * I cos(theta) / r^2.
-    // Tolerance: 5 standard errors of each 4x4-pixel block mean, estimated from 6 seeds of 200,000
-    // beams each (about 0.5% per block), plus 0.2% for evaluating the closed form at 16 points
-    // per pixel instead of integrating it.
+    // Tolerance: 5 standard errors of each 8x8-pixel block mean, the standard error estimated
+    // from 16 seeds of 100,000 beams (Student's t with 15 degrees of freedom exceeds 5 with
+    // probability 1.6e-4 per block, so a correct renderer fails this with probability 0.3%),
+    // plus 0.2% for evaluating the closed form at 4 points per pixel instead of integrating it.
     let s = scene(POINT_OVER_PLANE);
     let spd = Uniform::new(400.0, 700.0).unwrap();
-    let images: Vec<_> = (0..6).map(|seed| render_inline(&s, 200_000, 100 + seed, 2).1).collect();
-    let (w, h, b) = (32usize, 32usize, 4usize);
+    let images: Vec<_> = (0..16).map(|seed| render_inline(&s, 100_000, 100 + seed, 2).1).collect();
+    let (w, h, b) = (32usize, 32usize, 8usize);
     let intensity = 100.0 / (4.0 * std::f64::consts::PI);
     // Outside the view, so the light itself is not in the image.
     let light = DVec3::new(2.2, 1.0, 0.2);
@@ -421,4 +422,101 @@ fn a_time_budget_stops_the_render() {
     assert!(started.elapsed().as_secs_f64() < 30.0);
     assert!(report.beams > 0 && report.beams < u64::MAX / 4, "{}", report.beams);
     assert_eq!(report.rejected_contributions, 0);
+}
+
+#[test]
+fn wavelength_bundles_survive_a_surface_that_absorbs_some_wavelengths() {
+    // An integrating sphere black below 550 nm and 0.8 above: a bundle must lose only its
+    // absorbed wavelengths. Per wavelength, L = rho P spd / (pi A (1 - rho)); Y integrates it
+    // against ybar. Tolerance: 5 standard errors of the image mean over 6 seeds.
+    let json = r#"{
+      "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "fov": 90, "width": 16, "height": 16},
+      "objects": [{"shape": {"type": "Sphere", "center": [0, 0, 0], "radius": 2},
+                   "material": {"type": "Diffuse", "reflectance": {"nm": [400, 549.99, 550, 700], "values": [0, 0, 0.8, 0.8]}}}],
+      "lights": [{"type": "PointLight", "position": [0, 0, 0], "power": 10,
+                  "spd": {"type": "Uniform", "min_nm": 400, "max_nm": 700}}],
+      "settings": {"max_depth": 400, "rr_depth": 3}
+    }"#;
+    let s = scene(json);
+    assert_eq!(decide_effects(&s, None).wavelengths_per_path, spectrace_tracer::BUNDLE);
+    let area = 4.0 * std::f64::consts::PI * 4.0;
+    let rho = |l: f64| {
+        if l >= 550.0 {
+            0.8
+        } else if l > 549.99 {
+            0.8 * (l - 549.99) / 0.01
+        } else {
+            0.0
+        }
+    };
+    let expected = spectrace_spectrum::integrate_panels(
+        &|l| {
+            let r = rho(l);
+            r * 10.0 / 300.0 / (std::f64::consts::PI * area * (1.0 - r))
+                * spectrace_spectrum::cmf(l).y
+        },
+        400.0,
+        700.0,
+        &[549.99, 550.0],
+    ) / *CIE_Y_INTEGRAL;
+    let means: Vec<f64> = (0..6)
+        .map(|seed| {
+            let (_, image) = render_inline(&s, 100_000, 40 + seed, 2);
+            image.iter().map(|p| p.y).sum::<f64>() / image.len() as f64
+        })
+        .collect();
+    let mean = means.iter().sum::<f64>() / 6.0;
+    let se = (means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / 5.0 / 6.0).sqrt();
+    assert!((mean - expected).abs() < 5.0 * se, "{mean} vs {expected} (standard error {se})");
+    assert!(se < 0.02 * expected);
+}
+
+#[test]
+fn shading_normals_shade_light_traced_surfaces_like_camera_paths() {
+    // A flat two-triangle mesh whose vertex normals all lean 30 degrees towards +x: its
+    // radiance must be rho / pi * I |wi . n_s| / r^2 (the shading normal in the cosine), not the
+    // flat plane's. Tolerance as in the point-light test: 5 standard errors of 8x8 blocks from
+    // 16 seeds.
+    let n = [30f64.to_radians().sin(), 30f64.to_radians().cos(), 0.0];
+    let json = format!(
+        r#"{{
+      "camera": {{"position": [0, 3, 0.001], "look_at": [0, 0, 0], "up": [0, 0, -1], "fov": 60, "width": 32, "height": 32}},
+      "objects": [{{"shape": {{"type": "Mesh", "positions": [[-3, 0, -3], [3, 0, -3], [3, 0, 3], [-3, 0, 3]],
+                              "triangles": [[0, 2, 1], [0, 3, 2]], "normals": [{n:?}, {n:?}, {n:?}, {n:?}]}},
+                   "material": {{"type": "Diffuse", "reflectance": 0.5}}}}],
+      "lights": [{{"type": "PointLight", "position": [2.2, 1, 0.2], "power": 100,
+                  "spd": {{"type": "Uniform", "min_nm": 400, "max_nm": 700}}}}]
+    }}"#
+    );
+    let s = scene(&json);
+    let spd = Uniform::new(400.0, 700.0).unwrap();
+    let images: Vec<_> = (0..16).map(|seed| render_inline(&s, 100_000, 300 + seed, 2).1).collect();
+    let (w, h, b) = (32usize, 32usize, 8usize);
+    let intensity = 100.0 / (4.0 * std::f64::consts::PI);
+    let light = DVec3::new(2.2, 1.0, 0.2);
+    let ns = DVec3::from_array(n);
+    let analytic_pixel = |px: f64, py: f64| {
+        let d = s.camera.direction(px, py);
+        let o = s.camera.position();
+        let p = o + d * (-o.y / d.y);
+        let to = light - p;
+        let r2 = to.length_squared();
+        let cos_s = (to / r2.sqrt()).dot(ns).max(0.0);
+        y_of_radiance(0.5 / std::f64::consts::PI * intensity * cos_s / r2, &spd)
+    };
+    for (bx, by, mean, se) in block_stats(&images, w, h, b) {
+        let mut expected = 0.0;
+        for y in by * b..(by + 1) * b {
+            for x in bx * b..(bx + 1) * b {
+                for (sx, sy) in [(0.125, 0.125), (0.375, 0.625), (0.625, 0.375), (0.875, 0.875)] {
+                    expected += analytic_pixel(x as f64 + sx, y as f64 + sy);
+                }
+            }
+        }
+        expected /= (b * b * 4) as f64;
+        assert!(
+            (mean - expected).abs() < 5.0 * se + 0.002 * expected,
+            "block ({bx}, {by}): {mean} vs {expected} (standard error {se})"
+        );
+    }
 }

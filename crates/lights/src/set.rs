@@ -20,7 +20,9 @@ use crate::source::uniform;
 use crate::{Beam, BeamCounter, LightError, LightFlags, LightId, LightSample, LightSource};
 
 /// A set of lights that is itself a light: each beam comes from a light chosen with probability
-/// proportional to its power, and carries that light's index as its `parent`.
+/// proportional to its power, and carries that light's index as its `parent`. Sets inside sets are
+/// flattened when the set is built (their lights take their places in order), so `parent` always
+/// names a plain light.
 ///
 /// Its power is the sum of the lights' powers and its SPD their power-weighted mixture. The
 /// lights keep their own beam counts, so a beam's power can be computed from its parent
@@ -66,6 +68,21 @@ impl LightSet {
     /// [`LightError::EmptySet`] when there are no lights, when every light has zero power, or
     /// when a power is not finite or the total overflows.
     pub fn new(lights: Vec<Box<dyn LightSource>>) -> Result<Self, LightError> {
+        // Nested sets are flattened: a beam's parent is then always a plain light, whose
+        // spectrum and emission describe that beam.
+        let mut flat: Vec<Box<dyn LightSource>> = Vec::with_capacity(lights.len());
+        let mut pending = lights;
+        pending.reverse();
+        while let Some(mut light) = pending.pop() {
+            match light.take_lights() {
+                Some(mut children) => {
+                    children.reverse();
+                    pending.extend(children);
+                }
+                None => flat.push(light),
+            }
+        }
+        let lights = flat;
         if lights.is_empty() {
             return Err(LightError::EmptySet { reason: "a light set needs at least one light" });
         }
@@ -133,6 +150,13 @@ impl LightSource for LightSet {
             delta_position: f.iter().all(|x| x.delta_position),
             delta_direction: f.iter().all(|x| x.delta_direction),
         })
+    }
+    fn uniform_spectrum(&self) -> bool {
+        // Several lights colour their beams by their own spectra, not by the set's mixture.
+        self.lights.len() == 1 && self.lights[0].uniform_spectrum()
+    }
+    fn take_lights(&mut self) -> Option<Vec<Box<dyn LightSource>>> {
+        Some(std::mem::take(&mut self.lights))
     }
     fn emission_density(&self, _origin: DVec3, _direction: DVec3) -> f64 {
         // A set's beams come from different lights: ask the beam's own light (its `parent`).

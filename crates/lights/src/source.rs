@@ -63,6 +63,21 @@ pub trait LightSource: Send + Sync + Debug {
         0.0
     }
 
+    /// Whether every beam's wavelength is drawn from [`spd`](Self::spd) whatever its origin
+    /// and direction (true for every built-in light but a [`crate::LightSet`] of several
+    /// lights). Renderers that let one path carry several wavelengths drawn from `spd()` rely
+    /// on it; a light whose colour varies over its surface or with direction must return `false`.
+    fn uniform_spectrum(&self) -> bool {
+        true
+    }
+
+    /// For a group of lights (a [`crate::LightSet`]): hands over its lights, leaving it empty.
+    /// [`crate::LightSet::new`] uses it to flatten nested sets, so that every beam's `parent` is
+    /// a plain light. Plain lights return `None` (the default).
+    fn take_lights(&mut self) -> Option<Vec<Box<dyn LightSource>>> {
+        None
+    }
+
     /// Samples the light as seen from `receiver` (for connecting a surface point to the light):
     /// a point on the light, the direction from it towards the receiver, the radiant intensity
     /// that way, and the density of the choice. `None` (the default) when the light cannot be

@@ -818,3 +818,23 @@ fn sample_towards_gives_the_closed_form_irradiance() {
     let exact = disk.radiance() * PI * r * r / (r * r + h * h);
     assert!((mean - exact).abs() < 5.0 * sd / (n as f64).sqrt(), "{mean} vs {exact}");
 }
+
+#[test]
+fn nested_light_sets_are_flattened() {
+    let point = || -> Box<dyn LightSource> {
+        Box::new(PointLight::new(DVec3::ZERO, 1.0, d65(), WavelengthSampling::Importance).unwrap())
+    };
+    let inner = LightSet::new(vec![point(), point()]).unwrap();
+    assert!(!inner.uniform_spectrum());
+    let outer = LightSet::new(vec![point(), Box::new(inner), point()]).unwrap();
+    assert_eq!(outer.lights().len(), 4);
+    assert_eq!(outer.power(), 4.0);
+    assert!(outer.lights().iter().all(|l| l.uniform_spectrum()));
+    let mut rng = Pcg64::seed_from_u64(3);
+    for _ in 0..1000 {
+        assert!(outer.next_beam(&mut rng).parent.0 < 4);
+    }
+    // The flattened set serialises as one level: no nested set is left inside it.
+    let json = serde_json::to_string(&outer).unwrap();
+    assert_eq!(json.matches("LightSet").count(), 0, "{json}");
+}

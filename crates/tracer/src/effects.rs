@@ -5,7 +5,7 @@
 //! | effect | detected when | what the tracer does |
 //! |---|---|---|
 //! | dispersion | a material's index depends on wavelength | each beam carries one wavelength |
-//! | no dispersion | no such material | paths are wavelength-independent: one traced path carries a *bundle* of `BUNDLE` wavelengths (the same directions, a weight per wavelength), so colour noise falls `BUNDLE` times faster per traced path |
+//! | no dispersion | no such material (and every light colours all its beams by its one spectrum) | paths are wavelength-independent: one traced path carries a *bundle* of `BUNDLE` wavelengths (the same directions, a weight per wavelength), so the variance of the colour falls `BUNDLE` times faster per traced path |
 //! | specular surfaces | a mirror or glass exists | specular chains are followed (caustics) |
 //! | diffuse interreflection | a second bounce can reach a non-specular surface: more than one non-specular shape, a non-flat one, or any specular shape | beams continue after a diffuse hit; otherwise they end there (the light of later bounces can never reach the film) |
 //!
@@ -15,7 +15,8 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Wavelengths per traced path when no material is dispersive.
+/// Wavelengths per traced path when no material is dispersive. Colour noise (its variance) then
+/// falls `BUNDLE` times faster per traced path.
 pub const BUNDLE: usize = 4;
 
 /// What the scene contains, as the analysis sees it.
@@ -27,6 +28,10 @@ pub struct SceneFeatures {
     pub specular: bool,
     /// Number of shapes with a non-specular material.
     pub non_specular_shapes: usize,
+    /// Some light's colour varies between its beams (it does not draw every wavelength from
+    /// its one spectrum), so paths cannot carry wavelengths drawn from that spectrum.
+    #[serde(default)]
+    pub light_spectra_vary: bool,
     /// Some non-specular shape can send light to itself (anything but a flat shape: a sphere
     /// seen from inside, a torus, a mesh, an open cylinder).
     pub non_convex_non_specular: bool,
@@ -69,7 +74,11 @@ impl Effects {
             EffectsMode::Auto => Self {
                 mode,
                 features,
-                wavelengths_per_path: if features.dispersive { 1 } else { BUNDLE },
+                wavelengths_per_path: if features.dispersive || features.light_spectra_vary {
+                    1
+                } else {
+                    BUNDLE
+                },
                 continue_after_diffuse: interreflection,
             },
             EffectsMode::Off => {
@@ -78,7 +87,11 @@ impl Effects {
             EffectsMode::DirectOnly => Self {
                 mode,
                 features,
-                wavelengths_per_path: if features.dispersive { 1 } else { BUNDLE },
+                wavelengths_per_path: if features.dispersive || features.light_spectra_vary {
+                    1
+                } else {
+                    BUNDLE
+                },
                 continue_after_diffuse: false,
             },
         }

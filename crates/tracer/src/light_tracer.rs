@@ -29,6 +29,18 @@ use serde::{Deserialize, Serialize};
 use spectrace_geometry::{Ray, World};
 use spectrace_lights::{LightSet, LightSource, uniform};
 use spectrace_materials::{Incoming, Material};
+
+/// The factor that makes particle (importance) transport exact with shading normals:
+/// `|wi . n_s| |wo . n_g| / (|wi . n_g| |wo . n_s|)`, 1 where the normals agree (Veach 1997,
+/// section 5.3). `wi` points back to where the particle came from, `wo` where it goes.
+fn shading_correction(hit: &spectrace_geometry::Hit, wi: DVec3, wo: DVec3) -> f64 {
+    let (ns, ng) = (hit.shading_normal, hit.geometric_normal);
+    if ns == ng {
+        return 1.0;
+    }
+    let denominator = wi.dot(ng).abs() * wo.dot(ns).abs();
+    if denominator > 0.0 { wi.dot(ns).abs() * wo.dot(ng).abs() / denominator } else { 0.0 }
+}
 use spectrace_spectrum::{CIE_Y_INTEGRAL, SpectralPowerDistribution, cmf};
 
 use crate::{Effects, Film, PinholeCamera, SceneFeatures};
@@ -79,7 +91,10 @@ impl<'a> LightTracerScene<'a> {
 
     /// What the scene contains, for the effects analysis.
     pub fn features(&self, shapes_non_convex: &[bool]) -> SceneFeatures {
-        let mut f = SceneFeatures::default();
+        let mut f = SceneFeatures {
+            light_spectra_vary: self.lights.lights().iter().any(|l| !l.uniform_spectrum()),
+            ..SceneFeatures::default()
+        };
         for (i, m) in self.materials.iter().enumerate() {
             f.dispersive |= m.is_dispersive();
             if m.is_specular() {
@@ -203,23 +218,38 @@ pub fn trace_chunk(
                 break;
             }
             let u = [uniform(&mut rng), uniform(&mut rng), uniform(&mut rng)];
-            let incoming = Incoming {
-                direction: ray.direction,
-                normal: hit.shading_normal,
-                lambda: lambdas[0],
-            };
-            let Some(scattered) = material.scatter(&incoming, u) else { break };
-            weights[0] *= scattered.weight;
-            // The other wavelengths take the same direction (no dispersion: the same uniforms
-            // give the same direction) with their own weights.
-            for j in 1..k {
-                let other = Incoming { lambda: lambdas[j], ..incoming };
-                weights[j] *= match material.scatter(&other, u) {
-                    Some(s) if (s.direction - scattered.direction).length_squared() < 1e-20 => {
-                        s.weight
-                    }
-                    _ => 0.0,
+            // Scatter every live wavelength with the same uniforms: without dispersion they all
+            // take the same direction; a wavelength the surface absorbs drops out of the bundle
+            // alone (the first live one that scatters sets the direction).
+            let mut direction: Option<DVec3> = None;
+            for j in 0..k {
+                if weights[j] <= 0.0 {
+                    continue;
+                }
+                let incoming = Incoming {
+                    direction: ray.direction,
+                    normal: hit.shading_normal,
+                    lambda: lambdas[j],
                 };
+                match material.scatter(&incoming, u) {
+                    Some(s) => match direction {
+                        None => {
+                            direction = Some(s.direction);
+                            weights[j] *= s.weight;
+                        }
+                        Some(d) if (s.direction - d).length_squared() < 1e-20 => {
+                            weights[j] *= s.weight
+                        }
+                        Some(_) => weights[j] = 0.0,
+                    },
+                    None => weights[j] = 0.0,
+                }
+            }
+            let Some(new_direction) = direction else { break };
+            // Shading normals: the adjoint correction for particles (Veach 1997, section 5.3).
+            let correction = shading_correction(&hit, -ray.direction, new_direction);
+            for w in &mut weights[..k] {
+                *w *= correction;
             }
             depth += 1;
             if depth > settings.rr_depth {
@@ -236,7 +266,7 @@ pub fn trace_chunk(
             if weights[..k].iter().all(|&w| w <= 0.0) {
                 break;
             }
-            ray = hit.spawn_ray(scattered.direction);
+            ray = hit.spawn_ray(new_direction);
         }
     }
     stats
@@ -278,7 +308,19 @@ fn connect_to_camera(
     if scene.world.occluded(&shadow, distance) {
         return None;
     }
-    let cos = projection.to_camera.dot(hit.shading_normal).abs();
+    // The camera measures area on the true surface (geometric normal); the reflected radiance
+    // uses the shading normal, so particles are reweighted by |wi . n_s| / |wi . n_g|.
+    let wi = -arriving;
+    let cos = if hit.shading_normal == hit.geometric_normal {
+        projection.to_camera.dot(hit.shading_normal).abs()
+    } else {
+        let cos_in = wi.dot(hit.geometric_normal).abs();
+        if !(cos_in > 0.0) {
+            return None;
+        }
+        projection.to_camera.dot(hit.geometric_normal).abs() * wi.dot(hit.shading_normal).abs()
+            / cos_in
+    };
     let mut values = [0.0; MAX_BUNDLE];
     let mut any = false;
     for (v, &lambda) in values.iter_mut().zip(lambdas) {
