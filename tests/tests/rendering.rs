@@ -520,3 +520,90 @@ fn shading_normals_shade_light_traced_surfaces_like_camera_paths() {
         );
     }
 }
+
+#[test]
+fn extreme_settings_are_refused_or_survived_without_panics() {
+    let s = scene(POINT_OVER_PLANE);
+    let out = temp_dir("extreme");
+    // A time budget too large for a Duration means no budget; with a beam cap it just renders.
+    let report = render_scene(
+        &s,
+        &RenderOptions {
+            beams: Some(2000),
+            time: Some(1e300),
+            threads: Some(1),
+            out_dir: out.clone(),
+            ..RenderOptions::default()
+        },
+    );
+    assert!(report.is_ok(), "{report:?}");
+    // A tiny budget still renders one chunk.
+    let tiny = render_scene(
+        &s,
+        &RenderOptions {
+            time: Some(1e-12),
+            threads: Some(2),
+            out_dir: out.clone(),
+            ..RenderOptions::default()
+        },
+    )
+    .unwrap();
+    assert!(tiny.beams > 0);
+    let e = render_scene(
+        &s,
+        &RenderOptions {
+            beams: Some(100),
+            threads: Some(100_000),
+            out_dir: out.clone(),
+            ..RenderOptions::default()
+        },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("threads") && e.contains("at most"), "{e}");
+    // Bad output names and missing OBJ files name their field.
+    let bad_name =
+        POINT_OVER_PLANE.replace("\"lights\"", "\"output\": {\"name\": \"../escape\"}, \"lights\"");
+    assert!(load_error(&bad_name).contains("output.name"));
+    let missing_obj = POINT_OVER_PLANE.replace(
+        r#"{"type": "Rectangle", "corner": [-3, 0, 3], "edge_u": [6, 0, 0], "edge_v": [0, 0, -6]}"#,
+        r#"{"type": "Mesh", "obj": "does-not-exist.obj"}"#,
+    );
+    let e = load_error(&missing_obj);
+    assert!(e.contains("objects[0].shape") && e.contains("does-not-exist.obj"), "{e}");
+    // Light that is all outside the visible range renders black: reported, not rendered.
+    let invisible = POINT_OVER_PLANE.replace(
+        r#""spd": {"type": "Uniform", "min_nm": 400, "max_nm": 700}"#,
+        r#""spd": {"type": "Monochromatic", "lambda_nm": 1000}"#,
+    );
+    let e = render_scene(
+        &scene(&invisible),
+        &RenderOptions { beams: Some(1000), out_dir: out, ..RenderOptions::default() },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("no light can reach the camera"), "{e}");
+}
+
+#[test]
+fn the_same_seed_writes_the_same_files() {
+    let dir = temp_dir("same-files");
+    let path = dir.join("plane.json");
+    std::fs::write(&path, POINT_OVER_PLANE).unwrap();
+    let s = Scene::load(&path).unwrap();
+    for run in ["a", "b"] {
+        let opts = RenderOptions {
+            beams: Some(50_000),
+            seed: Some(3),
+            threads: Some(2),
+            out_dir: dir.join(run),
+            ..RenderOptions::default()
+        };
+        render_scene(&s, &opts).unwrap();
+    }
+    for ext in ["exr", "png"] {
+        let a = std::fs::read(dir.join("a").join(format!("plane.{ext}"))).unwrap();
+        let b = std::fs::read(dir.join("b").join(format!("plane.{ext}"))).unwrap();
+        assert!(a == b, "{ext} files differ between two renders with the same seed");
+    }
+}

@@ -89,30 +89,44 @@ fn main() -> ExitCode {
     }
 }
 
-/// The default scene of `cargo xtask render`.
+/// The default scene of `cargo xtask render`, relative to the workspace root.
 const SHOWCASE: &str = "scenes/showcase.json";
+
+/// The workspace root (the xtask crate's parent directory), so the commands work from any
+/// directory of the workspace.
+fn workspace_root() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .map_or_else(|| ".".into(), |p| p.to_path_buf())
+}
 
 /// `cargo xtask render [SCENE] [options]`: builds the renderer in release mode and renders the
 /// scene (the showcase scene by default); options pass through to `spectrace render`.
 fn render(args: &[String]) -> ExitCode {
     let (scene, rest) = match args.first() {
         Some(first) if !first.starts_with('-') => (first.clone(), &args[1..]),
-        _ => (SHOWCASE.to_owned(), args),
+        _ => (workspace_root().join(SHOWCASE).display().to_string(), args),
     };
     let mut command: Vec<String> = vec!["render".into(), scene];
     command.extend(rest.iter().cloned());
     run_spectrace(&command)
 }
 
-/// `cargo xtask accuracy [SCENES] [options]`: the error-against-time report (docs/accuracy.md).
+/// `cargo xtask accuracy [SCENES] [options]`: the error-against-time report (docs/accuracy.md),
+/// run from the workspace root (scene paths are relative to it).
 fn accuracy(args: &[String]) -> ExitCode {
     let mut command: Vec<String> = vec!["accuracy".into()];
     command.extend(args.iter().cloned());
-    run_spectrace(&command)
+    run_spectrace_in(&command, Some(&workspace_root()))
 }
 
-/// Builds `spectrace` in release mode, then runs it with `args`.
+/// Builds `spectrace` in release mode, then runs it with `args` in the current directory.
 fn run_spectrace(args: &[String]) -> ExitCode {
+    run_spectrace_in(args, None)
+}
+
+/// Builds `spectrace` in release mode, then runs it with `args` in `dir` (or here).
+fn run_spectrace_in(args: &[String], dir: Option<&std::path::Path>) -> ExitCode {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
     eprintln!("$ cargo build --release -p spectrace-renderer --bin spectrace");
     match Command::new(&cargo)
@@ -134,7 +148,12 @@ fn run_spectrace(args: &[String]) -> ExitCode {
         .join("release")
         .join(format!("spectrace{}", std::env::consts::EXE_SUFFIX));
     eprintln!("$ {} {}", binary.display(), args.join(" "));
-    match Command::new(&binary).args(args).status() {
+    let mut command = Command::new(&binary);
+    command.args(args);
+    if let Some(dir) = dir {
+        command.current_dir(dir);
+    }
+    match command.status() {
         Ok(s) if s.success() => ExitCode::SUCCESS,
         Ok(s) => ExitCode::from(s.code().unwrap_or(1).clamp(1, 255) as u8),
         Err(e) => {

@@ -100,6 +100,9 @@ pub struct RenderReport {
     pub version: String,
 }
 
+/// Most worker threads a render accepts.
+pub const MAX_THREADS: usize = 256;
+
 /// Beams traced to check that light can reach the camera before rendering.
 pub const PROBE_BEAMS: u64 = 20_000;
 
@@ -144,6 +147,12 @@ pub fn plan_for(scene: &Scene, options: &RenderOptions) -> Result<RenderPlan, Re
     if let Some(t) = options.threads {
         plan.threads = t;
     }
+    if plan.threads > MAX_THREADS {
+        return Err(RenderError::Options(format!(
+            "threads = {}: at most {MAX_THREADS} (each working thread keeps a film of its own)",
+            plan.threads
+        )));
+    }
     if plan.threads == 0 {
         plan.threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     }
@@ -178,15 +187,17 @@ pub fn probe(scene: &Scene, effects: &Effects) -> Result<(), SceneError> {
         &mut film,
     );
     scene.lights.reset_count();
-    if stats.splats == 0 {
+    let visible = film.to_xyz(1.0).iter().any(|p| p.x > 0.0 || p.y > 0.0 || p.z > 0.0);
+    if stats.splats == 0 || !visible {
         return Err(SceneError::Scene {
             path: scene.path.clone(),
             field: "lights".to_owned(),
             message: format!(
                 "no light can reach the camera: none of {PROBE_BEAMS} probe beams lit a point the camera sees \
-                 ({} hit a surface). Check that the lights face the objects, that some surface is not a mirror or \
-                 glass, and that the camera looks at the lit objects.",
-                stats.hits
+                 with visible light ({} hit a surface, {} reached the film). Check that the lights face the \
+                 objects, that their spectra lie in 360-830 nm, that some surface is not a mirror or glass, and \
+                 that the camera looks at the lit objects.",
+                stats.hits, stats.splats
             ),
         });
     }
@@ -395,9 +406,12 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
         seconds: 0.0,
     };
     for (part, path) in loaded.iter().zip(parts) {
-        if part.scene_fingerprint != first.scene_fingerprint || part.plan != first.plan {
+        if part.scene_fingerprint != first.scene_fingerprint
+            || part.plan != first.plan
+            || part.effects != first.effects
+        {
             return Err(RenderError::Options(format!(
-                "{}: belongs to another render (scene or settings differ from {})",
+                "{}: belongs to another render (scene, settings or effects differ from {})",
                 path.display(),
                 parts[0].display()
             )));

@@ -18,15 +18,25 @@ pub fn linear_srgb(xyz: &[Xyz]) -> Vec<[f32; 3]> {
         .collect()
 }
 
-/// Writes a linear EXR (32-bit float R, G, B).
+/// Writes a linear EXR (32-bit float R, G, B; ZIP compression, scan lines in increasing order,
+/// written sequentially so the same image always gives the same bytes).
 ///
 /// # Errors
 /// Any error of the `exr` crate, as text.
 pub fn write_exr(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<(), String> {
-    exr::prelude::write_rgb_file(path, width as usize, height as usize, |x, y| {
+    use exr::prelude::*;
+    let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
         let p = rgb[y * width as usize + x];
         (p[0], p[1], p[2])
-    })
+    });
+    Image::from_encoded_channels(
+        (width as usize, height as usize),
+        Encoding::SMALL_LOSSLESS,
+        channels,
+    )
+    .write()
+    .non_parallel()
+    .to_file(path)
     .map_err(|e| e.to_string())
 }
 

@@ -253,6 +253,14 @@ impl Scene {
                 format!("{t}: must be a positive number of seconds"),
             ));
         }
+        if let Some(name) = &file.output.name
+            && (name.is_empty() || name.contains(['/', '\\']) || name == "." || name == "..")
+        {
+            return Err(scene_error(
+                "output.name",
+                format!("{name:?}: must be a plain, non-empty file name (no directories)"),
+            ));
+        }
         if !file.output.exposure.is_finite() {
             return Err(scene_error("output.exposure", "must be finite".to_owned()));
         }
@@ -267,6 +275,10 @@ impl Scene {
             }
             // Only flat shapes can never send light to themselves; a sphere sees its own inside.
             non_convex.push(!matches!(object.shape, Shape::Rectangle(_) | Shape::Disk(_)));
+            object
+                .shape
+                .load(path.parent().unwrap_or_else(|| Path::new(".")))
+                .map_err(|e| scene_error(&format!("objects[{index}].shape"), e.to_string()))?;
             shapes.push(object.shape);
             materials.push(Arc::from(object.material));
         }

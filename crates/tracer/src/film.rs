@@ -2,29 +2,29 @@
 //!
 //! Floating-point addition is not associative, so a film summed in a different order (more
 //! threads, another chunk order, several machines) would differ in the last bits. Spectrace
-//! instead rounds every contribution once to a fixed-point integer with 80 fractional bits and
+//! instead rounds every contribution once to a fixed-point integer with 64 fractional bits and
 //! adds integers, which is exact and associative: any split of the work gives a bit-identical
-//! image. The cost is a resolution of 2^-80 (8.3e-25) per contribution and a range of 2^46
-//! (7.0e13) per pixel sum, both in film units; contributions outside the range, NaN and infinities
-//! are rejected and counted, never added.
+//! image. The cost is a resolution of 2^-64 (5.4e-20) per contribution and a range of 2^62
+//! (4.6e18) per pixel sum, both in the film's unscaled units (before the factor `power / beams`);
+//! contributions outside the range, NaN and infinities are rejected and counted, never added.
 
 use serde::{Deserialize, Serialize};
 use spectrace_spectrum::{Xyz, cmf};
 
 /// Fractional bits of the fixed-point sums.
-const FRAC_BITS: i32 = 80;
+const FRAC_BITS: i32 = 64;
 /// `2^FRAC_BITS`.
 const SCALE: f64 = (1u128 << FRAC_BITS) as f64;
-/// Largest magnitude of one contribution: `2^46`, so that 2^81 contributions fit in an i128.
-const MAX_CONTRIBUTION: f64 = 70_368_744_177_664.0; // 2^46
+/// Largest magnitude of one contribution: `2^62`; sums beyond `2^63` are refused as overflow.
+const MAX_CONTRIBUTION: f64 = 4_611_686_018_427_387_904.0; // 2^62
 
-/// An exact, order-independent sum of `f64` contributions (fixed point, 80 fractional bits).
+/// An exact, order-independent sum of `f64` contributions (fixed point, 64 fractional bits).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub struct ExactSum(i128);
 
 impl ExactSum {
     /// Adds `x`; returns `false` (and adds nothing) if `x` is NaN, infinite or larger in magnitude
-    /// than 2^46, or if the sum would overflow.
+    /// than 2^62, or if the sum would overflow.
     #[inline]
     pub fn add(&mut self, x: f64) -> bool {
         if !(x.abs() <= MAX_CONTRIBUTION) {
@@ -58,7 +58,7 @@ impl ExactSum {
         self.0 as f64 / SCALE
     }
 
-    /// The raw fixed-point integer (sum times 2^80).
+    /// The raw fixed-point integer (sum times 2^64).
     pub fn raw(self) -> i128 {
         self.0
     }
@@ -226,9 +226,10 @@ mod tests {
         let mut s = ExactSum::default();
         assert!(!s.add(f64::NAN));
         assert!(!s.add(f64::INFINITY));
-        assert!(!s.add(1e15));
-        assert!(s.add(7e13));
-        assert_eq!(s.value(), 7e13);
+        assert!(!s.add(1e19));
+        assert!(s.add(4e18));
+        assert_eq!(s.value(), 4e18);
+        assert!(!s.add(4e18) || !s.add(4e18), "2^63 overflows");
         let mut film = Film::new(2, 2).unwrap();
         assert!(!film.add(0, 0, Xyz::new(1.0, f64::NAN, 0.0)));
         assert!(!film.add(2, 0, Xyz::new(1.0, 1.0, 1.0)));

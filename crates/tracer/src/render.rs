@@ -116,29 +116,43 @@ pub fn render(
     let (w, h) = (scene.camera.width(), scene.camera.height());
     let next = AtomicU64::new(0);
     let done = AtomicU64::new(0);
-    let deadline = plan.time_budget.map(|s| started + Duration::from_secs_f64(s.max(0.0)));
+    // A budget too large to represent is no budget at all.
+    let deadline = plan
+        .time_budget
+        .and_then(|s| Duration::try_from_secs_f64(s.max(0.0)).ok())
+        .and_then(|d| started.checked_add(d));
     let results: Mutex<Vec<(Film, TraceStats, Vec<u64>)>> = Mutex::new(Vec::new());
     let mut first_error = None;
+    // More threads than chunks would only wait.
+    let threads = (plan.threads.max(1) as u64).min(plan.shard_chunk_count().max(1)) as usize;
     std::thread::scope(|scope| {
         let mut handles = Vec::new();
-        for _ in 0..plan.threads.max(1) {
+        for _ in 0..threads {
             handles.push(scope.spawn(|| -> Result<(), FilmError> {
-                let mut film = Film::new(w, h)?;
+                // The film is allocated with the first chunk: idle threads cost no memory.
+                let mut film: Option<Film> = None;
                 let mut stats = TraceStats::default();
                 let mut mine = Vec::new();
                 loop {
-                    if deadline.is_some_and(|d| Instant::now() >= d) {
+                    // The time budget stops new claims, but the first chunk always runs.
+                    if deadline.is_some_and(|d| Instant::now() >= d)
+                        && next.load(Ordering::Relaxed) > 0
+                    {
                         break;
                     }
                     let i = next.fetch_add(1, Ordering::Relaxed);
                     let Some(c) = plan.shard_chunk(i) else { break };
                     let n = plan.beams_in_chunk(c);
-                    let s = trace_chunk(scene, settings, effects, plan.seed, c, n, &mut film);
+                    let film = match &mut film {
+                        Some(f) => f,
+                        None => film.insert(Film::new(w, h)?),
+                    };
+                    let s = trace_chunk(scene, settings, effects, plan.seed, c, n, film);
                     stats.merge(&s);
                     mine.push(c);
                     progress(done.fetch_add(n, Ordering::Relaxed) + n);
                 }
-                if let Ok(mut r) = results.lock() {
+                if let (Some(film), Ok(mut r)) = (film, results.lock()) {
                     r.push((film, stats, mine));
                 }
                 Ok(())
