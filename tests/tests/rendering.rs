@@ -82,36 +82,26 @@ fn block_stats(
     out
 }
 
-const POINT_OVER_PLANE: &str = r#"{
-  "camera": {"position": [0, 3, 0.001], "look_at": [0, 0, 0], "up": [0, 0, -1], "fov": 60, "width": 32, "height": 32},
-  "objects": [{"shape": {"type": "Rectangle", "corner": [-3, 0, 3], "edge_u": [6, 0, 0], "edge_v": [0, 0, -6]},
-               "material": {"type": "Diffuse", "reflectance": 0.5}}],
-  "lights": [{"type": "PointLight", "position": [2.2, 1, 0.2], "power": 100,
-              "spd": {"type": "Uniform", "min_nm": 400, "max_nm": 700}}]
-}"#;
-
-#[test]
-fn point_light_over_a_diffuse_plane_matches_the_closed_form() {
-    // Radiance of a Lambertian plane lit by a point light: L = rho / pi * I cos(theta) / r^2.
-    // Tolerance: 5 standard errors of each 8x8-pixel block mean, the standard error estimated
-    // from 16 seeds of 100,000 beams (Student's t with 15 degrees of freedom exceeds 5 with
-    // probability 1.6e-4 per block, so a correct renderer fails this with probability 0.3%),
-    // plus 0.2% for evaluating the closed form at 4 points per pixel instead of integrating it.
-    let s = scene(POINT_OVER_PLANE);
+/// Renders `s` (a diffuse plane y = 0 of reflectance 0.5 under a 100 W point light at
+/// [`PLANE_LIGHT`] with a uniform 400-700 nm spectrum) with 16 seeds, and checks every 8x8 block
+/// of the image against `rho / pi * I * cos / r^2`, with `cos` given by `cos_at(unit vector to the
+/// light)`. Tolerance: 5 standard errors of each block mean from the 16 seeds (Student's t with 15
+/// degrees of freedom exceeds 5 with probability 1.6e-4 per block, so a correct renderer fails
+/// with probability 0.3%), plus 0.2% for evaluating the closed form at 4 points per pixel
+/// instead of integrating it.
+fn assert_lit_plane_matches(s: &Scene, first_seed: u64, cos_at: impl Fn(DVec3) -> f64) {
     let spd = Uniform::new(400.0, 700.0).unwrap();
-    let images: Vec<_> = (0..16).map(|seed| render_inline(&s, 100_000, 100 + seed, 2).1).collect();
+    let images: Vec<_> =
+        (0..16).map(|seed| render_inline(s, 100_000, first_seed + seed, 2).1).collect();
     let (w, h, b) = (32usize, 32usize, 8usize);
     let intensity = 100.0 / (4.0 * std::f64::consts::PI);
-    // Outside the view, so the light itself is not in the image.
-    let light = DVec3::new(2.2, 1.0, 0.2);
     let analytic_pixel = |px: f64, py: f64| {
         let d = s.camera.direction(px, py);
         let o = s.camera.position();
         let p = o + d * (-o.y / d.y);
-        let to = light - p;
+        let to = PLANE_LIGHT - p;
         let r2 = to.length_squared();
-        let cos = to.y / r2.sqrt();
-        y_of_radiance(0.5 / std::f64::consts::PI * intensity * cos / r2, &spd)
+        y_of_radiance(0.5 / std::f64::consts::PI * intensity * cos_at(to / r2.sqrt()) / r2, &spd)
     };
     for (bx, by, mean, se) in block_stats(&images, w, h, b) {
         let mut expected = 0.0;
@@ -128,6 +118,23 @@ fn point_light_over_a_diffuse_plane_matches_the_closed_form() {
             "block ({bx}, {by}): {mean} vs {expected} (standard error {se})"
         );
     }
+}
+
+/// The point light of the lit-plane scenes: outside the view, so it is not in the image itself.
+const PLANE_LIGHT: DVec3 = DVec3::new(2.2, 1.0, 0.2);
+
+const POINT_OVER_PLANE: &str = r#"{
+  "camera": {"position": [0, 3, 0.001], "look_at": [0, 0, 0], "up": [0, 0, -1], "fov": 60, "width": 32, "height": 32},
+  "objects": [{"shape": {"type": "Rectangle", "corner": [-3, 0, 3], "edge_u": [6, 0, 0], "edge_v": [0, 0, -6]},
+               "material": {"type": "Diffuse", "reflectance": 0.5}}],
+  "lights": [{"type": "PointLight", "position": [2.2, 1, 0.2], "power": 100,
+              "spd": {"type": "Uniform", "min_nm": 400, "max_nm": 700}}]
+}"#;
+
+#[test]
+fn point_light_over_a_diffuse_plane_matches_the_closed_form() {
+    // Radiance of a Lambertian plane lit by a point light: L = rho / pi * I cos(theta) / r^2.
+    assert_lit_plane_matches(&scene(POINT_OVER_PLANE), 100, |to_light| to_light.y);
 }
 
 #[test]
@@ -475,8 +482,7 @@ fn wavelength_bundles_survive_a_surface_that_absorbs_some_wavelengths() {
 fn shading_normals_shade_light_traced_surfaces_like_camera_paths() {
     // A flat two-triangle mesh whose vertex normals all lean 30 degrees towards +x: its
     // radiance must be rho / pi * I |wi . n_s| / r^2 (the shading normal in the cosine), not the
-    // flat plane's. Tolerance as in the point-light test: 5 standard errors of 8x8 blocks from
-    // 16 seeds.
+    // flat plane's.
     let n = [30f64.to_radians().sin(), 30f64.to_radians().cos(), 0.0];
     let json = format!(
         r#"{{
@@ -488,37 +494,8 @@ fn shading_normals_shade_light_traced_surfaces_like_camera_paths() {
                   "spd": {{"type": "Uniform", "min_nm": 400, "max_nm": 700}}}}]
     }}"#
     );
-    let s = scene(&json);
-    let spd = Uniform::new(400.0, 700.0).unwrap();
-    let images: Vec<_> = (0..16).map(|seed| render_inline(&s, 100_000, 300 + seed, 2).1).collect();
-    let (w, h, b) = (32usize, 32usize, 8usize);
-    let intensity = 100.0 / (4.0 * std::f64::consts::PI);
-    let light = DVec3::new(2.2, 1.0, 0.2);
     let ns = DVec3::from_array(n);
-    let analytic_pixel = |px: f64, py: f64| {
-        let d = s.camera.direction(px, py);
-        let o = s.camera.position();
-        let p = o + d * (-o.y / d.y);
-        let to = light - p;
-        let r2 = to.length_squared();
-        let cos_s = (to / r2.sqrt()).dot(ns).max(0.0);
-        y_of_radiance(0.5 / std::f64::consts::PI * intensity * cos_s / r2, &spd)
-    };
-    for (bx, by, mean, se) in block_stats(&images, w, h, b) {
-        let mut expected = 0.0;
-        for y in by * b..(by + 1) * b {
-            for x in bx * b..(bx + 1) * b {
-                for (sx, sy) in [(0.125, 0.125), (0.375, 0.625), (0.625, 0.375), (0.875, 0.875)] {
-                    expected += analytic_pixel(x as f64 + sx, y as f64 + sy);
-                }
-            }
-        }
-        expected /= (b * b * 4) as f64;
-        assert!(
-            (mean - expected).abs() < 5.0 * se + 0.002 * expected,
-            "block ({bx}, {by}): {mean} vs {expected} (standard error {se})"
-        );
-    }
+    assert_lit_plane_matches(&scene(&json), 300, |to_light| to_light.dot(ns).max(0.0));
 }
 
 #[test]
