@@ -267,7 +267,7 @@ fn sharded_renders_merge_bit_for_bit() {
         merge_parts(&parts[..2], &dir.join("bad")).unwrap_err().to_string().contains("missing")
     );
     let twice = vec![parts[0].clone(), parts[0].clone(), parts[1].clone()];
-    assert!(merge_parts(&twice, &dir.join("bad")).unwrap_err().to_string().contains("overlaps"));
+    assert!(merge_parts(&twice, &dir.join("bad")).unwrap_err().to_string().contains("is also in"));
 }
 
 fn load_error(json: &str) -> String {

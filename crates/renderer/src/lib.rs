@@ -9,7 +9,9 @@
 //! xtask's `render` subcommand calls it. Nothing but `xtask` and the tests depend on this crate.
 
 pub mod accuracy;
+mod files;
 mod output;
+mod part;
 mod scene;
 
 use std::path::{Path, PathBuf};
@@ -22,8 +24,18 @@ use spectrace_tracer::{
     image_scale, render, trace_chunk,
 };
 
-pub use output::{PARTIAL_VERSION, PartialFilm, linear_srgb, write_exr, write_png};
-pub use scene::{EffectsSettings, Object, OutputSettings, Scene, SceneError, SceneFile, Settings};
+pub use files::{
+    MAX_OUTPUT_NAME_BYTES, MAX_PART_BYTES, MAX_SCENE_BYTES, check_no_input_replaced,
+    check_output_name, prepare_out_dir, read_bounded, same_file, write_atomically,
+};
+pub use output::{
+    EncodedImage, encode_image, linear_srgb, write_exr, write_exr_scaled, write_png,
+    write_png_scaled,
+};
+pub use part::{PARTIAL_VERSION, PartialFilm};
+pub use scene::{
+    EffectsSettings, LoadOptions, Object, OutputSettings, Scene, SceneError, SceneFile, Settings,
+};
 
 /// Command-line overrides of a scene's settings.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -44,6 +56,8 @@ pub struct RenderOptions {
     pub out_dir: PathBuf,
     /// Show a progress bar and print the effects decision.
     pub verbose: bool,
+    /// Refuse files (OBJ meshes) outside the scene file's folder (see [`LoadOptions`]).
+    pub restrict_paths: bool,
 }
 
 /// Why a render failed.
@@ -90,6 +104,14 @@ pub struct RenderReport {
     /// Contributions rejected by the film as non-finite or out of range (0 on every shipped
     /// scene).
     pub rejected_contributions: u64,
+    /// The EXR holds the image multiplied by `2^exr_scale_log2`: 0 unless the image lies beyond
+    /// the range of 32-bit floats (see [`encode_image`]).
+    pub exr_scale_log2: i32,
+    /// Channel values that would have overflowed to infinity (or underflowed to zero) in the
+    /// EXR without that scale.
+    pub out_of_range_values: u64,
+    /// Anything the user should know about the result (also printed).
+    pub warnings: Vec<String>,
     /// Tracer counters.
     pub stats: TraceStats,
     /// Total power of the lights (W).
@@ -209,8 +231,37 @@ pub fn probe(scene: &Scene, effects: &Effects) -> Result<(), SceneError> {
 /// # Errors
 /// [`RenderError`] for an invalid scene or options, or a file that cannot be written.
 pub fn render_file(path: &Path, options: &RenderOptions) -> Result<RenderReport, RenderError> {
-    let scene = Scene::load(path)?;
+    let scene = Scene::load_with(path, LoadOptions { restrict_paths: options.restrict_paths })?;
     render_scene(&scene, options)
+}
+
+/// The files a render will write, checked before any work starts: a valid base name, an output
+/// folder that is a folder, and no output that would replace an input.
+fn planned_outputs(
+    out_dir: &Path,
+    name: &str,
+    settings: &OutputSettings,
+    shard: Option<(u64, u64)>,
+    inputs: &[PathBuf],
+) -> Result<Vec<PathBuf>, RenderError> {
+    check_output_name(name).map_err(|e| RenderError::Options(format!("output name: {e}")))?;
+    prepare_out_dir(out_dir).map_err(RenderError::Options)?;
+    let outputs = match shard {
+        Some((k, n)) => vec![out_dir.join(format!("{name}.part-{k}-of-{n}.bin"))],
+        None => {
+            let mut v = Vec::new();
+            if settings.exr {
+                v.push(out_dir.join(format!("{name}.exr")));
+            }
+            if settings.png {
+                v.push(out_dir.join(format!("{name}.png")));
+            }
+            v.push(out_dir.join(format!("{name}.json")));
+            v
+        }
+    };
+    check_no_input_replaced(&outputs, inputs).map_err(RenderError::Options)?;
+    Ok(outputs)
 }
 
 /// Renders a loaded scene with overrides and writes its outputs.
@@ -219,6 +270,8 @@ pub fn render_file(path: &Path, options: &RenderOptions) -> Result<RenderReport,
 /// As [`render_file`].
 pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderReport, RenderError> {
     let plan = plan_for(scene, options)?;
+    let name = scene.output_name();
+    planned_outputs(&options.out_dir, &name, &scene.output, plan.shard, &scene.inputs)?;
     let effects = decide_effects(scene, options.effects);
     if options.verbose {
         eprintln!("{}", effects.summary());
@@ -231,9 +284,6 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
         .map_err(|e| RenderError::Options(e.to_string()))?;
     bar.finish_and_clear();
     let wall = started.elapsed().as_secs_f64();
-    std::fs::create_dir_all(&options.out_dir)
-        .map_err(|e| RenderError::File { path: options.out_dir.clone(), message: e.to_string() })?;
-    let name = scene.output_name();
     if let Some((k, n)) = plan.shard {
         let part = PartialFilm {
             version: PARTIAL_VERSION,
@@ -247,52 +297,69 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
             output: output.clone(),
         };
         let path = options.out_dir.join(format!("{name}.part-{k}-of-{n}.bin"));
-        let bytes = bincode::serde::encode_to_vec(&part, bincode::config::standard())
-            .map_err(|e| RenderError::File { path: path.clone(), message: e.to_string() })?;
-        std::fs::write(&path, bytes)
-            .map_err(|e| RenderError::File { path: path.clone(), message: e.to_string() })?;
+        let bytes =
+            part.encode().map_err(|message| RenderError::File { path: path.clone(), message })?;
+        write_atomically(&path, |p| std::fs::write(p, &bytes).map_err(|e| e.to_string()))
+            .map_err(|message| RenderError::File { path: path.clone(), message })?;
         return Ok(report(
             scene.path.display().to_string(),
-            &scene.camera,
+            (scene.camera.width(), scene.camera.height()),
             plan,
             effects,
             &output,
             wall,
             scene.lights.power(),
-            vec![path.display().to_string()],
+            Written { files: vec![path.display().to_string()], ..Written::default() },
         ));
     }
-    let outputs =
+    let written =
         write_outputs(&options.out_dir, &name, &scene.output, scene.lights.power(), &output)?;
     let report = report(
         scene.path.display().to_string(),
-        &scene.camera,
+        (scene.camera.width(), scene.camera.height()),
         plan,
         effects,
         &output,
         wall,
         scene.lights.power(),
-        outputs,
+        written,
     );
     write_sidecar(&options.out_dir, &name, &report)?;
     Ok(report)
 }
 
+/// What [`write_outputs`] wrote.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Written {
+    /// The files.
+    pub files: Vec<String>,
+    /// The EXR's scale exponent (see [`encode_image`]).
+    pub exr_scale_log2: i32,
+    /// Values beyond the range of 32-bit floats without that scale.
+    pub out_of_range_values: u64,
+    /// Warnings for the user.
+    pub warnings: Vec<String>,
+}
+
 #[allow(clippy::too_many_arguments)]
 fn report(
     scene: String,
-    camera: &spectrace_tracer::PinholeCamera,
+    (width, height): (u32, u32),
     plan: RenderPlan,
     effects: Effects,
     output: &RenderOutput,
     wall: f64,
     light_power: f64,
-    outputs: Vec<String>,
+    written: Written,
 ) -> RenderReport {
+    let mut warnings = written.warnings;
+    if output.film.rejected() > 0 {
+        warnings.push(rejected_warning(output.film.rejected()));
+    }
     RenderReport {
         scene,
-        width: camera.width(),
-        height: camera.height(),
+        width,
+        height,
         plan,
         effects,
         effects_summary: effects.summary(),
@@ -302,9 +369,19 @@ fn report(
         rejected_contributions: output.film.rejected(),
         stats: output.stats,
         light_power,
-        outputs,
+        outputs: written.files,
+        exr_scale_log2: written.exr_scale_log2,
+        out_of_range_values: written.out_of_range_values,
+        warnings,
         version: env!("CARGO_PKG_VERSION").to_owned(),
     }
+}
+
+fn rejected_warning(n: u64) -> String {
+    format!(
+        "{n} contributions were not finite or beyond the film's range and were left out: \
+         the image is darker than it should be where they fell"
+    )
 }
 
 fn progress_bar(plan: &RenderPlan, visible: bool) -> indicatif::ProgressBar {
@@ -328,7 +405,8 @@ pub fn image(output: &RenderOutput, light_power: f64) -> Vec<spectrace_spectrum:
     output.film.to_xyz(image_scale(light_power, output.beams))
 }
 
-/// Writes the EXR and PNG of a finished render; returns their paths.
+/// Writes the EXR and PNG of a finished render (each to a temporary name, then renamed into
+/// place); returns what was written.
 ///
 /// # Errors
 /// [`RenderError::File`] if a file cannot be written.
@@ -338,21 +416,39 @@ pub fn write_outputs(
     settings: &OutputSettings,
     light_power: f64,
     output: &RenderOutput,
-) -> Result<Vec<String>, RenderError> {
+) -> Result<Written, RenderError> {
     let (w, h) = (output.film.width(), output.film.height());
-    let rgb = linear_srgb(&image(output, light_power));
-    let mut written = Vec::new();
+    let image = encode_image(output, light_power);
+    let mut written = Written {
+        exr_scale_log2: image.scale_log2,
+        out_of_range_values: image.out_of_range_values,
+        ..Written::default()
+    };
+    if image.scale_log2 != 0 {
+        written.warnings.push(format!(
+            "the image lies beyond the range of 32-bit floats ({} values would be infinite or \
+             zero): the EXR holds it multiplied by 2^{} (header attribute spectraceScaleLog2, \
+             sidecar exr_scale_log2)",
+            image.out_of_range_values, image.scale_log2
+        ));
+    }
+    let file_error = |path: &Path| {
+        let path = path.to_owned();
+        move |message| RenderError::File { path, message }
+    };
     if settings.exr {
         let path = dir.join(format!("{name}.exr"));
-        write_exr(&path, w, h, &rgb)
-            .map_err(|message| RenderError::File { path: path.clone(), message })?;
-        written.push(path.display().to_string());
+        write_atomically(&path, |p| write_exr_scaled(p, w, h, &image.rgb, image.scale_log2))
+            .map_err(file_error(&path))?;
+        written.files.push(path.display().to_string());
     }
     if settings.png {
         let path = dir.join(format!("{name}.png"));
-        write_png(&path, w, h, &rgb, settings.exposure)
-            .map_err(|message| RenderError::File { path: path.clone(), message })?;
-        written.push(path.display().to_string());
+        write_atomically(&path, |p| {
+            write_png_scaled(p, w, h, &image.rgb, settings.exposure, image.scale_log2)
+        })
+        .map_err(file_error(&path))?;
+        written.files.push(path.display().to_string());
     }
     Ok(written)
 }
@@ -361,110 +457,132 @@ fn write_sidecar(dir: &Path, name: &str, report: &RenderReport) -> Result<(), Re
     let path = dir.join(format!("{name}.json"));
     let text = serde_json::to_string_pretty(report)
         .map_err(|e| RenderError::File { path: path.clone(), message: e.to_string() })?;
-    std::fs::write(&path, text).map_err(|e| RenderError::File { path, message: e.to_string() })
+    write_atomically(&path, |p| std::fs::write(p, &text).map_err(|e| e.to_string()))
+        .map_err(|message| RenderError::File { path, message })
 }
 
 /// Merges the partial films of a sharded render into the final outputs, bit-identical to a
 /// one-machine render with the same seed.
 ///
+/// Every part is read with a size limit and validated field by field ([`PartialFilm::decode`]);
+/// parts must come from the same render, may not share a chunk, and (without a time budget) must
+/// cover every chunk. Outputs go into `out_dir` under the parts' validated name and never replace
+/// a part file.
+///
 /// # Errors
-/// [`RenderError::File`] for unreadable parts; [`RenderError::Options`] when the parts do not
-/// belong together (different scene, plan or size), overlap, or miss chunks.
+/// [`RenderError::File`] for an unreadable or invalid part (naming the file and the field);
+/// [`RenderError::Options`] when the parts do not belong together, overlap, miss chunks, or their
+/// counts overflow.
 pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, RenderError> {
-    let started = Instant::now();
     let mut loaded: Vec<PartialFilm> = Vec::new();
     for path in parts {
-        let bytes = std::fs::read(path)
-            .map_err(|e| RenderError::File { path: path.clone(), message: e.to_string() })?;
-        let (part, _): (PartialFilm, usize) =
-            bincode::serde::decode_from_slice(&bytes, bincode::config::standard()).map_err(
-                |e| RenderError::File {
-                    path: path.clone(),
-                    message: format!("not a Spectrace partial film: {e}"),
-                },
-            )?;
-        if part.version != PARTIAL_VERSION {
-            return Err(RenderError::File {
-                path: path.clone(),
-                message: format!(
-                    "partial film version {} (expected {PARTIAL_VERSION})",
-                    part.version
-                ),
-            });
-        }
+        let part = PartialFilm::read(path)
+            .map_err(|message| RenderError::File { path: path.clone(), message })?;
         loaded.push(part);
     }
     let Some(first) = loaded.first().cloned() else {
         return Err(RenderError::Options("merge needs at least one partial film".to_owned()));
     };
+    let outputs = planned_outputs(out_dir, &first.name, &first.output_settings, None, parts)?;
+    let (w, h) = (first.output.film.width(), first.output.film.height());
     let mut merged = RenderOutput {
-        film: Film::new(first.output.film.width(), first.output.film.height())
-            .map_err(|e| RenderError::Options(e.to_string()))?,
+        film: Film::new(w, h).map_err(|e| RenderError::Options(e.to_string()))?,
         stats: TraceStats::default(),
         chunks: Vec::new(),
         beams: 0,
         seconds: 0.0,
     };
-    for (part, path) in loaded.iter().zip(parts) {
-        if part.scene_fingerprint != first.scene_fingerprint
-            || part.plan != first.plan
-            || part.effects != first.effects
-        {
+    // Which part holds each chunk: coverage is checked by chunk identity, not by count.
+    let mut owner: std::collections::BTreeMap<u64, usize> = std::collections::BTreeMap::new();
+    for (index, (part, path)) in loaded.iter().zip(parts).enumerate() {
+        let different = if part.scene_fingerprint != first.scene_fingerprint {
+            Some("scene")
+        } else if part.plan != first.plan {
+            Some("plan (beams, chunk size, seed or time budget)")
+        } else if part.effects != first.effects {
+            Some("effects decision")
+        } else if part.name != first.name || part.output_settings != first.output_settings {
+            Some("output settings")
+        } else if part.light_power.to_bits() != first.light_power.to_bits() {
+            Some("light power")
+        } else if (part.output.film.width(), part.output.film.height()) != (w, h) {
+            Some("image size")
+        } else {
+            None
+        };
+        if let Some(what) = different {
             return Err(RenderError::Options(format!(
-                "{}: belongs to another render (scene, settings or effects differ from {})",
+                "{}: belongs to another render: its {what} differs from {}",
                 path.display(),
                 parts[0].display()
             )));
         }
-        if part.output.chunks.iter().any(|c| merged.chunks.binary_search(c).is_ok()) {
-            return Err(RenderError::Options(format!(
-                "{}: overlaps chunks already merged (the same shard twice?)",
-                path.display()
-            )));
+        for &c in &part.output.chunks {
+            if let Some(&other) = owner.get(&c) {
+                return Err(RenderError::Options(format!(
+                    "{}: chunk {c} is also in {} (the same shard twice?)",
+                    path.display(),
+                    parts[other].display()
+                )));
+            }
+            owner.insert(c, index);
         }
+        add_counts(&merged, &part.output).map_err(|what| {
+            RenderError::Options(format!(
+                "{}: adding its {what} to the other parts' overflows: not parts of one render",
+                path.display()
+            ))
+        })?;
         merged
             .merge(&part.output)
             .map_err(|e| RenderError::Options(format!("{}: {e}", path.display())))?;
     }
     if first.plan.time_budget.is_none() {
         let expected = first.plan.chunks();
-        if merged.chunks.len() as u64 != expected {
-            let missing = (0..expected)
-                .filter(|c| merged.chunks.binary_search(c).is_err())
-                .take(10)
-                .collect::<Vec<_>>();
+        if owner.len() as u64 != expected {
+            let missing =
+                (0..expected).filter(|c| !owner.contains_key(c)).take(10).collect::<Vec<_>>();
             return Err(RenderError::Options(format!(
                 "the parts cover {} of {expected} chunks; missing e.g. {missing:?}",
-                merged.chunks.len()
+                owner.len()
             )));
         }
     }
-    std::fs::create_dir_all(out_dir)
-        .map_err(|e| RenderError::File { path: out_dir.to_owned(), message: e.to_string() })?;
-    let outputs =
+    let written =
         write_outputs(out_dir, &first.name, &first.output_settings, first.light_power, &merged)?;
-    let mut report = RenderReport {
-        scene: first.scene_path.clone(),
-        width: merged.film.width(),
-        height: merged.film.height(),
-        plan: first.plan,
-        effects: first.effects,
-        effects_summary: first.effects.summary(),
-        beams: merged.beams,
-        wall_seconds: loaded.iter().map(|p| p.output.seconds).fold(0.0, f64::max),
-        beams_per_second: 0.0,
-        rejected_contributions: merged.film.rejected(),
-        stats: merged.stats,
-        light_power: first.light_power,
-        outputs,
-        version: env!("CARGO_PKG_VERSION").to_owned(),
-    };
+    debug_assert!(
+        written.files.iter().all(|f| outputs.iter().any(|o| o.display().to_string() == *f))
+    );
     let total_seconds: f64 = loaded.iter().map(|p| p.output.seconds).sum();
+    let mut report = report(
+        first.scene_path.clone(),
+        (w, h),
+        first.plan,
+        first.effects,
+        &merged,
+        loaded.iter().map(|p| p.output.seconds).fold(0.0, f64::max),
+        first.light_power,
+        written,
+    );
     report.beams_per_second =
         if total_seconds > 0.0 { merged.beams as f64 / total_seconds } else { 0.0 };
-    let _ = started;
     write_sidecar(out_dir, &first.name, &report)?;
     Ok(report)
+}
+
+/// Checks that adding `part`'s counters to `merged`'s cannot overflow (tampered parts could make
+/// them wrap); names the counter that would.
+fn add_counts(merged: &RenderOutput, part: &RenderOutput) -> Result<(), &'static str> {
+    let fits = |a: u64, b: u64, what: &'static str| a.checked_add(b).map(|_| ()).ok_or(what);
+    fits(merged.beams, part.beams, "beams")?;
+    fits(merged.stats.beams, part.stats.beams, "beam count")?;
+    fits(merged.stats.hits, part.stats.hits, "hit count")?;
+    fits(merged.stats.splats, part.stats.splats, "splat count")?;
+    fits(merged.stats.roulette_kills, part.stats.roulette_kills, "roulette count")?;
+    fits(merged.stats.depth_limited, part.stats.depth_limited, "depth-limit count")?;
+    fits(merged.film.accepted(), part.film.accepted(), "accepted-contribution count")?;
+    fits(merged.film.rejected(), part.film.rejected(), "rejected-contribution count")?;
+    Ok(())
 }
 
 /// One row of the effects benchmark: the same scene and beams rendered with the effects

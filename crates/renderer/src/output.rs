@@ -1,12 +1,17 @@
-//! Writing images: linear EXR, sRGB PNG with exposure, and partial films for sharded renders.
+//! Writing images: linear EXR and sRGB PNG with exposure, never a silent infinity.
+//!
+//! The EXR holds 32-bit floats, whose range (about 1.2e-38 to 3.4e38) is far narrower than the
+//! film's. [`encode_image`] therefore checks the image's range first: an image that fits is
+//! written as it is, bit for bit the film's values; one that does not (a light of 1e43 W, or of
+//! 1e-45 W) is written multiplied by a power of two, `2^exr_scale_log2`, chosen so its largest
+//! value is near 1. The exponent is recorded in the EXR header (`spectraceScaleLog2`) and in the
+//! sidecar, a warning says so, and the sidecar counts the values that would have overflowed to
+//! infinity or underflowed to zero without it. The PNG always shows the true values.
 
 use std::path::Path;
 
-use serde::{Deserialize, Serialize};
 use spectrace_spectrum::{Xyz, srgb_encode};
-use spectrace_tracer::{Effects, RenderOutput, RenderPlan};
-
-use crate::OutputSettings;
+use spectrace_tracer::{RenderOutput, image_scale};
 
 /// Linear sRGB (Rec. 709 primaries, D65 white) of every pixel, row-major from the top-left.
 pub fn linear_srgb(xyz: &[Xyz]) -> Vec<[f32; 3]> {
@@ -24,20 +29,39 @@ pub fn linear_srgb(xyz: &[Xyz]) -> Vec<[f32; 3]> {
 /// # Errors
 /// Any error of the `exr` crate, as text.
 pub fn write_exr(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<(), String> {
+    write_exr_scaled(path, width, height, rgb, 0)
+}
+
+/// Writes a linear EXR of values stored multiplied by `2^scale_log2`; a non-zero exponent is
+/// recorded in the header attribute `spectraceScaleLog2`.
+///
+/// # Errors
+/// Any error of the `exr` crate, as text.
+pub fn write_exr_scaled(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[[f32; 3]],
+    scale_log2: i32,
+) -> Result<(), String> {
     use exr::prelude::*;
     let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
         let p = rgb[y * width as usize + x];
         (p[0], p[1], p[2])
     });
-    Image::from_encoded_channels(
+    let mut image = Image::from_encoded_channels(
         (width as usize, height as usize),
         Encoding::SMALL_LOSSLESS,
         channels,
-    )
-    .write()
-    .non_parallel()
-    .to_file(path)
-    .map_err(|e| e.to_string())
+    );
+    if scale_log2 != 0 {
+        image
+            .layer_data
+            .attributes
+            .other
+            .insert(Text::from("spectraceScaleLog2"), AttributeValue::I32(scale_log2));
+    }
+    image.write().non_parallel().to_file(path).map_err(|e| e.to_string())
 }
 
 /// Writes an 8-bit sRGB PNG of `linear * 2^exposure` (negative values, from out-of-gamut
@@ -52,13 +76,39 @@ pub fn write_png(
     rgb: &[[f32; 3]],
     exposure: f64,
 ) -> Result<(), String> {
+    write_png_scaled(path, width, height, rgb, exposure, 0)
+}
+
+/// As [`write_png`], for values stored multiplied by `2^scale_log2` (the PNG shows the true
+/// values times `2^exposure`).
+///
+/// # Errors
+/// Any error of the `image` crate, as text.
+pub fn write_png_scaled(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[[f32; 3]],
+    exposure: f64,
+    scale_log2: i32,
+) -> Result<(), String> {
     let gain = 2f64.powf(exposure);
+    let shift = exposure - f64::from(scale_log2);
+    let display = |c: f32| -> f64 {
+        let c = f64::from(c);
+        if scale_log2 == 0 {
+            c * gain
+        } else if c > 0.0 {
+            // The true value may lie beyond f64: work in log2; anything that large saturates.
+            (c.log2() + shift).min(1000.0).exp2()
+        } else {
+            0.0
+        }
+    };
     let bytes: Vec<u8> = rgb
         .iter()
         .flat_map(|p| {
-            p.map(|c| {
-                (srgb_encode(f64::from(c) * gain) * 255.0 + 0.5).floor().clamp(0.0, 255.0) as u8
-            })
+            p.map(|c| (srgb_encode(display(c)) * 255.0 + 0.5).floor().clamp(0.0, 255.0) as u8)
         })
         .collect();
     let image =
@@ -66,29 +116,85 @@ pub fn write_png(
     image.save_with_format(path, image::ImageFormat::Png).map_err(|e| e.to_string())
 }
 
-/// A shard's result, written by `spectrace render --shard K/N` and read by `spectrace merge`.
-/// Lossless: the film's exact fixed-point sums.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct PartialFilm {
-    /// Format version (1).
-    pub version: u32,
-    /// Fingerprint of the scene (all parts of one image must share it).
-    pub scene_fingerprint: u64,
-    /// The scene file, for the final image's metadata.
-    pub scene_path: String,
-    /// The plan (beams, chunk size, seed) every part must share.
-    pub plan: RenderPlan,
-    /// Total power of the scene's lights (W), for the image's normalisation.
-    pub light_power: f64,
-    /// The effects decision the parts were rendered with.
-    pub effects: Effects,
-    /// Output settings of the scene.
-    pub output_settings: OutputSettings,
-    /// Base name of the output files.
-    pub name: String,
-    /// The shard's render.
-    pub output: RenderOutput,
+/// An image ready for the EXR: linear sRGB in 32-bit floats, possibly scaled to fit their range.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EncodedImage {
+    /// Linear sRGB per pixel, row-major, multiplied by `2^scale_log2`.
+    pub rgb: Vec<[f32; 3]>,
+    /// The exponent of the power of two the values were multiplied by (0 when the image fits).
+    pub scale_log2: i32,
+    /// Channel values that would have overflowed to infinity, or underflowed from a non-zero
+    /// value to zero, in 32-bit floats without the scale.
+    pub out_of_range_values: u64,
 }
 
-/// Current [`PartialFilm::version`].
-pub const PARTIAL_VERSION: u32 = 1;
+/// Largest magnitude written unscaled: half of `f32::MAX`, so rounding to f32 cannot overflow.
+const F32_SAFE_MAX: f64 = 1.7e38;
+/// f32's smallest normal number.
+const F32_SAFE_MIN: f64 = 1.1754943508222875e-38;
+/// An image whose largest value is below this (2^-100) is scaled up.
+const DIM_LIMIT: f64 = 7.888609052210118e-31;
+
+/// `x * 2^e`, exact unless the result over- or underflows (`ldexp`).
+fn ldexp(mut x: f64, mut e: i64) -> f64 {
+    while e > 1000 {
+        x *= 2f64.powi(1000);
+        e -= 1000;
+    }
+    while e < -1000 {
+        x *= 2f64.powi(-1000);
+        e += 1000;
+    }
+    x * 2f64.powi(e as i32)
+}
+
+/// The binary exponent of a positive finite `x` (`x = m 2^e`, `m` in `[1, 2)`).
+fn exponent(x: f64) -> i64 {
+    x.log2().floor() as i64
+}
+
+/// The image of a finished render (light power over beams times the film), as the EXR stores it;
+/// see the module docs for the scaling of images beyond the range of 32-bit floats.
+pub fn encode_image(output: &RenderOutput, light_power: f64) -> EncodedImage {
+    let exact = output.film.to_xyz(image_scale(light_power, output.beams));
+    let rgb: Vec<[f64; 3]> = exact.iter().map(|p| p.to_linear_srgb()).collect();
+    let largest =
+        rgb.iter().flatten().try_fold(0.0f64, |m, &c| c.is_finite().then(|| m.max(c.abs())));
+    // An image fits if nothing overflows and it is not so dim that 32-bit floats lose its
+    // precision; single dim pixels of a normal image round to f32 as any renderer's would.
+    let fits = largest.is_some_and(|m| m <= F32_SAFE_MAX && (m == 0.0 || m >= DIM_LIMIT));
+    if fits {
+        return EncodedImage { rgb: to_f32(&rgb), scale_log2: 0, out_of_range_values: 0 };
+    }
+    // Recompute without overflow: the power's mantissa over the beams, then powers of two.
+    let beams = output.beams.max(1) as f64;
+    let power_exp = if light_power > 0.0 { exponent(light_power) } else { 0 };
+    let base = ldexp(light_power, -power_exp) / beams;
+    let rgb: Vec<[f64; 3]> = output.film.to_xyz(base).iter().map(|p| p.to_linear_srgb()).collect();
+    let largest = rgb.iter().flatten().fold(0.0f64, |m, &c| m.max(c.abs()));
+    if !(largest > 0.0 && largest.is_finite()) {
+        return EncodedImage { rgb: to_f32(&rgb), scale_log2: 0, out_of_range_values: 0 };
+    }
+    // The true image is `rgb * 2^power_exp`; store it times `2^scale` with the largest value in
+    // [1, 2).
+    let true_exp = exponent(largest) + power_exp;
+    let scale = (-true_exp).clamp(i64::from(i32::MIN / 2), i64::from(i32::MAX / 2));
+    let out_of_range_values = rgb
+        .iter()
+        .flatten()
+        .filter(|&&c| {
+            let a = c.abs();
+            a > 0.0 && {
+                let e = a.log2() + power_exp as f64;
+                e > F32_SAFE_MAX.log2() || e < F32_SAFE_MIN.log2() - 23.0
+            }
+        })
+        .count() as u64;
+    let stored: Vec<[f64; 3]> =
+        rgb.iter().map(|p| p.map(|c| ldexp(c, power_exp + scale))).collect();
+    EncodedImage { rgb: to_f32(&stored), scale_log2: scale as i32, out_of_range_values }
+}
+
+fn to_f32(rgb: &[[f64; 3]]) -> Vec<[f32; 3]> {
+    rgb.iter().map(|p| p.map(|c| c as f32)).collect()
+}

@@ -12,6 +12,8 @@ use spectrace_tracer::{
     DEFAULT_CHUNK_BEAMS, EffectsMode, LightTracerSettings, PinholeCamera, RenderPlan,
 };
 
+use crate::files::{MAX_SCENE_BYTES, check_output_name, read_bounded};
+
 /// A scene file, as written (see `scenes/README.md` for every field).
 #[derive(Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -188,17 +190,50 @@ pub struct Scene {
     pub effects: EffectsSettings,
     /// Output settings.
     pub output: OutputSettings,
+    /// Every file the scene was read from: the scene file (when loaded from one) and its OBJ
+    /// meshes. Outputs may never replace any of them.
+    pub inputs: Vec<PathBuf>,
+}
+
+/// How a scene file may refer to other files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct LoadOptions {
+    /// Refuse any file (OBJ mesh) outside the scene file's folder, symlinks resolved: for
+    /// render farms that accept scenes from others (`--restrict-paths`).
+    pub restrict_paths: bool,
 }
 
 impl Scene {
-    /// Reads and validates a scene file.
+    /// Reads and validates a scene file (at most [`MAX_SCENE_BYTES`] bytes).
     ///
     /// # Errors
     /// [`SceneError`] with the file, line, column and field of the first problem.
     pub fn load(path: &Path) -> Result<Self, SceneError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|source| SceneError::Io { path: path.to_owned(), source })?;
-        Self::from_json(&text, path)
+        Self::load_with(path, LoadOptions::default())
+    }
+
+    /// As [`Scene::load`], with options.
+    ///
+    /// # Errors
+    /// As [`Scene::load`]; with `restrict_paths`, also a mesh outside the scene's folder.
+    pub fn load_with(path: &Path, options: LoadOptions) -> Result<Self, SceneError> {
+        let bytes = read_bounded(path, MAX_SCENE_BYTES, "scene").map_err(|message| {
+            SceneError::Scene { path: path.to_owned(), field: "(file)".to_owned(), message }
+        })?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+            let line = valid.iter().filter(|&&b| b == b'\n').count() + 1;
+            let column = valid.iter().rev().take_while(|&&b| b != b'\n').count() + 1;
+            SceneError::Syntax {
+                path: path.to_owned(),
+                line,
+                column,
+                message: "the file is not UTF-8 text (a scene file is JSON in UTF-8)".to_owned(),
+            }
+        })?;
+        let mut scene = Self::from_json_with(&text, path, options)?;
+        scene.inputs.insert(0, path.to_owned());
+        Ok(scene)
     }
 
     /// Validates a scene given as JSON text; `path` names it in errors and resolves relative
@@ -207,6 +242,21 @@ impl Scene {
     /// # Errors
     /// [`SceneError`] with the line, column and field of the first problem.
     pub fn from_json(text: &str, path: &Path) -> Result<Self, SceneError> {
+        Self::from_json_with(text, path, LoadOptions::default())
+    }
+
+    /// As [`Scene::from_json`], with options.
+    ///
+    /// # Errors
+    /// As [`Scene::from_json`].
+    pub fn from_json_with(
+        text: &str,
+        path: &Path,
+        options: LoadOptions,
+    ) -> Result<Self, SceneError> {
+        // Editors on some systems start UTF-8 files with a byte-order mark; JSON does not allow
+        // one, but it carries no meaning, so it is skipped.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         // Syntax first, so syntax errors are reported as such with their position.
         let value: serde_json::Value =
             serde_json::from_str(text).map_err(|e| SceneError::Syntax {
@@ -253,13 +303,8 @@ impl Scene {
                 format!("{t}: must be a positive number of seconds"),
             ));
         }
-        if let Some(name) = &file.output.name
-            && (name.is_empty() || name.contains(['/', '\\']) || name == "." || name == "..")
-        {
-            return Err(scene_error(
-                "output.name",
-                format!("{name:?}: must be a plain, non-empty file name (no directories)"),
-            ));
+        if let Some(name) = &file.output.name {
+            check_output_name(name).map_err(|e| scene_error("output.name", e))?;
         }
         if !file.output.exposure.is_finite() {
             return Err(scene_error("output.exposure", "must be finite".to_owned()));
@@ -267,7 +312,20 @@ impl Scene {
         let mut shapes = Vec::with_capacity(file.objects.len());
         let mut materials = Vec::with_capacity(file.objects.len());
         let mut non_convex = Vec::with_capacity(file.objects.len());
+        let mut inputs = Vec::new();
+        let base = path.parent().unwrap_or_else(|| Path::new("."));
         for (index, mut object) in file.objects.into_iter().enumerate() {
+            if let Shape::Mesh(mesh) = &object.shape
+                && let Some(obj) = mesh.obj_path()
+            {
+                let resolved = base.join(obj);
+                if options.restrict_paths {
+                    check_inside(base, &resolved).map_err(|message| {
+                        scene_error(&format!("objects[{index}].shape.obj"), message)
+                    })?;
+                }
+                inputs.push(resolved);
+            }
             if let Some(t) = object.transform.take() {
                 object.shape = apply_transform(object.shape, &t).map_err(|message| {
                     scene_error(&format!("objects[{index}].transform"), message)
@@ -277,12 +335,11 @@ impl Scene {
             non_convex.push(!matches!(object.shape, Shape::Rectangle(_) | Shape::Disk(_)));
             object
                 .shape
-                .load(path.parent().unwrap_or_else(|| Path::new(".")))
+                .load(base)
                 .map_err(|e| scene_error(&format!("objects[{index}].shape"), e.to_string()))?;
             shapes.push(object.shape);
             materials.push(Arc::from(object.material));
         }
-        let base = path.parent().unwrap_or_else(|| Path::new("."));
         let world = World::with_base_dir(shapes, base)
             .map_err(|e| scene_error("objects", e.to_string()))?;
         let lights =
@@ -299,6 +356,7 @@ impl Scene {
             settings: file.settings,
             effects: file.effects,
             output: file.output,
+            inputs,
         })
     }
 
@@ -357,6 +415,25 @@ fn apply_transform(shape: Shape, t: &Transform) -> Result<Shape, String> {
         map.insert("transform".to_owned(), serde_json::json!({ "matrix": rows }));
     }
     serde_json::from_value(value).map_err(|e| e.to_string())
+}
+
+/// Refuses `file` unless it resolves (symlinks followed) to a place inside `base`.
+fn check_inside(base: &Path, file: &Path) -> Result<(), String> {
+    let base_dir = if base.as_os_str().is_empty() { Path::new(".") } else { base };
+    let root = std::fs::canonicalize(base_dir)
+        .map_err(|e| format!("cannot resolve the scene's folder {}: {e}", base_dir.display()))?;
+    let real = std::fs::canonicalize(file)
+        .map_err(|e| format!("{}: cannot resolve: {e}", file.display()))?;
+    if real.starts_with(&root) {
+        Ok(())
+    } else {
+        Err(format!(
+            "{} resolves to {}, outside the scene's folder {} (refused by --restrict-paths)",
+            file.display(),
+            real.display(),
+            root.display()
+        ))
+    }
 }
 
 /// serde_json appends " at line L column C"; the position is reported separately.

@@ -28,19 +28,19 @@ enum Command {
         /// The scene file (JSON; see scenes/README.md).
         scene: PathBuf,
         /// Beams for the whole image (overrides settings.beams).
-        #[arg(long, conflicts_with = "time")]
+        #[arg(long, conflicts_with = "time", allow_negative_numbers = true, value_parser = parse_count)]
         beams: Option<u64>,
         /// Render for this many seconds instead of a fixed number of beams.
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true, value_parser = parse_seconds)]
         time: Option<f64>,
         /// Output directory.
         #[arg(long, default_value = "out")]
         out: PathBuf,
         /// Worker threads (0: one per core; overrides settings.threads).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true, value_parser = parse_threads)]
         threads: Option<usize>,
         /// Seed of every random stream (overrides settings.seed).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true, value_parser = parse_seed)]
         seed: Option<u64>,
         /// Render only the work chunks whose index is K mod N and write a partial film (K/N).
         #[arg(long, value_parser = parse_shard)]
@@ -51,6 +51,10 @@ enum Command {
         /// No progress bar or effects line.
         #[arg(long)]
         quiet: bool,
+        /// Refuse any file the scene names (OBJ meshes) outside the scene file's folder, symlinks
+        /// resolved: for scenes from others (see docs/robustness.md).
+        #[arg(long)]
+        restrict_paths: bool,
     },
     /// Measure beams/s of scenes, and what the effects analysis saves (auto against off).
     Bench {
@@ -58,10 +62,10 @@ enum Command {
         #[arg(required = true)]
         scenes: Vec<PathBuf>,
         /// Beams per render.
-        #[arg(long, default_value_t = 1_000_000)]
+        #[arg(long, default_value_t = 1_000_000, allow_negative_numbers = true, value_parser = parse_count)]
         beams: u64,
         /// Worker threads (0: one per core).
-        #[arg(long, default_value_t = 0)]
+        #[arg(long, default_value_t = 0, allow_negative_numbers = true, value_parser = parse_threads)]
         threads: usize,
     },
     /// Error against time for every accuracy knob: writes docs/accuracy.md and docs/accuracy.svg.
@@ -93,6 +97,42 @@ enum Command {
         #[arg(long, default_value = "out")]
         out: PathBuf,
     },
+}
+
+/// A whole number of at least 1 (beams).
+fn parse_count(s: &str) -> Result<u64, String> {
+    match s.trim().parse::<u64>() {
+        Ok(0) => Err(format!("`{s}`: must be at least 1")),
+        Ok(n) => Ok(n),
+        Err(_) if s.trim().parse::<f64>().is_ok() => Err(format!(
+            "`{s}`: must be a whole number from 1 to {} (no sign, no decimals)",
+            u64::MAX
+        )),
+        Err(_) => Err(format!("`{s}`: not a whole number")),
+    }
+}
+
+/// A positive, finite number of seconds.
+fn parse_seconds(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(t) if t > 0.0 && t.is_finite() => Ok(t),
+        Ok(_) => Err(format!("`{s}`: must be a positive, finite number of seconds")),
+        Err(_) => Err(format!("`{s}`: not a number of seconds")),
+    }
+}
+
+/// A thread count (0: one per core).
+fn parse_threads(s: &str) -> Result<usize, String> {
+    s.trim().parse::<usize>().map_err(|_| {
+        format!("`{s}`: must be a whole number of threads, from 0 (one per core) to 256")
+    })
+}
+
+/// A 64-bit seed.
+fn parse_seed(s: &str) -> Result<u64, String> {
+    s.trim()
+        .parse::<u64>()
+        .map_err(|_| format!("`{s}`: must be a whole number from 0 to {}", u64::MAX))
 }
 
 fn parse_shard(s: &str) -> Result<(u64, u64), String> {
@@ -146,7 +186,18 @@ fn bench(scenes: &[PathBuf], beams: u64, threads: usize) -> ExitCode {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Render { scene, beams, time, out, threads, seed, shard, effects, quiet } => {
+        Command::Render {
+            scene,
+            beams,
+            time,
+            out,
+            threads,
+            seed,
+            shard,
+            effects,
+            quiet,
+            restrict_paths,
+        } => {
             let options = RenderOptions {
                 beams,
                 time,
@@ -156,6 +207,7 @@ fn main() -> ExitCode {
                 effects,
                 out_dir: out,
                 verbose: !quiet,
+                restrict_paths,
             };
             render_file(&scene, &options)
         }
@@ -193,6 +245,9 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(report) => {
+            for w in &report.warnings {
+                eprintln!("warning: {w}");
+            }
             println!(
                 "{} beams in {:.2} s ({:.3e} beams/s), {} rejected contributions; wrote {}",
                 report.beams,
