@@ -9,6 +9,8 @@
 //! - `cargo xtask render [SCENE] [options]`: builds the renderer in release mode and renders a
 //!   scene (default `scenes/showcase.json`); options go to `spectrace render`.
 //! - `cargo xtask accuracy [SCENES]`: the error-against-time report, `docs/accuracy.md`.
+//! - `cargo xtask fuzz [--cases N] [--seed S]`: a longer run of the scene and part-file fuzzer
+//!   (`tests/tests/fuzz.rs`) in release mode.
 
 use std::process::{Command, ExitCode};
 
@@ -81,6 +83,7 @@ fn main() -> ExitCode {
         }
         "render" => render(&args[1..]),
         "accuracy" => accuracy(&args[1..]),
+        "fuzz" => fuzz(&args[1..]),
         other => {
             eprintln!("unknown command `{other}`\n");
             print_help();
@@ -118,6 +121,47 @@ fn accuracy(args: &[String]) -> ExitCode {
     let mut command: Vec<String> = vec!["accuracy".into()];
     command.extend(args.iter().cloned());
     run_spectrace_in(&command, Some(&workspace_root()))
+}
+
+/// `cargo xtask fuzz [--cases N] [--seed S]`: the fuzz tests with N mutants per target (default
+/// 5000) from seed S (default: the time), in release mode.
+fn fuzz(args: &[String]) -> ExitCode {
+    let mut cases = "5000".to_owned();
+    let mut seed = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(1, |d| d.as_secs())
+        .to_string();
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        let value = it.next().filter(|v| v.parse::<u64>().is_ok());
+        match (a.as_str(), value) {
+            ("--cases", Some(v)) => cases = v.clone(),
+            ("--seed", Some(v)) => seed = v.clone(),
+            _ => {
+                eprintln!("usage: cargo xtask fuzz [--cases N] [--seed S] (whole numbers)");
+                return ExitCode::from(2);
+            }
+        }
+    }
+    eprintln!("fuzzing with {cases} cases per target, seed {seed}");
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
+    let status = Command::new(&cargo)
+        .args(["test", "--release", "-p", "spectrace-tests", "fuzz::", "--", "--nocapture"])
+        .env("SPECTRACE_FUZZ_CASES", &cases)
+        .env("SPECTRACE_FUZZ_SEED", &seed)
+        .current_dir(workspace_root())
+        .status();
+    match status {
+        Ok(s) if s.success() => ExitCode::SUCCESS,
+        Ok(_) => {
+            eprintln!("the fuzzer found a failure: rerun with --seed {seed} to reproduce it");
+            ExitCode::FAILURE
+        }
+        Err(e) => {
+            eprintln!("could not run cargo: {e}");
+            ExitCode::FAILURE
+        }
+    }
 }
 
 /// Builds `spectrace` in release mode, then runs it with `args` in the current directory.
@@ -171,6 +215,7 @@ fn print_help() {
          render [SCENE] [--beams N | --time SECS] [--out DIR] [--threads N] [--seed S] [--shard K/N]\n           \
                   build in release and render SCENE (default scenes/showcase.json)\n  \
          accuracy [SCENES]  error against time for every accuracy knob (docs/accuracy.md)\n  \
+         fuzz [--cases N] [--seed S]  fuzz the scene and part-file loaders (release)\n  \
          bench    run every crate's benchmarks (release)\n  \
          ci       run the checks CI runs: tests, rustfmt, clippy -D warnings\n  \
          help     this text"
