@@ -24,7 +24,9 @@ use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 use crate::disk::circle_extent;
-use crate::float::{Frame, finite_point, gamma, positive, stable_quadratic_roots, unit_direction};
+use crate::float::{
+    Frame, finite_point, gamma, positive, safe_length, stable_quadratic_roots, unit_direction,
+};
 use crate::shape::{Primitives, similarity};
 use crate::{Bounds, GeometryError, Hit, Ray, Transform};
 
@@ -60,7 +62,18 @@ impl TryFrom<CylinderRepr> for Cylinder {
         let axis = unit_direction(S, "axis", r.axis)?;
         let height = match r.height {
             Some(h) => positive(S, "height", h)?,
-            None => positive(S, "axis", r.axis.length())?,
+            None => {
+                let len = safe_length(r.axis);
+                if !len.is_finite() {
+                    return Err(GeometryError::parameter(
+                        S,
+                        "axis",
+                        r.axis,
+                        "too large: its length (the height) overflows; give a smaller axis or `height`",
+                    ));
+                }
+                positive(S, "axis", len)?
+            }
         };
         let radius = positive(S, "radius", r.radius)?;
         let t = r.transform.unwrap_or_default();

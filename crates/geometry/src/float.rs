@@ -26,18 +26,34 @@ pub(crate) fn finite_point(
     }
 }
 
-/// A unit vector along `v`, or an error naming the field when `v` is zero or not finite.
+/// The length of `v`, computed without overflow or underflow in the squares (scaled by its
+/// largest component first): finite for any finite `v` whose length fits in an f64, infinite if
+/// the length itself exceeds `f64::MAX`, NaN if `v` is not finite.
+pub(crate) fn safe_length(v: DVec3) -> f64 {
+    if !v.is_finite() {
+        return f64::NAN;
+    }
+    let m = v.abs().max_element();
+    if m == 0.0 { 0.0 } else { m * (v / m).length() }
+}
+
+/// A unit vector along `v`, or an error naming the field when `v` is zero or not finite. Any
+/// finite non-zero vector is accepted however large or small its components: it is scaled by its
+/// largest component before normalising, so the squares neither overflow nor underflow.
 pub(crate) fn unit_direction(
     shape: &'static str,
     field: &'static str,
     v: DVec3,
 ) -> Result<DVec3, GeometryError> {
-    let len = v.length();
-    if v.is_finite() && len > 0.0 && len.is_finite() {
-        Ok(v / len)
-    } else {
-        Err(GeometryError::parameter(shape, field, v, "must be finite and non-zero"))
+    if !v.is_finite() {
+        return Err(GeometryError::parameter(shape, field, v, "must be finite"));
     }
+    let m = v.abs().max_element();
+    if m == 0.0 {
+        return Err(GeometryError::parameter(shape, field, v, "must be non-zero (no direction)"));
+    }
+    let scaled = v / m;
+    Ok(scaled / scaled.length())
 }
 
 /// A finite value `> 0`, or an error naming the field.

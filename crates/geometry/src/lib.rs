@@ -40,7 +40,7 @@ pub use bounds::Bounds;
 pub use cylinder::Cylinder;
 pub use disk::Disk;
 pub use error::GeometryError;
-pub use mesh::Mesh;
+pub use mesh::{MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_OBJ_BYTES, Mesh};
 pub use prism::Prism;
 pub use ray::{Hit, Ray};
 pub use rectangle::Rectangle;

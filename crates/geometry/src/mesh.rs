@@ -133,6 +133,22 @@ fn build(
     if triangles.is_empty() {
         return Err(GeometryError::parameter(S, "triangles", "[]", "must not be empty"));
     }
+    if positions.len() > MAX_MESH_VERTICES {
+        return Err(GeometryError::parameter(
+            S,
+            "positions",
+            positions.len(),
+            "too many vertices: the limit is MAX_MESH_VERTICES = 2^25",
+        ));
+    }
+    if triangles.len() > MAX_MESH_TRIANGLES {
+        return Err(GeometryError::parameter(
+            S,
+            "triangles",
+            triangles.len(),
+            "too many triangles: the limit is MAX_MESH_TRIANGLES = 2^25",
+        ));
+    }
     if let Some((i, p)) = positions.iter().enumerate().find(|(_, p)| !p.is_finite()) {
         return Err(GeometryError::parameter(S, "positions", (i, p), "must be finite"));
     }
@@ -169,11 +185,90 @@ fn build(
     Ok(MeshData { positions, triangles, normals, uvs })
 }
 
-/// Reads an OBJ file into mesh data (all models merged).
+/// The largest OBJ file [`Mesh::load`] reads: 1 GiB. A longer file, or a device that never ends,
+/// is refused with an error instead of exhausting memory.
+pub const MAX_OBJ_BYTES: u64 = 1 << 30;
+
+/// The most vertices (positions) a mesh may have, inline or from an OBJ file: 2^25 (33,554,432),
+/// which bounds a mesh's memory to about 2 GiB.
+pub const MAX_MESH_VERTICES: usize = 1 << 25;
+
+/// The most triangles a mesh may have, inline or from an OBJ file: 2^25 (33,554,432).
+pub const MAX_MESH_TRIANGLES: usize = 1 << 25;
+
+/// `bytes` written for people: `"1 GiB"`, `"4 MiB"`, `"100 bytes"`.
+fn byte_size(bytes: u64) -> String {
+    const UNITS: [(u64, &str); 3] = [(1 << 30, "GiB"), (1 << 20, "MiB"), (1 << 10, "KiB")];
+    UNITS.iter().find(|&&(unit, _)| bytes >= unit && bytes.is_multiple_of(unit)).map_or_else(
+        || format!("{bytes} bytes"),
+        |&(unit, name)| format!("{} {name}", bytes / unit),
+    )
+}
+
+/// Reads the whole of a regular file of at most `limit` bytes. Devices, FIFOs and directories
+/// are refused before being opened (opening a FIFO would block, reading `/dev/zero` never ends);
+/// the read itself goes through `take(limit + 1)`, so a file that grows is refused too.
+fn read_bounded(path: &Path, limit: u64) -> Result<Vec<u8>, String> {
+    use std::io::Read;
+    let too_large = || format!("larger than the {} limit", byte_size(limit));
+    let not_regular =
+        |kind: &str| format!("not a regular file ({kind}); give the path of an .obj file");
+    let kind = |m: &std::fs::Metadata| {
+        let t = m.file_type();
+        if t.is_dir() { "a directory" } else { "a device, FIFO or socket" }
+    };
+    let meta = std::fs::metadata(path).map_err(|e| e.to_string())?;
+    if !meta.is_file() {
+        return Err(not_regular(kind(&meta)));
+    }
+    if meta.len() > limit {
+        return Err(too_large());
+    }
+    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let meta = file.metadata().map_err(|e| e.to_string())?;
+    if !meta.is_file() {
+        return Err(not_regular(kind(&meta)));
+    }
+    let mut bytes = Vec::new();
+    file.take(limit.saturating_add(1)).read_to_end(&mut bytes).map_err(|e| e.to_string())?;
+    if bytes.len() as u64 > limit {
+        return Err(too_large());
+    }
+    Ok(bytes)
+}
+
+/// Reads an OBJ file into mesh data (all models merged), at most [`MAX_OBJ_BYTES`] long.
 fn read_obj(path: &Path, transform: Option<&Transform>) -> Result<MeshData, GeometryError> {
+    read_obj_limited(path, transform, MAX_OBJ_BYTES)
+}
+
+/// [`read_obj`] with the byte limit as a parameter (tests use a small one). Material libraries
+/// (`mtllib`) are never opened: Spectrace takes materials from the scene file.
+fn read_obj_limited(
+    path: &Path,
+    transform: Option<&Transform>,
+    limit: u64,
+) -> Result<MeshData, GeometryError> {
     let err = |reason: String| GeometryError::Obj { path: path.to_path_buf(), reason };
+    let bytes = read_bounded(path, limit).map_err(err)?;
     let (models, _materials) =
-        tobj::load_obj(path, &tobj::GPU_LOAD_OPTIONS).map_err(|e| err(e.to_string()))?;
+        tobj::load_obj_buf(&mut bytes.as_slice(), &tobj::GPU_LOAD_OPTIONS, |_mtl_path| {
+            Ok((Vec::new(), Default::default()))
+        })
+        .map_err(|e| err(e.to_string()))?;
+    drop(bytes);
+    let vertex_count: usize = models.iter().map(|m| m.mesh.positions.len() / 3).sum();
+    if vertex_count > MAX_MESH_VERTICES {
+        return Err(err(format!(
+            "{vertex_count} vertices, more than the limit of {MAX_MESH_VERTICES}"
+        )));
+    }
+    let triangle_count: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
+    if triangle_count > MAX_MESH_TRIANGLES {
+        return Err(err(format!(
+            "{triangle_count} triangles, more than the limit of {MAX_MESH_TRIANGLES}"
+        )));
+    }
     let mut positions = Vec::new();
     let mut triangles = Vec::new();
     let mut normals = Some(Vec::new());
@@ -404,5 +499,34 @@ impl Primitives for Mesh {
             triangle: index,
             error,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    #[test]
+    fn an_obj_one_byte_over_the_limit_is_refused() {
+        let dir = std::env::temp_dir().join(format!("spectrace-obj-limit-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("tri.obj");
+        let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+        std::fs::write(&path, obj).unwrap();
+        let len = obj.len() as u64;
+        let data = read_obj_limited(&path, None, len).unwrap();
+        assert_eq!(data.triangles.len(), 1);
+        let e = read_obj_limited(&path, None, len - 1).unwrap_err().to_string();
+        assert!(e.contains(&format!("larger than the {} bytes limit", len - 1)), "{e}");
+        assert!(e.contains("Mesh.obj"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn byte_sizes_are_written_in_the_largest_exact_unit() {
+        assert_eq!(byte_size(MAX_OBJ_BYTES), "1 GiB");
+        assert_eq!(byte_size(3 << 20), "3 MiB");
+        assert_eq!(byte_size(1000), "1000 bytes");
     }
 }

@@ -83,9 +83,32 @@ impl TryFrom<PrismRepr> for Prism {
             triangles.push([p, q, q + 3]);
             triangles.push([p, q + 3, p + 3]);
         }
-        let mesh = Mesh::from_triangles(positions, triangles)?;
+        if positions.iter().any(|p| !p.is_finite()) {
+            let (field, value) = if c.abs().max_element() >= side.max(length) {
+                ("center", format!("{c:?}"))
+            } else if side >= length {
+                ("side", format!("{side:?}"))
+            } else {
+                ("length", format!("{length:?}"))
+            };
+            return Err(GeometryError::Parameter {
+                shape: S,
+                field,
+                value,
+                reason: "too large: the prism's vertices overflow f64",
+            });
+        }
+        // Errors of the inner mesh are about the prism's own fields.
+        let as_prism = |e: GeometryError| match e {
+            GeometryError::Parameter { field, value, reason, .. } => {
+                let field = if field == "transform" { field } else { "center" };
+                GeometryError::Parameter { shape: S, field, value, reason }
+            }
+            other => other,
+        };
+        let mesh = Mesh::from_triangles(positions, triangles).map_err(as_prism)?;
         let mesh = match &r.transform {
-            Some(t) => mesh.transformed(t)?,
+            Some(t) => mesh.transformed(t).map_err(as_prism)?,
             None => mesh,
         };
         Ok(Self { mesh, repr: Box::new(r) })

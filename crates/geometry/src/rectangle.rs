@@ -22,7 +22,7 @@
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
-use crate::float::{finite_point, gamma};
+use crate::float::{finite_point, gamma, safe_length, unit_direction};
 use crate::shape::Primitives;
 use crate::{Bounds, GeometryError, Hit, Ray, Transform};
 
@@ -57,32 +57,92 @@ impl TryFrom<RectangleRepr> for Rectangle {
         finite_point(S, "corner", r.corner)?;
         finite_point(S, "edge_u", r.edge_u)?;
         finite_point(S, "edge_v", r.edge_v)?;
+        edge_frame(S, "edge_u", r.edge_u, "edge_v", r.edge_v)?;
+        if !(r.corner + r.edge_u + r.edge_v).is_finite() {
+            return Err(GeometryError::parameter(
+                S,
+                "corner",
+                r.corner,
+                "too large: corner + edge_u + edge_v overflows",
+            ));
+        }
         let t = r.transform.unwrap_or_default();
         let corner = finite_point(S, "transform", t.point(r.corner))?;
         let edge_u = t.vector(r.edge_u);
         let edge_v = t.vector(r.edge_v);
-        let cross = edge_u.cross(edge_v);
-        let area = cross.length();
-        let scale = edge_u.length() * edge_v.length();
-        if !(area > 1e-12 * scale) || !area.is_finite() {
+        if !(corner + edge_u + edge_v).is_finite() {
             return Err(GeometryError::parameter(
                 S,
-                "edge_v",
-                r.edge_v,
-                "degenerate: edges are zero or parallel",
+                "transform",
+                t.to_rows(),
+                "too large: the transformed corners overflow",
             ));
         }
-        let c2 = cross.length_squared();
+        let f = edge_frame(S, "transform", edge_u, "transform", edge_v)?;
         Ok(Self {
             corner,
             edge_u,
             edge_v,
-            normal: cross / area,
-            dual_u: edge_v.cross(cross) / c2,
-            dual_v: cross.cross(edge_u) / c2,
+            normal: f.normal,
+            dual_u: f.unit_v.cross(f.normal) / (f.len_u * f.sin),
+            dual_v: f.normal.cross(f.unit_u) / (f.len_v * f.sin),
             repr: Box::new(r),
         })
     }
+}
+
+/// The normalised edges of a parallelogram, their lengths and the sine of the angle between them.
+struct EdgeFrame {
+    unit_u: DVec3,
+    unit_v: DVec3,
+    len_u: f64,
+    len_v: f64,
+    sin: f64,
+    normal: DVec3,
+}
+
+/// Judges two edges on their directions (normalised first, so huge or tiny finite edges are not
+/// mistaken for degenerate ones): each must be non-zero, they must not be parallel, and the area
+/// `|u| |v| sin` must fit in an f64.
+fn edge_frame(
+    shape: &'static str,
+    field_u: &'static str,
+    u: DVec3,
+    field_v: &'static str,
+    v: DVec3,
+) -> Result<EdgeFrame, GeometryError> {
+    let unit_u = unit_direction(shape, field_u, u)?;
+    let unit_v = unit_direction(shape, field_v, v)?;
+    let cross = unit_u.cross(unit_v);
+    let sin = cross.length();
+    if !(sin > 1e-12) {
+        return Err(GeometryError::parameter(
+            shape,
+            field_v,
+            v,
+            "degenerate: parallel to edge_u (the edges span no area)",
+        ));
+    }
+    let (len_u, len_v) = (safe_length(u), safe_length(v));
+    let area = len_u * len_v * sin;
+    if !area.is_finite() {
+        let (field, value) = if len_u >= len_v { (field_u, u) } else { (field_v, v) };
+        return Err(GeometryError::parameter(
+            shape,
+            field,
+            value,
+            "too large: the area |edge_u| |edge_v| sin(angle) overflows",
+        ));
+    }
+    if !(area > 0.0) {
+        return Err(GeometryError::parameter(
+            shape,
+            field_v,
+            v,
+            "too small: the area |edge_u| |edge_v| sin(angle) underflows to 0",
+        ));
+    }
+    Ok(EdgeFrame { unit_u, unit_v, len_u, len_v, sin, normal: cross / sin })
 }
 
 impl From<Rectangle> for RectangleRepr {

@@ -57,20 +57,62 @@ impl Transform {
                 "last row must be [0, 0, 0, 1] (affine)",
             ));
         }
-        let linear = DMat3::from_mat4(matrix);
-        let det = linear.determinant();
-        let scale = linear.x_axis.length() * linear.y_axis.length() * linear.z_axis.length();
-        if !(det.abs() > 1e-12 * scale) || !det.is_finite() {
+        let linear = DMat3::from_mat4(matrix).transpose(); // columns are now the rows
+        let rows = [linear.x_axis, linear.y_axis, linear.z_axis];
+        // Row equilibration: dividing each row by its largest entry keeps every entry in
+        // [-1, 1], so the determinant and the inverse of the scaled part cannot overflow, and
+        // singularity is judged relative to the matrix's own scale.
+        let mut row_scale = [0.0; 3];
+        for (i, row) in rows.iter().enumerate() {
+            row_scale[i] = row.abs().max_element();
+            if row_scale[i] == 0.0 {
+                return Err(GeometryError::parameter(
+                    "Transform",
+                    F,
+                    matrix.row(i),
+                    "singular: a row of the linear part is zero",
+                ));
+            }
+        }
+        let scaled = DMat3::from_cols(
+            rows[0] / row_scale[0],
+            rows[1] / row_scale[1],
+            rows[2] / row_scale[2],
+        )
+        .transpose(); // back to glam's layout: scaled = D^-1 A
+        let det = scaled.determinant();
+        let norms = rows.iter().zip(row_scale).map(|(r, s)| (*r / s).length()).product::<f64>();
+        if !(det.abs() > 1e-12 * norms) {
             return Err(GeometryError::parameter(
                 "Transform",
                 F,
-                det,
-                "singular (determinant ~ 0)",
+                det / norms,
+                "singular: the rows are (nearly) linearly dependent (|det| / product of row \
+                 lengths ~ 0)",
             ));
         }
-        let inverse = matrix.inverse();
+        // A^-1 = (D^-1 A)^-1 D^-1: column j of the scaled inverse divided by row_scale[j].
+        let si = scaled.inverse();
+        let inv_linear = DMat3::from_cols(
+            si.x_axis / row_scale[0],
+            si.y_axis / row_scale[1],
+            si.z_axis / row_scale[2],
+        );
+        let translation = matrix.w_axis.truncate();
+        let inv_translation = -(inv_linear * translation);
+        let inverse = DMat4::from_cols(
+            inv_linear.x_axis.extend(0.0),
+            inv_linear.y_axis.extend(0.0),
+            inv_linear.z_axis.extend(0.0),
+            inv_translation.extend(1.0),
+        );
         if !inverse.is_finite() {
-            return Err(GeometryError::parameter("Transform", F, det, "not invertible"));
+            return Err(GeometryError::parameter(
+                "Transform",
+                F,
+                matrix,
+                "entries too large or too small: the inverse overflows f64",
+            ));
         }
         Ok(Self { matrix, inverse })
     }
@@ -134,7 +176,16 @@ impl Transform {
                 "must be finite and non-zero",
             ));
         }
-        Ok(Self { matrix: DMat4::from_scale(factors), inverse: DMat4::from_scale(factors.recip()) })
+        let recip = factors.recip();
+        if !recip.is_finite() {
+            return Err(GeometryError::parameter(
+                "Transform",
+                "scale",
+                factors,
+                "too small: its reciprocal (the inverse scale) overflows",
+            ));
+        }
+        Ok(Self { matrix: DMat4::from_scale(factors), inverse: DMat4::from_scale(recip) })
     }
 
     /// `self` applied after `first`: `self.after(first).point(p) == self.point(first.point(p))`.
@@ -181,17 +232,33 @@ impl Transform {
     /// Whether the linear part is a rotation (or reflection) times a uniform scale, within a
     /// relative `1e-9`; returns that scale. Analytic curved shapes accept only these.
     pub fn similarity_scale(&self) -> Option<f64> {
+        // Scaled by the largest entry first so huge or tiny (finite) scales do not overflow or
+        // underflow in `l^T l`.
         let l = DMat3::from_mat4(self.matrix);
+        let m = l.to_cols_array().iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+        if !(m > 0.0) {
+            return None;
+        }
+        let l = l * (1.0 / m);
         let g = l.transpose() * l;
         let s2 = (g.x_axis.x + g.y_axis.y + g.z_axis.z) / 3.0;
         let tol = 1e-9 * s2;
         let off = (g - DMat3::from_diagonal(DVec3::splat(s2))).to_cols_array();
-        off.iter().all(|x| x.abs() <= tol).then(|| s2.sqrt())
+        let scale = s2.sqrt() * m;
+        (off.iter().all(|x| x.abs() <= tol) && scale.is_finite() && scale > 0.0).then_some(scale)
     }
 
-    /// Whether the transform flips orientation (negative determinant).
+    /// Whether the transform flips orientation (negative determinant). Judged on the rows
+    /// scaled by their largest entries, so the sign is right even when the determinant itself
+    /// would overflow or underflow.
     pub fn flips_orientation(&self) -> bool {
-        DMat3::from_mat4(self.matrix).determinant() < 0.0
+        let rows = DMat3::from_mat4(self.matrix).transpose();
+        let scale = |r: DVec3| {
+            let m = r.abs().max_element();
+            if m > 0.0 { r / m } else { r }
+        };
+        DMat3::from_cols(scale(rows.x_axis), scale(rows.y_axis), scale(rows.z_axis)).determinant()
+            < 0.0
     }
 }
 

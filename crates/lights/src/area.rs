@@ -148,9 +148,16 @@ impl RectangleLight {
     ) -> Result<Self, LightError> {
         const L: &str = "RectangleLight";
         let corner = finite_point(L, "corner", corner)?;
-        let normal = rectangle_normal(L, edge_u, edge_v)?;
+        let (normal, area) = rectangle_normal(L, edge_u, edge_v)?;
+        if !(corner + edge_u + edge_v).is_finite() {
+            return Err(LightError::parameter(
+                L,
+                "corner",
+                corner.to_array(),
+                "too large: corner + edge_u + edge_v overflows",
+            ));
+        }
         let emission = SpdLight::new(L, spd, power, wavelength_sampling)?;
-        let area = edge_u.cross(edge_v).length();
         Ok(Self { emission, corner, edge_u, edge_v, two_sided, frame: Frame::new(normal), area })
     }
 
@@ -254,6 +261,23 @@ impl DiskLight {
         let center = finite_point(L, "center", center)?;
         let normal = unit_direction(L, "normal", normal)?;
         let radius = positive(L, "radius", radius)?;
+        let area = PI * radius * radius;
+        if !area.is_finite() {
+            return Err(LightError::parameter(
+                L,
+                "radius",
+                radius,
+                "too large: the area overflows",
+            ));
+        }
+        if !(area > 0.0) {
+            return Err(LightError::parameter(
+                L,
+                "radius",
+                radius,
+                "too small: the area underflows to 0",
+            ));
+        }
         let emission = SpdLight::new(L, spd, power, wavelength_sampling)?;
         Ok(Self { emission, center, normal, radius, two_sided, frame: Frame::new(normal) })
     }

@@ -20,25 +20,40 @@ pub(crate) fn finite_point(
     }
 }
 
-/// Normalises a direction, rejecting zero, tiny-to-normalise and non-finite vectors.
+/// Normalises a direction. Any finite non-zero vector is accepted, however large or small its
+/// components: it is scaled by its largest component first, so the squares neither overflow nor
+/// underflow. Zero and non-finite vectors are refused, saying which.
 pub(crate) fn unit_direction(
     light: &'static str,
     field: &'static str,
     d: DVec3,
 ) -> Result<DVec3, LightError> {
-    let len = d.length();
-    if d.is_finite() && len > 0.0 && len.is_finite() {
-        // Already unit (to rounding): keep it bit for bit, so saving and reloading a light
-        // reproduces it exactly.
-        if (len - 1.0).abs() <= 4.0 * f64::EPSILON {
-            return Ok(d);
-        }
-        let n = d / len;
-        if n.is_finite() && (n.length() - 1.0).abs() < 1e-12 {
-            return Ok(n);
-        }
+    if !d.is_finite() {
+        return Err(LightError::parameter(light, field, d.to_array(), "must be finite"));
     }
-    Err(LightError::parameter(light, field, d.to_array(), "must be a non-zero, finite vector"))
+    let m = d.abs().max_element();
+    if m == 0.0 {
+        return Err(LightError::parameter(
+            light,
+            field,
+            d.to_array(),
+            "must be non-zero (no direction)",
+        ));
+    }
+    // Already unit (to rounding): keep it bit for bit, so saving and reloading a light
+    // reproduces it exactly.
+    if (d.length() - 1.0).abs() <= 4.0 * f64::EPSILON {
+        return Ok(d);
+    }
+    let scaled = d / m;
+    Ok(scaled / scaled.length())
+}
+
+/// The length of a finite `v` without overflow or underflow in the squares (infinite only if the
+/// length itself exceeds `f64::MAX`).
+pub(crate) fn safe_length(v: DVec3) -> f64 {
+    let m = v.abs().max_element();
+    if m == 0.0 || !m.is_finite() { m } else { m * (v / m).length() }
 }
 
 /// Checks a non-negative finite scalar.

@@ -25,7 +25,7 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 use spectrace_spectrum::SpectralPowerDistribution;
 
-use crate::geometry::{finite_point, unit_direction};
+use crate::geometry::{finite_point, safe_length, unit_direction};
 use crate::source::uniform;
 use crate::{Beam, LightError, LightFlags, LightSource, SpdLight, WavelengthSampling};
 
@@ -75,25 +75,48 @@ impl From<Sky> for SkyRepr {
     }
 }
 
-/// Checks that two edges span a parallelogram of non-zero area; returns its unit normal.
+/// Checks that two edges span a parallelogram of non-zero, representable area; returns its unit
+/// normal and its area. The edges are judged on their directions (normalised first), so huge or
+/// tiny finite edges are not mistaken for parallel ones.
 pub(crate) fn rectangle_normal(
     light: &'static str,
     edge_u: DVec3,
     edge_v: DVec3,
-) -> Result<DVec3, LightError> {
+) -> Result<(DVec3, f64), LightError> {
     finite_point(light, "edge_u", edge_u)?;
     finite_point(light, "edge_v", edge_v)?;
-    let cross = edge_u.cross(edge_v);
-    let scale = edge_u.length() * edge_v.length();
-    if !(scale > 0.0) || !(cross.length() > 1e-12 * scale) || !cross.is_finite() {
+    let unit_u = unit_direction(light, "edge_u", edge_u)?;
+    let unit_v = unit_direction(light, "edge_v", edge_v)?;
+    let cross = unit_u.cross(unit_v);
+    let sin = cross.length();
+    if !(sin > 1e-12) {
         return Err(LightError::parameter(
             light,
             "edge_v",
             edge_v.to_array(),
-            "edge_u and edge_v must be non-zero and not parallel (the rectangle is degenerate)",
+            "must not be parallel to edge_u (the rectangle is degenerate)",
         ));
     }
-    Ok(cross.normalize())
+    let (len_u, len_v) = (safe_length(edge_u), safe_length(edge_v));
+    let area = len_u * len_v * sin;
+    if !area.is_finite() {
+        let (field, value) = if len_u >= len_v { ("edge_u", edge_u) } else { ("edge_v", edge_v) };
+        return Err(LightError::parameter(
+            light,
+            field,
+            value.to_array(),
+            "too large: the area |edge_u| |edge_v| sin(angle) overflows",
+        ));
+    }
+    if !(area > 0.0) {
+        return Err(LightError::parameter(
+            light,
+            "edge_v",
+            edge_v.to_array(),
+            "too small: the area |edge_u| |edge_v| sin(angle) underflows to 0",
+        ));
+    }
+    Ok((cross / sin, area))
 }
 
 impl Sky {
@@ -113,7 +136,7 @@ impl Sky {
     ) -> Result<Self, LightError> {
         const L: &str = "Sky";
         let corner = finite_point(L, "corner", corner)?;
-        let normal = rectangle_normal(L, edge_u, edge_v)?;
+        let (normal, _area) = rectangle_normal(L, edge_u, edge_v)?;
         let direction = unit_direction(L, "direction", direction)?;
         if direction.dot(normal).abs() < 1e-9 {
             return Err(LightError::parameter(

@@ -146,8 +146,8 @@ impl Gaussian {
     /// A Gaussian line truncated to `[min_nm, max_nm]`.
     ///
     /// # Errors
-    /// [`SpectrumError::Parameter`] for a non-finite centre, a width that is not positive and
-    /// finite, a bad range, or a line with no representable mass inside the range.
+    /// [`SpectrumError::Parameter`] for a non-finite centre, a width that is not positive, finite
+    /// and normal (a subnormal width is refused naming `fwhm_nm`), a bad range, or a line with no representable mass inside the range.
     pub fn with_range(
         center_nm: f64,
         fwhm_nm: f64,
@@ -166,8 +166,16 @@ impl Gaussian {
                 "must be positive and finite",
             ));
         }
-        check_range(S, min_nm, max_nm)?;
         let sigma = fwhm_nm / FWHM_PER_SIGMA;
+        if !sigma.is_normal() || !(1.0 / sigma).is_finite() {
+            return Err(SpectrumError::parameter(
+                S,
+                "fwhm_nm",
+                fwhm_nm,
+                "too small: subnormal (below ~1e-307), the line's peak density 1/sigma overflows",
+            ));
+        }
+        check_range(S, min_nm, max_nm)?;
         let (a, b) = ((min_nm - center_nm) / sigma, (max_nm - center_nm) / sigma);
         let mass = normal_mass(a, b);
         if !(mass > 0.0) || !(1.0 / (sigma * mass)).is_finite() {

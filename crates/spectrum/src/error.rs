@@ -28,8 +28,10 @@ pub enum SpectrumError {
         reason: &'static str,
     },
     /// A reflectance or transmittance value is outside `[0, 1]`.
-    #[error("{field}[{index}] = {value}: a reflectance must lie in [0, 1]")]
+    #[error("{field}[{index}] = {value}: a {quantity} must lie in [0, 1]")]
     ReflectanceOutOfRange {
+        /// `"reflectance"` or `"transmittance"`.
+        quantity: &'static str,
         /// The field name (`"values"` or `"constant"`).
         field: &'static str,
         /// Index of the offending value (0 for a constant).

@@ -311,6 +311,12 @@ fn bad_input_names_the_field() {
     assert!(Blackbody::new(f64::NAN).is_err());
     let e = Gaussian::new(550.0, 0.0).unwrap_err();
     assert!(e.to_string().starts_with("Gaussian.fwhm_nm = 0"), "{e}");
+    for tiny in [1e-320, 1e-310, 5e-324] {
+        let e = Gaussian::new(532.0, tiny).unwrap_err().to_string();
+        assert!(e.starts_with("Gaussian.fwhm_nm = ") && e.contains("too small"), "{tiny}: {e}");
+        assert!(!e.contains("center_nm"), "{e}");
+    }
+    assert!(Gaussian::new(532.0, 1e-300).is_ok());
     let e = Gaussian::new(5000.0, 1.0).unwrap_err();
     assert!(e.to_string().contains("no representable mass"), "{e}");
     let e = Uniform::new(700.0, 400.0).unwrap_err();

@@ -93,6 +93,17 @@ pub struct CameraRepr {
     pub height: u32,
 }
 
+/// The unit vector along a finite `v`, scaled by its largest component first so huge or tiny
+/// components neither overflow nor underflow; `None` for zero.
+fn unit(v: DVec3) -> Option<DVec3> {
+    let m = v.abs().max_element();
+    if !(m > 0.0) {
+        return None;
+    }
+    let scaled = v / m;
+    Some(scaled / scaled.length())
+}
+
 fn default_up() -> DVec3 {
     DVec3::Y
 }
@@ -137,21 +148,39 @@ impl PinholeCamera {
         if !repr.position.is_finite() {
             return Err(invalid("position", repr.position.to_array(), "must be finite"));
         }
+        if !repr.look_at.is_finite() {
+            return Err(invalid("look_at", repr.look_at.to_array(), "must be finite"));
+        }
         let view = repr.look_at - repr.position;
-        if !repr.look_at.is_finite() || !(view.length() > 0.0) {
+        if !view.is_finite() {
+            let (field, value) =
+                if repr.position.abs().max_element() >= repr.look_at.abs().max_element() {
+                    ("position", repr.position)
+                } else {
+                    ("look_at", repr.look_at)
+                };
             return Err(invalid(
-                "look_at",
-                repr.look_at.to_array(),
-                "must be finite and differ from position",
+                field,
+                value.to_array(),
+                "too large: position and look_at are too far apart (look_at - position overflows)",
             ));
         }
-        let forward = view.normalize();
-        let right = forward.cross(repr.up);
-        if !repr.up.is_finite() || !(right.length() > 1e-9 * repr.up.length()) {
+        let Some(forward) = unit(view) else {
+            return Err(invalid("look_at", repr.look_at.to_array(), "must differ from position"));
+        };
+        if !repr.up.is_finite() {
+            return Err(invalid("up", repr.up.to_array(), "must be finite"));
+        }
+        let Some(up_dir) = unit(repr.up) else {
+            return Err(invalid("up", repr.up.to_array(), "must be non-zero"));
+        };
+        // Both unit vectors: judged on direction, whatever their magnitudes.
+        let right = forward.cross(up_dir);
+        if !(right.length() > 1e-9) {
             return Err(invalid(
                 "up",
                 repr.up.to_array(),
-                "must be non-zero and not parallel to the view direction",
+                "must not be parallel to the view direction (look_at - position)",
             ));
         }
         let right = right.normalize();
@@ -328,5 +357,33 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.to_string().contains("camera.width"), "{e}");
+    }
+
+    fn camera_error(position: [f64; 3], look_at: [f64; 3], up: [f64; 3]) -> String {
+        let mut r = camera(FovAxis::Vertical).repr;
+        r.position = DVec3::from_array(position);
+        r.look_at = DVec3::from_array(look_at);
+        r.up = DVec3::from_array(up);
+        PinholeCamera::new(r).map_or_else(|e| e.to_string(), |_| String::new())
+    }
+
+    #[test]
+    fn huge_or_tiny_vectors_are_judged_on_direction_and_overflow_blames_the_points() {
+        // A far but finite pinhole is a valid camera; the old check blamed `up`.
+        assert_eq!(camera_error([0.0, 0.0, 1e300], [0.0; 3], [0.0, 1.0, 0.0]), "");
+        assert_eq!(camera_error([0.0, 0.0, 1e-320], [0.0; 3], [0.0, 1e300, 0.0]), "");
+        assert_eq!(camera_error([0.0, 0.0, 1.0], [0.0; 3], [0.0, 1e-320, 0.0]), "");
+        let e = camera_error([0.0, 0.0, 1.7e308], [0.0, 0.0, -1.7e308], [0.0, 1.0, 0.0]);
+        assert!(e.starts_with("camera.position") && e.contains("too far apart"), "{e}");
+        let e = camera_error([0.0, 0.0, 1.0e308], [0.0, 0.0, -1.7e308], [0.0, 1.0, 0.0]);
+        assert!(e.starts_with("camera.look_at") && e.contains("too far apart"), "{e}");
+        let e = camera_error([0.0, 0.0, 1e300], [0.0; 3], [0.0, 0.0, 1e300]);
+        assert!(e.starts_with("camera.up") && e.contains("parallel"), "{e}");
+        let e = camera_error([0.0, 0.0, 1.0], [0.0; 3], [0.0, -0.0, 0.0]);
+        assert!(e.starts_with("camera.up") && e.contains("non-zero"), "{e}");
+        let e = camera_error([0.0, 0.0, f64::INFINITY], [0.0; 3], [0.0, 1.0, 0.0]);
+        assert!(e.starts_with("camera.position") && e.contains("finite"), "{e}");
+        let e = camera_error([0.0, 0.0, 1.0], [0.0, f64::NAN, 0.0], [0.0, 1.0, 0.0]);
+        assert!(e.starts_with("camera.look_at") && e.contains("finite"), "{e}");
     }
 }

@@ -4,7 +4,7 @@
 use glam::DVec3;
 use rand::SeedableRng;
 use rand_pcg::Pcg64;
-use spectrace_materials::spectrum::Reflectance;
+use spectrace_materials::spectrum::Transmittance;
 use spectrace_materials::{
     Dielectric, Incoming, Ior, Material, ScatterKind, Transport, fresnel_dielectric,
 };
@@ -121,7 +121,7 @@ fn a_parallel_slab_returns_the_original_direction() {
 
 #[test]
 fn transmittance_tints_refraction_only_and_radiance_scales_by_eta_squared() {
-    let tint = Reflectance::from_table(&[400.0, 700.0], &[0.5, 1.0]).unwrap();
+    let tint = Transmittance::from_table(&[400.0, 700.0], &[0.5, 1.0]).unwrap();
     let material = Dielectric::new(Ior::constant(1.5).unwrap(), Some(tint));
     let entering = beam(DVec3::NEG_Y, DVec3::Y, 400.0);
     let t = material.scatter(&entering, [0.5, 0.0, 0.0]).unwrap();
@@ -139,7 +139,7 @@ fn transmittance_tints_refraction_only_and_radiance_scales_by_eta_squared() {
         material.scatter(&entering, [0.5; 3])
     );
     let opaque =
-        Dielectric::new(Ior::constant(1.5).unwrap(), Some(Reflectance::constant(0.0).unwrap()));
+        Dielectric::new(Ior::constant(1.5).unwrap(), Some(Transmittance::constant(0.0).unwrap()));
     assert_eq!(opaque.scatter(&entering, [0.5, 0.0, 0.0]), None);
 }
 

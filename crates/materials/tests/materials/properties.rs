@@ -42,7 +42,7 @@ fn materials() -> Vec<(Box<dyn Material>, Option<Ior>)> {
     ];
     for ior in iors {
         all.push((Box::new(Dielectric::new(ior.clone(), None)), Some(ior.clone())));
-        all.push((Box::new(Dielectric::new(ior.clone(), Some(tinted.clone()))), Some(ior)));
+        all.push((Box::new(Dielectric::new(ior.clone(), Some(tinted.clone().into()))), Some(ior)));
     }
     all
 }

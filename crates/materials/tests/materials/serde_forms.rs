@@ -95,6 +95,20 @@ fn error_of(json: &str) -> String {
 }
 
 #[test]
+fn a_transmittance_out_of_range_is_called_a_transmittance() {
+    let message = error_of(r#"{"type": "Dielectric", "ior": 1.5, "transmittance": 1.5}"#);
+    assert!(message.contains("a transmittance must lie in [0, 1]"), "{message}");
+    assert!(!message.contains("reflectance"), "{message}");
+    let message = error_of(
+        r#"{"type": "Dielectric", "ior": 1.5, "transmittance": {"nm": [400, 400], "values": [1, 1]}}"#,
+    );
+    assert!(message.contains("Transmittance: ") && message.contains("nm[1]"), "{message}");
+    let message = error_of(r#"{"type": "Dielectric", "ior": 1.5, "transmittance": "clear"}"#);
+    assert!(message.contains("expected a transmittance: a number in [0, 1]"), "{message}");
+    assert!(message.contains(r#"found a string "clear""#), "{message}");
+}
+
+#[test]
 fn bad_input_errors_name_the_field() {
     let cases = [
         (
@@ -124,6 +138,14 @@ fn bad_input_errors_name_the_field() {
         (r#"{"type": "Dielectric", "ior": 1.5, "tint": 0.5}"#, "unknown field `tint`"),
         (r#"{"type": "Dielectric"}"#, "missing field `ior`"),
         (r#"{"type": "Diffuse", "reflectance": 1.2}"#, "reflectance must lie in [0, 1]"),
+        (
+            r#"{"type": "Diffuse", "reflectance": "0.5"}"#,
+            "expected a reflectance: a number in [0, 1] or a table {\"nm\": [...], \"values\": [...]}, found a string \"0.5\"",
+        ),
+        (
+            r#"{"type": "Mirror", "reflectance": {"nm": [400, 700], "values": [0.5, "NaN"]}}"#,
+            "values[1]: expected a number, found a string \"NaN\"",
+        ),
         (r#"{"type": "Diffuse", "reflectance": 0.5, "colour": 1}"#, "unknown field `colour`"),
         (r#"{"type": "Mirror"}"#, "missing field `reflectance`"),
         (r#"{"type": "Velvet"}"#, "Velvet"),
