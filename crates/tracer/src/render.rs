@@ -1,7 +1,7 @@
 //! Running the light tracer over work chunks on several threads (and, with shards, machines).
 
-use std::sync::{Mutex, PoisonError};
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
