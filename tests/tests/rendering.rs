@@ -547,6 +547,17 @@ fn extreme_settings_are_refused_or_survived_without_panics() {
     .unwrap_err()
     .to_string();
     assert!(e.contains("threads") && e.contains("at most"), "{e}");
+    // A resolution beyond the film's limit is refused before anything is allocated or traced.
+    let huge = POINT_OVER_PLANE
+        .replace(r#""width": 32, "height": 32"#, r#""width": 100000, "height": 100000"#);
+    assert_ne!(huge, POINT_OVER_PLANE);
+    let e = render_scene(
+        &scene(&huge),
+        &RenderOptions { beams: Some(100), out_dir: out.clone(), ..RenderOptions::default() },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("camera") && e.contains("100000x100000") && e.contains("2^25"), "{e}");
     // Bad output names and missing OBJ files name their field.
     let bad_name =
         POINT_OVER_PLANE.replace("\"lights\"", "\"output\": {\"name\": \"../escape\"}, \"lights\"");

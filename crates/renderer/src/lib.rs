@@ -18,8 +18,8 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 use spectrace_lights::LightSource;
 use spectrace_tracer::{
-    Effects, EffectsMode, Film, LightTracerScene, RenderOutput, RenderPlan, TraceStats,
-    image_scale, render, trace_chunk,
+    Effects, EffectsMode, Film, FilmError, LightTracerScene, MemoryLimit, RenderOutput, RenderPlan,
+    TraceStats, image_scale, render, trace_chunk,
 };
 
 pub use output::{PARTIAL_VERSION, PartialFilm, linear_srgb, write_exr, write_png};
@@ -207,19 +207,31 @@ impl spectrace_tracer::Splat for VisibleLight {
     }
 }
 
-/// Checks that some light reaches the camera before rendering: traces beams (on their own random
+/// Checks, before rendering, that the film fits (at most [`spectrace_tracer::MAX_PIXELS`] pixels
+/// and within [`MemoryLimit::system`], see [`RenderPlan::check_memory`]; nothing is allocated)
+/// and that some light reaches the camera: traces beams (on their own random
 /// streams) until one puts visible light on the film, at most `min(PROBE_BEAMS, plan.beams)` of
 /// them and for at most `min(PROBE_SECONDS, plan.time_budget / 10)`. Most scenes need a handful
 /// of beams. A probe that runs out of time is inconclusive and lets the render go on.
 ///
 /// # Errors
-/// [`SceneError::Scene`] explaining that the image would be black, when none of the beams lit
-/// the film.
+/// [`SceneError::Scene`] for a camera resolution that is not a valid film or does not fit in
+/// memory, and, explaining that the image would be black, when none of the beams lit the film.
 pub fn probe(
     scene: &Scene,
     effects: &Effects,
     plan: &RenderPlan,
 ) -> Result<ProbeOutcome, SceneError> {
+    let (width, height) = (scene.camera.width(), scene.camera.height());
+    let camera_error = |e: FilmError| SceneError::Scene {
+        path: scene.path.clone(),
+        field: "camera".to_owned(),
+        message: e.to_string(),
+    };
+    if u64::from(width) * u64::from(height) > spectrace_tracer::MAX_PIXELS {
+        return Err(camera_error(FilmError::InvalidSize(width, height)));
+    }
+    plan.check_memory(width, height, &MemoryLimit::system()).map_err(camera_error)?;
     let started = Instant::now();
     let limit = plan.time_budget.map_or(PROBE_SECONDS, |t| (t / 10.0).min(PROBE_SECONDS));
     let deadline = std::time::Duration::try_from_secs_f64(limit.max(0.0))
@@ -228,8 +240,7 @@ pub fn probe(
     let max_beams = PROBE_BEAMS.min(plan.beams).max(1);
     let tracer = tracer_scene(scene);
     let settings = scene.tracer_settings();
-    let mut sink =
-        VisibleLight { width: scene.camera.width(), height: scene.camera.height(), lit: false };
+    let mut sink = VisibleLight { width, height, lit: false };
     let mut stats = TraceStats::default();
     let mut timed_out = false;
     for beam in 0..max_beams {
