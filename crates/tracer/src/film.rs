@@ -133,8 +133,8 @@ pub fn human_bytes(bytes: u64) -> String {
 /// film shared between threads. The light tracer ([`crate::trace_chunk`]) writes through it.
 pub trait Splat {
     /// Adds an XYZ contribution to pixel `(x, y)` (0-based, from the top-left); returns `false`
-    /// (and counts a rejection) if the pixel is outside the film or a component is NaN, infinite
-    /// or larger than 2^62.
+    /// if the pixel is outside the film or a component is NaN, infinite or larger than 2^62
+    /// (films and writers then count a rejection and add nothing).
     fn splat(&mut self, x: u32, y: u32, xyz: Xyz) -> bool;
 }
 
