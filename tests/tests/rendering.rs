@@ -9,7 +9,8 @@ use spectrace_geometry::{Ray, Shape, World};
 use spectrace_lights::LightSource;
 use spectrace_materials::{Dielectric, Incoming, Material};
 use spectrace_renderer::{
-    RenderOptions, Scene, decide_effects, merge_parts, plan_for, render_scene, tracer_scene,
+    PROBE_BEAMS, RenderOptions, Scene, decide_effects, merge_parts, plan_for, probe, render_scene,
+    tracer_scene,
 };
 use spectrace_spectrum::{CIE_Y_INTEGRAL, SpectralPowerDistribution, Uniform, xyz_of};
 use spectrace_tracer::{RenderOutput, render};
@@ -217,11 +218,19 @@ fn prism_disperses_by_snells_law_with_the_sellmeier_index() {
 }
 
 #[test]
-fn same_seed_same_image_with_one_or_two_threads() {
-    let s = scene(POINT_OVER_PLANE);
+fn same_seed_same_image_with_one_two_or_four_threads() {
+    // Small chunks, so that four threads interleave their flushes into the shared film.
+    let s = scene(
+        &POINT_OVER_PLANE
+            .replace("\"lights\"", "\"settings\": {\"chunk_beams\": 3000}, \"lights\""),
+    );
     let (one, _) = render_inline(&s, 60_000, 5, 1);
     let (two, _) = render_inline(&s, 60_000, 5, 2);
+    let (four, _) = render_inline(&s, 60_000, 5, 4);
+    assert!(one.film.accepted() > 1000, "{}", one.film.accepted());
     assert_eq!(one.film, two.film);
+    assert_eq!(one.film, four.film);
+    assert_eq!((one.beams, four.beams, four.stats.beams), (60_000, 60_000, 60_000));
     let (other_seed, _) = render_inline(&s, 60_000, 6, 2);
     assert_ne!(one.film, other_seed.film);
 }
@@ -538,6 +547,17 @@ fn extreme_settings_are_refused_or_survived_without_panics() {
     .unwrap_err()
     .to_string();
     assert!(e.contains("threads") && e.contains("at most"), "{e}");
+    // A resolution beyond the film's limit is refused before anything is allocated or traced.
+    let huge = POINT_OVER_PLANE
+        .replace(r#""width": 32, "height": 32"#, r#""width": 100000, "height": 100000"#);
+    assert_ne!(huge, POINT_OVER_PLANE);
+    let e = render_scene(
+        &scene(&huge),
+        &RenderOptions { beams: Some(100), out_dir: out.clone(), ..RenderOptions::default() },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("camera") && e.contains("100000x100000") && e.contains("2^25"), "{e}");
     // Bad output names and missing OBJ files name their field.
     let bad_name =
         POINT_OVER_PLANE.replace("\"lights\"", "\"output\": {\"name\": \"../escape\"}, \"lights\"");
@@ -583,4 +603,88 @@ fn the_same_seed_writes_the_same_files() {
         let b = std::fs::read(dir.join("b").join(format!("plane.{ext}"))).unwrap();
         assert!(a == b, "{ext} files differ between two renders with the same seed");
     }
+}
+
+/// A closed box of six mirror rectangles around a point light, with `max_depth = rr_depth =
+/// 8000`: every beam bounces 8000 times. The camera is inside (it sees the light directly) or
+/// outside (no light can reach it).
+fn mirror_box(camera_inside: bool) -> Scene {
+    let wall = |corner: [f64; 3], u: [f64; 3], v: [f64; 3]| {
+        format!(
+            r#"{{"shape": {{"type": "Rectangle", "corner": {corner:?}, "edge_u": {u:?}, "edge_v": {v:?}}}, "material": {{"type": "Mirror", "reflectance": 1.0}}}}"#
+        )
+    };
+    let walls = [
+        wall([-1.0, -1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 0.0, 2.0]),
+        wall([-1.0, 1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 0.0, 2.0]),
+        wall([-1.0, -1.0, -1.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]),
+        wall([1.0, -1.0, -1.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]),
+        wall([-1.0, -1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]),
+        wall([-1.0, -1.0, 1.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]),
+    ];
+    let z = if camera_inside { 0.5 } else { 3.0 };
+    scene(&format!(
+        r#"{{"camera": {{"position": [0, 0, {z}], "look_at": [0, 0, -1], "fov": 90, "width": 8, "height": 8}},
+            "objects": [{}],
+            "lights": [{{"type": "PointLight", "position": [0.3, 0.2, -0.1], "power": 1, "spd": {{"type": "Uniform"}}}}],
+            "settings": {{"max_depth": 8000, "rr_depth": 8000}}}}"#,
+        walls.join(",")
+    ))
+}
+
+#[test]
+fn a_closed_mirror_box_keeps_the_beam_count_and_the_time_budget() {
+    let out = temp_dir("mirror-box");
+    let inside = mirror_box(true);
+    let effects = decide_effects(&inside, None);
+    // The probe stops at the first beam that lights the film (it used to trace 20,000 beams of
+    // 8000 bounces: 55 s).
+    let beams_100 = RenderOptions { beams: Some(100), out_dir: out.clone(), ..Default::default() };
+    let probed = probe(&inside, &effects, &plan_for(&inside, &beams_100).unwrap()).unwrap();
+    assert!(probed.lit);
+    assert_eq!(probed.beams, 1);
+    let started = std::time::Instant::now();
+    let report = render_scene(&inside, &beams_100).unwrap();
+    assert!(started.elapsed().as_secs_f64() < 30.0, "{:?}", started.elapsed());
+    assert_eq!((report.beams, report.stats.beams, report.stats.depth_limited), (100, 100, 100));
+    assert_eq!(report.stats.hits, 100 * 8001);
+
+    // A time budget stops the render at the deadline: the first chunks (16,384 beams of 8000
+    // bounces each, about 45 s) are cut short, and the output counts exactly the beams traced.
+    let budget = 0.5;
+    let timed = RenderOptions {
+        time: Some(budget),
+        threads: Some(2),
+        out_dir: out.clone(),
+        ..Default::default()
+    };
+    let report = render_scene(&inside, &timed).unwrap();
+    assert!(report.wall_seconds < budget + 5.0, "{} s", report.wall_seconds);
+    assert!(report.beams > 0 && report.beams < 16_384, "{}", report.beams);
+    assert_eq!(report.stats.beams, report.beams);
+    assert_eq!(report.stats.depth_limited, report.beams);
+    let plan = plan_for(&inside, &timed).unwrap();
+    let output =
+        render(&tracer_scene(&inside), &inside.tracer_settings(), &effects, &plan, &|_| {})
+            .unwrap();
+    assert!(output.seconds < budget + 5.0, "{} s", output.seconds);
+    assert!(output.beams > 0 && output.beams < 16_384, "{}", output.beams);
+    assert_eq!(output.stats.beams, output.beams);
+    assert!(!output.chunks.is_empty() && output.chunks.len() <= 2, "{:?}", output.chunks);
+    assert!(output.film.accepted() > 0);
+
+    // Camera outside: no light can reach it. The probe gives up after the plan's 100 beams...
+    let outside = mirror_box(false);
+    let started = std::time::Instant::now();
+    let e = render_scene(&outside, &beams_100).unwrap_err().to_string();
+    assert!(started.elapsed().as_secs_f64() < 30.0, "{:?}", started.elapsed());
+    assert!(e.contains("none of 100 probe beams"), "{e}");
+    // ... and with a time budget it is inconclusive after a tenth of it, and the render goes on.
+    let probed = probe(&outside, &effects, &plan_for(&outside, &timed).unwrap()).unwrap();
+    assert!(!probed.lit);
+    assert!(probed.beams > 0 && probed.beams < PROBE_BEAMS, "{}", probed.beams);
+    assert!(probed.seconds < budget, "{} s", probed.seconds);
+    let report = render_scene(&outside, &timed).unwrap();
+    assert!(report.wall_seconds < budget + 5.0, "{} s", report.wall_seconds);
+    assert_eq!(report.stats.splats, 0);
 }

@@ -20,8 +20,8 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 use spectrace_lights::LightSource;
 use spectrace_tracer::{
-    Effects, EffectsMode, Film, LightTracerScene, RenderOutput, RenderPlan, TraceStats,
-    image_scale, render, trace_chunk,
+    Effects, EffectsMode, Film, FilmError, LightTracerScene, MemoryLimit, RenderOutput, RenderPlan,
+    TraceStats, image_scale, render, trace_chunk,
 };
 
 pub use files::{
@@ -187,43 +187,115 @@ pub fn plan_for(scene: &Scene, options: &RenderOptions) -> Result<RenderPlan, Re
     Ok(plan)
 }
 
-/// Checks that some light reaches the camera: traces [`PROBE_BEAMS`] beams (on their own random
-/// streams) and fails if none is seen.
+/// Longest the pre-render probe may run (s); with a time budget, at most a tenth of it.
+pub const PROBE_SECONDS: f64 = 2.0;
+
+/// What the pre-render probe found.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProbeOutcome {
+    /// Beams traced.
+    pub beams: u64,
+    /// `true`: a beam put visible light on the film; `false`: the probe ran out of time first
+    /// (inconclusive: the render goes on).
+    pub lit: bool,
+    /// Wall time (s).
+    pub seconds: f64,
+}
+
+/// A sink that only records whether visible light reached the film (no film is allocated).
+struct VisibleLight {
+    width: u32,
+    height: u32,
+    lit: bool,
+}
+
+impl spectrace_tracer::Splat for VisibleLight {
+    fn splat(&mut self, x: u32, y: u32, xyz: spectrace_spectrum::Xyz) -> bool {
+        // As the film would: in the frame, every component in range, and one that is positive
+        // after rounding to the film's fixed point.
+        let mut positive = false;
+        for v in [xyz.x, xyz.y, xyz.z] {
+            let mut sum = spectrace_tracer::ExactSum::default();
+            if !sum.add(v) {
+                return false;
+            }
+            positive |= sum.raw() > 0;
+        }
+        if x >= self.width || y >= self.height {
+            return false;
+        }
+        self.lit |= positive;
+        true
+    }
+}
+
+/// Checks, before rendering, that the film fits (at most [`spectrace_tracer::MAX_PIXELS`] pixels
+/// and within [`MemoryLimit::system`], see [`RenderPlan::check_memory`]; nothing is allocated)
+/// and that some light reaches the camera: traces beams (on their own random
+/// streams) until one puts visible light on the film, at most `min(PROBE_BEAMS, plan.beams)` of
+/// them and for at most `min(PROBE_SECONDS, plan.time_budget / 10)`. Most scenes need a handful
+/// of beams. A probe that runs out of time is inconclusive and lets the render go on.
 ///
 /// # Errors
-/// [`SceneError::Scene`] explaining that the image would be black.
-pub fn probe(scene: &Scene, effects: &Effects) -> Result<(), SceneError> {
-    let mut film =
-        Film::new(scene.camera.width(), scene.camera.height()).map_err(|e| SceneError::Scene {
-            path: scene.path.clone(),
-            field: "camera".to_owned(),
-            message: e.to_string(),
-        })?;
-    let stats = trace_chunk(
-        &tracer_scene(scene),
-        &scene.tracer_settings(),
-        effects,
-        u64::MAX,
-        0,
-        PROBE_BEAMS,
-        &mut film,
-    );
-    scene.lights.reset_count();
-    let visible = film.to_xyz(1.0).iter().any(|p| p.x > 0.0 || p.y > 0.0 || p.z > 0.0);
-    if stats.splats == 0 || !visible {
-        return Err(SceneError::Scene {
-            path: scene.path.clone(),
-            field: "lights".to_owned(),
-            message: format!(
-                "no light can reach the camera: none of {PROBE_BEAMS} probe beams lit a point the camera sees \
-                 with visible light ({} hit a surface, {} reached the film). Check that the lights face the \
-                 objects, that their spectra lie in 360-830 nm, that some surface is not a mirror or glass, and \
-                 that the camera looks at the lit objects.",
-                stats.hits, stats.splats
-            ),
-        });
+/// [`SceneError::Scene`] for a camera resolution that is not a valid film or does not fit in
+/// memory, and, explaining that the image would be black, when none of the beams lit the film.
+pub fn probe(
+    scene: &Scene,
+    effects: &Effects,
+    plan: &RenderPlan,
+) -> Result<ProbeOutcome, SceneError> {
+    let (width, height) = (scene.camera.width(), scene.camera.height());
+    let camera_error = |e: FilmError| SceneError::Scene {
+        path: scene.path.clone(),
+        field: "camera".to_owned(),
+        message: e.to_string(),
+    };
+    if u64::from(width) * u64::from(height) > spectrace_tracer::MAX_PIXELS {
+        return Err(camera_error(FilmError::InvalidSize(width, height)));
     }
-    Ok(())
+    plan.check_memory(width, height, &MemoryLimit::system()).map_err(camera_error)?;
+    let started = Instant::now();
+    let limit = plan.time_budget.map_or(PROBE_SECONDS, |t| (t / 10.0).min(PROBE_SECONDS));
+    let deadline = std::time::Duration::try_from_secs_f64(limit.max(0.0))
+        .ok()
+        .and_then(|d| started.checked_add(d));
+    let max_beams = PROBE_BEAMS.min(plan.beams).max(1);
+    let tracer = tracer_scene(scene);
+    let settings = scene.tracer_settings();
+    let mut sink = VisibleLight { width, height, lit: false };
+    let mut stats = TraceStats::default();
+    let mut timed_out = false;
+    for beam in 0..max_beams {
+        // One beam per chunk, so that the probe can stop after any beam.
+        stats.merge(&trace_chunk(&tracer, &settings, effects, u64::MAX, beam, 1, &mut sink));
+        if sink.lit {
+            break;
+        }
+        if deadline.is_some_and(|d| Instant::now() >= d) {
+            timed_out = true;
+            break;
+        }
+    }
+    scene.lights.reset_count();
+    let outcome = ProbeOutcome {
+        beams: stats.beams,
+        lit: sink.lit,
+        seconds: started.elapsed().as_secs_f64(),
+    };
+    if sink.lit || (timed_out && stats.beams < max_beams) {
+        return Ok(outcome);
+    }
+    Err(SceneError::Scene {
+        path: scene.path.clone(),
+        field: "lights".to_owned(),
+        message: format!(
+            "no light can reach the camera: none of {} probe beams lit a point the camera sees \
+             with visible light ({} hit a surface, {} reached the film). Check that the lights face the \
+             objects, that their spectra lie in 360-830 nm, that some surface is not a mirror or glass, and \
+             that the camera looks at the lit objects.",
+            stats.beams, stats.hits, stats.splats
+        ),
+    })
 }
 
 /// Renders a scene file with overrides and writes its outputs (or, with a shard, its partial film).
@@ -276,7 +348,14 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
     if options.verbose {
         eprintln!("{}", effects.summary());
     }
-    probe(scene, &effects)?;
+    let probed = probe(scene, &effects, &plan)?;
+    if options.verbose && !probed.lit {
+        eprintln!(
+            "note: the pre-render probe ran out of time after {} beams without seeing light reach \
+             the camera; rendering anyway",
+            probed.beams
+        );
+    }
     let bar = progress_bar(&plan, options.verbose);
     let started = Instant::now();
     let update = |done: u64| bar.set_position(done.min(bar.length().unwrap_or(u64::MAX)));

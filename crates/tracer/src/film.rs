@@ -8,6 +8,8 @@
 //! (4.6e18) per pixel sum, both in the film's unscaled units (before the factor `power / beams`);
 //! contributions outside the range, NaN and infinities are rejected and counted, never added.
 
+use std::sync::{Mutex, PoisonError};
+
 use serde::{Deserialize, Serialize};
 use spectrace_spectrum::{Xyz, cmf};
 
@@ -18,6 +20,25 @@ const SCALE: f64 = (1u128 << FRAC_BITS) as f64;
 /// Largest magnitude of one contribution: `2^62`; sums beyond `2^63` are refused as overflow.
 const MAX_CONTRIBUTION: f64 = 4_611_686_018_427_387_904.0; // 2^62
 
+/// Bytes of one pixel: three `i128` sums.
+const PIXEL_BYTES: u64 = std::mem::size_of::<[ExactSum; 3]>() as u64;
+
+/// Most pixels a film may have: 2^25 (33.5 million, e.g. 8192 x 4096), 1.6 GB of sums.
+pub const MAX_PIXELS: u64 = 1 << 25;
+
+/// `x` rounded once to fixed point, or `None` if it is NaN, infinite or larger in magnitude than
+/// 2^62.
+#[inline]
+fn to_fixed(x: f64) -> Option<i128> {
+    (x.abs() <= MAX_CONTRIBUTION).then(|| (x * SCALE).round() as i128)
+}
+
+/// The three components of `xyz` in fixed point, or `None` if any of them is out of range.
+#[inline]
+fn xyz_to_fixed(xyz: Xyz) -> Option<[i128; 3]> {
+    Some([to_fixed(xyz.x)?, to_fixed(xyz.y)?, to_fixed(xyz.z)?])
+}
+
 /// An exact, order-independent sum of `f64` contributions (fixed point, 64 fractional bits).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub struct ExactSum(i128);
@@ -27,10 +48,7 @@ impl ExactSum {
     /// than 2^62, or if the sum would overflow.
     #[inline]
     pub fn add(&mut self, x: f64) -> bool {
-        if !(x.abs() <= MAX_CONTRIBUTION) {
-            return false;
-        }
-        let fixed = (x * SCALE).round() as i128;
+        let Some(fixed) = to_fixed(x) else { return false };
         match self.0.checked_add(fixed) {
             Some(s) => {
                 self.0 = s;
@@ -76,6 +94,48 @@ pub enum FilmError {
         "film size {0}x{1} is invalid: both must be at least 1 and their product at most 2^25 (33.5 million pixels)"
     )]
     InvalidSize(u32, u32),
+    /// The render needs more memory than it may use; nothing was allocated.
+    #[error(
+        "a {width}x{height} film (camera.width x camera.height) needs {} ({}), more than the {} a render may use ({limit_source}); lower the camera's resolution",
+        human_bytes(*needed),
+        breakdown,
+        human_bytes(*limit)
+    )]
+    TooLarge {
+        /// Film width.
+        width: u32,
+        /// Film height.
+        height: u32,
+        /// Bytes the render needs.
+        needed: u64,
+        /// What those bytes are.
+        breakdown: String,
+        /// Bytes it may use.
+        limit: u64,
+        /// Where the limit comes from.
+        limit_source: String,
+    },
+}
+
+/// `bytes` in the largest binary unit that keeps a number >= 1, with one decimal (`1.5 GiB`).
+pub fn human_bytes(bytes: u64) -> String {
+    const UNITS: [&str; 5] = ["bytes", "KiB", "MiB", "GiB", "TiB"];
+    let mut value = bytes as f64;
+    let mut unit = 0;
+    while value >= 1024.0 && unit + 1 < UNITS.len() {
+        value /= 1024.0;
+        unit += 1;
+    }
+    if unit == 0 { format!("{bytes} bytes") } else { format!("{value:.1} {}", UNITS[unit]) }
+}
+
+/// Where contributions go: a [`Film`] directly, or a [`FilmWriter`] that buffers them for a
+/// film shared between threads. The light tracer ([`crate::trace_chunk`]) writes through it.
+pub trait Splat {
+    /// Adds an XYZ contribution to pixel `(x, y)` (0-based, from the top-left); returns `false`
+    /// if the pixel is outside the film or a component is NaN, infinite or larger than 2^62
+    /// (films and writers then count a rejection and add nothing).
+    fn splat(&mut self, x: u32, y: u32, xyz: Xyz) -> bool;
 }
 
 /// A film of `width x height` pixels, each accumulating X, Y, Z exactly.
@@ -95,11 +155,11 @@ impl Film {
     /// An empty film.
     ///
     /// # Errors
-    /// [`FilmError::InvalidSize`] for a zero dimension or more than 2^25 pixels (each pixel takes
-    /// 48 bytes, and every render thread keeps a film).
+    /// [`FilmError::InvalidSize`] for a zero dimension or more than [`MAX_PIXELS`] pixels (each
+    /// pixel takes 48 bytes; see [`Film::bytes_for`]).
     pub fn new(width: u32, height: u32) -> Result<Self, FilmError> {
         let n = u64::from(width) * u64::from(height);
-        if width == 0 || height == 0 || n > 1 << 25 {
+        if width == 0 || height == 0 || n > MAX_PIXELS {
             return Err(FilmError::InvalidSize(width, height));
         }
         Ok(Self {
@@ -109,6 +169,13 @@ impl Film {
             rejected: 0,
             accepted: 0,
         })
+    }
+
+    /// Bytes a `width x height` film occupies: 48 per pixel (three `i128` sums) plus the struct.
+    pub fn bytes_for(width: u32, height: u32) -> u64 {
+        (u64::from(width) * u64::from(height))
+            .saturating_mul(PIXEL_BYTES)
+            .saturating_add(std::mem::size_of::<Film>() as u64)
     }
 
     /// Width in pixels.
@@ -126,19 +193,26 @@ impl Film {
     /// out of range; nothing is then added.
     #[inline]
     pub fn add(&mut self, x: u32, y: u32, xyz: Xyz) -> bool {
-        if x >= self.width || y >= self.height {
+        match (pixel_index(x, y, self.width, self.height), xyz_to_fixed(xyz)) {
+            (Some(index), Some(fixed)) => self.add_fixed(index, fixed),
+            _ => {
+                self.rejected += 1;
+                false
+            }
+        }
+    }
+
+    /// Adds a contribution already in fixed point to pixel `index`: all three components or
+    /// none (a rejection is counted when the index is outside or a sum would overflow).
+    #[inline]
+    fn add_fixed(&mut self, index: usize, fixed: [i128; 3]) -> bool {
+        let Some(pixel) = self.sums.get_mut(index) else {
             self.rejected += 1;
             return false;
-        }
-        let limit = |v: f64| v.abs() <= MAX_CONTRIBUTION;
-        if !(limit(xyz.x) && limit(xyz.y) && limit(xyz.z)) {
-            self.rejected += 1;
-            return false;
-        }
-        let pixel = &mut self.sums[(y * self.width + x) as usize];
-        let mut trial = *pixel;
-        if trial[0].add(xyz.x) && trial[1].add(xyz.y) && trial[2].add(xyz.z) {
-            *pixel = trial;
+        };
+        let sum = |c: usize| pixel[c].0.checked_add(fixed[c]);
+        if let (Some(x), Some(y), Some(z)) = (sum(0), sum(1), sum(2)) {
+            *pixel = [ExactSum(x), ExactSum(y), ExactSum(z)];
             self.accepted += 1;
             true
         } else {
@@ -196,6 +270,102 @@ impl Film {
     /// Contributions added.
     pub fn accepted(&self) -> u64 {
         self.accepted
+    }
+}
+
+/// The row-major index of pixel `(x, y)`, if it lies on a `width x height` film.
+#[inline]
+fn pixel_index(x: u32, y: u32, width: u32, height: u32) -> Option<usize> {
+    // Films have at most 2^25 pixels, so the index fits in u32 and usize.
+    (x < width && y < height).then(|| (y * width + x) as usize)
+}
+
+impl Splat for Film {
+    #[inline]
+    fn splat(&mut self, x: u32, y: u32, xyz: Xyz) -> bool {
+        self.add(x, y, xyz)
+    }
+}
+
+/// One buffered contribution: pixel index and fixed-point XYZ.
+type Entry = (u32, [i128; 3]);
+
+/// A thread's writer into a film shared between threads: contributions are checked and rounded
+/// to fixed point at once (so `splat` answers exactly as [`Film::add`] would), kept in a buffer
+/// of [`FilmWriter::CAPACITY`] entries, and added to the film under its lock when the buffer is
+/// full, on [`FilmWriter::flush`] and when the writer is dropped; the buffer is sorted by pixel
+/// first, for cache locality. Since the film's sums are exact integers, the result is bit for bit
+/// the film that direct adds in any order give, whatever the number of writers.
+///
+/// One difference: a pixel sum overflowing 2^63 (reachable only with contributions near the
+/// 2^62 limit) is found at the flush, so `splat` has already answered `true`; the film counts it
+/// as rejected.
+#[derive(Debug)]
+pub struct FilmWriter<'a> {
+    film: &'a Mutex<Film>,
+    width: u32,
+    height: u32,
+    entries: Vec<Entry>,
+    rejected: u64,
+}
+
+impl<'a> FilmWriter<'a> {
+    /// Contributions buffered before a flush (256 KiB: large enough that the lock is rare,
+    /// small enough to stay in a core's L2 cache).
+    pub const CAPACITY: usize = 4096;
+
+    /// Bytes one writer occupies (its buffer and the struct).
+    pub const BYTES: u64 = (Self::CAPACITY * std::mem::size_of::<Entry>()
+        + std::mem::size_of::<FilmWriter<'static>>()) as u64;
+
+    /// A writer into `film`.
+    pub fn new(film: &'a Mutex<Film>) -> Self {
+        let (width, height) = {
+            let f = film.lock().unwrap_or_else(PoisonError::into_inner);
+            (f.width, f.height)
+        };
+        Self { film, width, height, entries: Vec::with_capacity(Self::CAPACITY), rejected: 0 }
+    }
+
+    /// Adds the buffered contributions (and rejections) to the film.
+    pub fn flush(&mut self) {
+        if self.entries.is_empty() && self.rejected == 0 {
+            return;
+        }
+        self.entries.sort_unstable_by_key(|e| e.0);
+        let mut film = self.film.lock().unwrap_or_else(PoisonError::into_inner);
+        for &(index, fixed) in &self.entries {
+            film.add_fixed(index as usize, fixed);
+        }
+        film.rejected += self.rejected;
+        drop(film);
+        self.entries.clear();
+        self.rejected = 0;
+    }
+}
+
+impl Splat for FilmWriter<'_> {
+    #[inline]
+    fn splat(&mut self, x: u32, y: u32, xyz: Xyz) -> bool {
+        match (pixel_index(x, y, self.width, self.height), xyz_to_fixed(xyz)) {
+            (Some(index), Some(fixed)) => {
+                if self.entries.len() >= Self::CAPACITY {
+                    self.flush();
+                }
+                self.entries.push((index as u32, fixed));
+                true
+            }
+            _ => {
+                self.rejected += 1;
+                false
+            }
+        }
+    }
+}
+
+impl Drop for FilmWriter<'_> {
+    fn drop(&mut self) {
+        self.flush();
     }
 }
 
@@ -260,5 +430,53 @@ mod tests {
         assert_eq!(merged, one);
         assert!(Film::new(8, 5).unwrap().merge(&Film::new(5, 8).unwrap()).is_err());
         assert!(Film::new(0, 5).is_err());
+    }
+
+    #[test]
+    fn buffered_writers_into_a_shared_film_equal_direct_adds_bit_for_bit() {
+        // More contributions than a buffer holds, some of them invalid (NaN, infinite, beyond
+        // 2^62, outside the film), written by three interleaved writers.
+        let contributions: Vec<(u32, u32, Xyz)> = (0..3 * FilmWriter::CAPACITY as u32 + 77)
+            .map(|i| {
+                let v = 1.0 / (1.0 + f64::from(i)) * 10f64.powi((i % 9) as i32 - 4);
+                let xyz = match i % 101 {
+                    0 => Xyz::new(f64::NAN, v, v),
+                    1 => Xyz::new(v, f64::INFINITY, v),
+                    2 => Xyz::new(v, v, 1e19),
+                    _ => Xyz::new(v, 0.5 * v, -0.25 * v),
+                };
+                ((i * 7) % 13, (i * 3) % 6, xyz)
+            })
+            .collect();
+        let mut direct = Film::new(12, 5).unwrap();
+        let mut direct_answers = Vec::new();
+        for &(x, y, xyz) in &contributions {
+            direct_answers.push(direct.splat(x, y, xyz));
+        }
+        let shared = Mutex::new(Film::new(12, 5).unwrap());
+        let mut buffered_answers = Vec::new();
+        {
+            let mut writers =
+                [FilmWriter::new(&shared), FilmWriter::new(&shared), FilmWriter::new(&shared)];
+            for (k, &(x, y, xyz)) in contributions.iter().enumerate().rev() {
+                buffered_answers.push(writers[k % 3].splat(x, y, xyz));
+            }
+            writers[1].flush();
+            // The others flush when dropped.
+        }
+        buffered_answers.reverse();
+        assert_eq!(buffered_answers, direct_answers);
+        let shared = shared.into_inner().unwrap();
+        assert!(direct.rejected() > 0 && direct.accepted() > 3 * FilmWriter::CAPACITY as u64 / 2);
+        assert_eq!(shared, direct);
+    }
+
+    #[test]
+    fn film_bytes_are_48_per_pixel() {
+        let b = Film::bytes_for(8192, 4096);
+        assert!((48 << 25..(48 << 25) + 1024).contains(&b), "{b}");
+        assert_eq!(Film::bytes_for(u32::MAX, u32::MAX), u64::MAX);
+        assert_eq!(human_bytes(1536), "1.5 KiB");
+        assert_eq!(human_bytes(12), "12 bytes");
     }
 }

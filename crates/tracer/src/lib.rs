@@ -21,8 +21,11 @@ mod render;
 
 pub use camera::{CameraError, CameraRepr, FovAxis, PinholeCamera, Projection};
 pub use effects::{BUNDLE, Effects, EffectsMode, SceneFeatures};
-pub use film::{ExactSum, Film, FilmError};
+pub use film::{ExactSum, Film, FilmError, FilmWriter, MAX_PIXELS, Splat, human_bytes};
 pub use light_tracer::{
-    LightTracerScene, LightTracerSettings, TraceStats, chunk_rng, image_scale, trace_chunk,
+    LightTracerScene, LightTracerSettings, MAX_DEPTH, TraceStats, chunk_rng, image_scale,
+    trace_chunk, trace_chunk_until,
 };
-pub use render::{DEFAULT_CHUNK_BEAMS, RenderOutput, RenderPlan, render};
+pub use render::{
+    DEFAULT_CHUNK_BEAMS, FALLBACK_MEMORY_LIMIT, MemoryLimit, RenderOutput, RenderPlan, render,
+};

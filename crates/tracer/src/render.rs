@@ -1,13 +1,13 @@
 //! Running the light tracer over work chunks on several threads (and, with shards, machines).
 
-use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
 
-use crate::light_tracer::{LightTracerScene, LightTracerSettings, TraceStats, trace_chunk};
-use crate::{Effects, Film, FilmError};
+use crate::light_tracer::{LightTracerScene, LightTracerSettings, TraceStats, trace_chunk_until};
+use crate::{Effects, Film, FilmError, FilmWriter};
 
 /// Beams per work chunk by default: small enough to balance threads, large enough that the
 /// per-chunk cost (a generator, a film merge) is negligible.
@@ -26,8 +26,57 @@ pub struct RenderPlan {
     pub threads: usize,
     /// Render only the chunks whose index is `k` mod `n` (`(k, n)`), for one machine of many.
     pub shard: Option<(u64, u64)>,
-    /// Stop claiming new chunks after this many seconds (the chunks already claimed finish).
+    /// Time budget (s): after it, no new chunk is claimed and the chunks being traced stop
+    /// within a few microseconds of work (between beams; at least one beam is always traced).
     pub time_budget: Option<f64>,
+}
+
+/// Memory a render may use when the available memory cannot be read (no `/proc/meminfo`):
+/// 4 GiB, which holds the largest film ([`crate::MAX_PIXELS`] pixels, 1.5 GiB) with room to spare.
+pub const FALLBACK_MEMORY_LIMIT: u64 = 4 << 30;
+
+/// How much memory a render may use, and where that figure comes from.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MemoryLimit {
+    /// Bytes.
+    pub bytes: u64,
+    /// Where the figure comes from, in words (for error messages).
+    pub source: String,
+}
+
+impl MemoryLimit {
+    /// Three quarters of the memory the system can give without swapping (`MemAvailable` in
+    /// `/proc/meminfo`), or [`FALLBACK_MEMORY_LIMIT`] where that cannot be read. The film is
+    /// written at random places all through the render, so it must stay resident (a swapped film
+    /// would crawl); the remaining quarter is for the scene, the image conversion after the render
+    /// and the rest of the system.
+    pub fn system() -> Self {
+        match std::fs::read_to_string("/proc/meminfo").ok().as_deref().and_then(mem_available) {
+            Some(available) => Self {
+                bytes: available / 4 * 3,
+                source: format!(
+                    "3/4 of the {} available according to /proc/meminfo",
+                    crate::human_bytes(available)
+                ),
+            },
+            None => Self {
+                bytes: FALLBACK_MEMORY_LIMIT,
+                source: "the fallback limit: the available memory could not be read".to_owned(),
+            },
+        }
+    }
+}
+
+/// `MemAvailable` of a `/proc/meminfo` text, in bytes.
+fn mem_available(meminfo: &str) -> Option<u64> {
+    let line = meminfo.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let mut words = line.split_whitespace().skip(1);
+    let value: u64 = words.next()?.parse().ok()?;
+    match words.next() {
+        Some("kB") => value.checked_mul(1024),
+        None => Some(value),
+        Some(_) => None,
+    }
 }
 
 impl RenderPlan {
@@ -67,6 +116,49 @@ impl RenderPlan {
             .saturating_mul(self.chunk_beams.max(1))
             .saturating_add(self.beams_in_chunk(last))
     }
+
+    /// Threads that actually work: `threads` (at least 1), but no more than this shard's chunks.
+    pub fn worker_threads(&self) -> usize {
+        (self.threads.max(1) as u64).min(self.shard_chunk_count().max(1)) as usize
+    }
+
+    /// Bytes [`render`] needs for a `width x height` image: one shared film plus one
+    /// [`FilmWriter`] buffer per working thread. It does not grow with the thread count beyond
+    /// the small buffers.
+    pub fn memory_bytes(&self, width: u32, height: u32) -> u64 {
+        Film::bytes_for(width, height)
+            .saturating_add((self.worker_threads() as u64).saturating_mul(FilmWriter::BYTES))
+    }
+
+    /// Checks that a `width x height` render fits in `limit`; returns the bytes it needs.
+    ///
+    /// # Errors
+    /// [`FilmError::TooLarge`] saying how much is needed and how much may be used.
+    pub fn check_memory(
+        &self,
+        width: u32,
+        height: u32,
+        limit: &MemoryLimit,
+    ) -> Result<u64, FilmError> {
+        let needed = self.memory_bytes(width, height);
+        if needed <= limit.bytes {
+            return Ok(needed);
+        }
+        let threads = self.worker_threads();
+        Err(FilmError::TooLarge {
+            width,
+            height,
+            needed,
+            breakdown: format!(
+                "a film of {} at 48 bytes per pixel and {threads} thread buffer{} of {}",
+                crate::human_bytes(Film::bytes_for(width, height)),
+                if threads == 1 { "" } else { "s" },
+                crate::human_bytes(FilmWriter::BYTES)
+            ),
+            limit: limit.bytes,
+            limit_source: limit.source.clone(),
+        })
+    }
 }
 
 /// The result of a render (or of one shard).
@@ -76,9 +168,10 @@ pub struct RenderOutput {
     pub film: Film,
     /// Counters.
     pub stats: TraceStats,
-    /// The chunks that were rendered, sorted.
+    /// The chunks that were rendered, sorted. With a time budget, the chunks being traced when
+    /// it ran out are listed too, though they were cut short.
     pub chunks: Vec<u64>,
-    /// Beams in those chunks.
+    /// Beams traced (exactly: the image is normalised by it); equals `stats.beams`.
     pub beams: u64,
     /// Wall time (s).
     pub seconds: f64,
@@ -100,11 +193,20 @@ impl RenderOutput {
     }
 }
 
-/// Renders the plan's chunks on `plan.threads` threads; `progress(beams_done)` is called after
-/// every chunk (from worker threads).
+/// Renders the plan's chunks on `plan.threads` threads into one shared film; `progress(beams)`
+/// is called after every chunk (from worker threads) with the beams traced so far.
+///
+/// Memory: one film for the whole render plus a small [`FilmWriter`] buffer per thread
+/// ([`RenderPlan::memory_bytes`]), checked against [`MemoryLimit::system`] before anything is
+/// allocated. The film is exact, so the image is bit-identical for any thread count.
+///
+/// With a time budget, threads stop claiming chunks once it has passed (the first chunk is
+/// always claimed) and the chunks in progress stop between beams within a few microseconds of
+/// work; the output counts exactly the beams traced.
 ///
 /// # Errors
-/// [`FilmError::InvalidSize`] for a camera whose resolution cannot be allocated.
+/// [`FilmError::InvalidSize`] for a camera whose resolution is not a valid film;
+/// [`FilmError::TooLarge`] when the render would need more memory than it may use.
 pub fn render(
     scene: &LightTracerScene<'_>,
     settings: &LightTracerSettings,
@@ -114,6 +216,8 @@ pub fn render(
 ) -> Result<RenderOutput, FilmError> {
     let started = Instant::now();
     let (w, h) = (scene.camera.width(), scene.camera.height());
+    plan.check_memory(w, h, &MemoryLimit::system())?;
+    let film = Mutex::new(Film::new(w, h)?);
     let next = AtomicU64::new(0);
     let done = AtomicU64::new(0);
     // A budget too large to represent is no budget at all.
@@ -121,16 +225,11 @@ pub fn render(
         .time_budget
         .and_then(|s| Duration::try_from_secs_f64(s.max(0.0)).ok())
         .and_then(|d| started.checked_add(d));
-    let results: Mutex<Vec<(Film, TraceStats, Vec<u64>)>> = Mutex::new(Vec::new());
-    let mut first_error = None;
-    // More threads than chunks would only wait.
-    let threads = (plan.threads.max(1) as u64).min(plan.shard_chunk_count().max(1)) as usize;
+    let results: Mutex<Vec<(TraceStats, Vec<u64>)>> = Mutex::new(Vec::new());
     std::thread::scope(|scope| {
-        let mut handles = Vec::new();
-        for _ in 0..threads {
-            handles.push(scope.spawn(|| -> Result<(), FilmError> {
-                // The film is allocated with the first chunk: idle threads cost no memory.
-                let mut film: Option<Film> = None;
+        for _ in 0..plan.worker_threads() {
+            scope.spawn(|| {
+                let mut writer = FilmWriter::new(&film);
                 let mut stats = TraceStats::default();
                 let mut mine = Vec::new();
                 loop {
@@ -143,47 +242,47 @@ pub fn render(
                     let i = next.fetch_add(1, Ordering::Relaxed);
                     let Some(c) = plan.shard_chunk(i) else { break };
                     let n = plan.beams_in_chunk(c);
-                    let film = match &mut film {
-                        Some(f) => f,
-                        None => film.insert(Film::new(w, h)?),
-                    };
-                    let s = trace_chunk(scene, settings, effects, plan.seed, c, n, film);
+                    let s = trace_chunk_until(
+                        scene,
+                        settings,
+                        effects,
+                        plan.seed,
+                        c,
+                        n,
+                        deadline,
+                        &mut writer,
+                    );
+                    writer.flush();
                     stats.merge(&s);
                     mine.push(c);
-                    progress(done.fetch_add(n, Ordering::Relaxed) + n);
+                    progress(done.fetch_add(s.beams, Ordering::Relaxed) + s.beams);
+                    if s.beams < n {
+                        // Cut short by the deadline.
+                        break;
+                    }
                 }
-                if let (Some(film), Ok(mut r)) = (film, results.lock()) {
-                    r.push((film, stats, mine));
+                writer.flush();
+                if let Ok(mut r) = results.lock() {
+                    r.push((stats, mine));
                 }
-                Ok(())
-            }));
-        }
-        for handle in handles {
-            if let Ok(Err(e)) = handle.join() {
-                first_error.get_or_insert(e);
-            }
+            });
         }
     });
-    if let Some(e) = first_error {
-        return Err(e);
-    }
-    let mut film = Film::new(w, h)?;
+    let film = film.into_inner().unwrap_or_else(PoisonError::into_inner);
     let mut stats = TraceStats::default();
     let mut rendered = Vec::new();
-    for (f, s, c) in results.into_inner().unwrap_or_default() {
-        film.merge(&f)?;
+    for (s, c) in results.into_inner().unwrap_or_default() {
         stats.merge(&s);
         rendered.extend(c);
     }
     rendered.sort_unstable();
-    // With a time budget, chunks are claimed in order and every claimed chunk finishes, so the
-    // rendered set is a prefix of the shard's chunks; the output reports exactly that set.
-    let beams = rendered.iter().map(|&c| plan.beams_in_chunk(c)).sum();
+    // Without a budget every chunk of the shard was traced whole; with one, the rendered set is
+    // the chunks claimed, the last ones possibly cut short, and the beams are counted exactly.
     Ok(RenderOutput {
         film,
+        beams: stats.beams,
         stats,
         chunks: rendered,
-        beams,
         seconds: started.elapsed().as_secs_f64(),
     })
 }
@@ -220,5 +319,41 @@ mod tests {
         let huge = plan(u64::MAX / 2, 1 << 14, Some((1, 2)));
         assert!(huge.shard_chunk_count() > 1 << 40);
         assert_eq!(huge.shard_chunk(5), Some(11));
+    }
+
+    #[test]
+    fn memory_needs_one_film_whatever_the_thread_count() {
+        let (w, h) = (8192, 4096);
+        let with = |threads: usize| RenderPlan { threads, ..plan(u64::MAX / 2, 1 << 14, None) };
+        let film = Film::bytes_for(w, h);
+        let one = with(1).memory_bytes(w, h);
+        let four = with(4).memory_bytes(w, h);
+        let many = with(256).memory_bytes(w, h);
+        assert_eq!(one, film + FilmWriter::BYTES);
+        assert_eq!(four - one, 3 * FilmWriter::BYTES);
+        // 256 threads need less than 5% more than one (a film per thread was 256 films).
+        assert!(many < film + film / 20, "{many} vs {film}");
+        // Threads beyond the chunks do not work and need nothing.
+        assert_eq!(RenderPlan { threads: 8, ..plan(1000, 1000, None) }.memory_bytes(w, h), one);
+    }
+
+    #[test]
+    fn a_render_that_cannot_fit_is_refused_with_what_it_needs() {
+        let p = RenderPlan { threads: 4, ..plan(1 << 20, 1 << 14, None) };
+        let small = MemoryLimit { bytes: 1 << 30, source: "a test limit".to_owned() };
+        let e = p.check_memory(8192, 4096, &small).unwrap_err().to_string();
+        assert!(
+            e.contains("8192x4096")
+                && e.contains("camera.width")
+                && e.contains("1.5 GiB")
+                && e.contains("4 thread buffers")
+                && e.contains("1.0 GiB")
+                && e.contains("a test limit"),
+            "{e}"
+        );
+        assert_eq!(p.check_memory(640, 480, &small).unwrap(), p.memory_bytes(640, 480));
+        assert_eq!(mem_available("MemTotal: 8 kB\nMemAvailable:   3 kB\n"), Some(3072));
+        assert_eq!(mem_available("MemTotal: 8 kB\n"), None);
+        assert!(MemoryLimit::system().bytes > 0);
     }
 }
