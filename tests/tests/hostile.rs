@@ -328,6 +328,20 @@ impl TapWrite for PathBuf {
     }
 }
 
+/// Failure 6: `max_depth` has a documented upper bound.
+#[test]
+fn max_depth_beyond_its_bound_is_refused() {
+    for (depth, ok) in [(10_000u64, true), (10_001, false), (4_000_000_000, false)] {
+        let json = PLANE.replace("\"chunk_beams\": 1000", &format!("\"max_depth\": {depth}"));
+        let r = Scene::from_json(&json, Path::new("x.json"));
+        assert_eq!(r.is_ok(), ok, "{depth}");
+        if let Err(e) = r {
+            let e = e.to_string();
+            assert!(e.contains("settings.max_depth") && e.contains("at most 10000"), "{e}");
+        }
+    }
+}
+
 /// `--restrict-paths`: meshes outside the scene's folder (by `..`, absolute path or symlink) are
 /// refused; without it they load, as a user on their own machine expects.
 #[test]

@@ -687,4 +687,10 @@ fn a_closed_mirror_box_keeps_the_beam_count_and_the_time_budget() {
     let report = render_scene(&outside, &timed).unwrap();
     assert!(report.wall_seconds < budget + 5.0, "{} s", report.wall_seconds);
     assert_eq!(report.stats.splats, 0);
+    // The black image is not silent: the report warns that no light reached the camera.
+    assert!(
+        report.warnings.iter().any(|w| w.contains("no light reached the camera")),
+        "{:?}",
+        report.warnings
+    );
 }

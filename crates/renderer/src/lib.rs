@@ -171,7 +171,7 @@ pub fn plan_for(scene: &Scene, options: &RenderOptions) -> Result<RenderPlan, Re
     }
     if plan.threads > MAX_THREADS {
         return Err(RenderError::Options(format!(
-            "threads = {}: at most {MAX_THREADS} (each working thread keeps a film of its own)",
+            "threads = {}: at most {MAX_THREADS}",
             plan.threads
         )));
     }
@@ -364,6 +364,18 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
     bar.finish_and_clear();
     let wall = started.elapsed().as_secs_f64();
     if let Some((k, n)) = plan.shard {
+        let path = options.out_dir.join(format!("{name}.part-{k}-of-{n}.bin"));
+        let shard_report = report(
+            scene.path.display().to_string(),
+            (scene.camera.width(), scene.camera.height()),
+            plan,
+            effects,
+            &output,
+            wall,
+            scene.lights.power(),
+            Written { files: vec![path.display().to_string()], ..Written::default() },
+        );
+        // The film moves into the part (no copy of what may be 1.5 GiB).
         let part = PartialFilm {
             version: PARTIAL_VERSION,
             scene_fingerprint: scene.fingerprint(),
@@ -373,26 +385,24 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
             effects,
             output_settings: scene.output.clone(),
             name: name.clone(),
-            output: output.clone(),
+            output,
         };
-        let path = options.out_dir.join(format!("{name}.part-{k}-of-{n}.bin"));
         let bytes =
             part.encode().map_err(|message| RenderError::File { path: path.clone(), message })?;
+        drop(part);
         write_atomically(&path, |p| std::fs::write(p, &bytes).map_err(|e| e.to_string()))
             .map_err(|message| RenderError::File { path: path.clone(), message })?;
-        return Ok(report(
-            scene.path.display().to_string(),
-            (scene.camera.width(), scene.camera.height()),
-            plan,
-            effects,
-            &output,
-            wall,
-            scene.lights.power(),
-            Written { files: vec![path.display().to_string()], ..Written::default() },
+        return Ok(shard_report);
+    }
+    let mut written =
+        write_outputs(&options.out_dir, &name, &scene.output, scene.lights.power(), &output)?;
+    if !probed.lit && output.film.accepted() == 0 {
+        written.warnings.push(format!(
+            "no light reached the camera: the image is black (the pre-render probe ran out of \
+             time after {} beams, and none of the {} beams rendered lit a point the camera sees)",
+            probed.beams, output.beams
         ));
     }
-    let written =
-        write_outputs(&options.out_dir, &name, &scene.output, scene.lights.power(), &output)?;
     let report = report(
         scene.path.display().to_string(),
         (scene.camera.width(), scene.camera.height()),
@@ -553,27 +563,42 @@ fn write_sidecar(dir: &Path, name: &str, report: &RenderReport) -> Result<(), Re
 /// [`RenderError::Options`] when the parts do not belong together, overlap, miss chunks, or their
 /// counts overflow.
 pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, RenderError> {
-    let mut loaded: Vec<PartialFilm> = Vec::new();
-    for path in parts {
-        let part = PartialFilm::read(path)
-            .map_err(|message| RenderError::File { path: path.clone(), message })?;
-        loaded.push(part);
-    }
-    let Some(first) = loaded.first().cloned() else {
+    let read = |path: &PathBuf| {
+        PartialFilm::read(path).map_err(|message| RenderError::File { path: path.clone(), message })
+    };
+    let Some(first_path) = parts.first() else {
         return Err(RenderError::Options("merge needs at least one partial film".to_owned()));
     };
-    let outputs = planned_outputs(out_dir, &first.name, &first.output_settings, None, parts)?;
+    // Parts are read one at a time: memory holds the merged film and one part, whatever their
+    // number. The first part's film becomes the merged film.
+    let mut first = read(first_path)?;
     let (w, h) = (first.output.film.width(), first.output.film.height());
-    let mut merged = RenderOutput {
-        film: Film::new(w, h).map_err(|e| RenderError::Options(e.to_string()))?,
+    let limit = MemoryLimit::system();
+    let needed = Film::bytes_for(w, h).saturating_mul(2);
+    if needed > limit.bytes {
+        return Err(RenderError::Options(format!(
+            "merging {w}x{h} films needs {} (the merged film and one part), more than the {} \
+             this machine may use ({})",
+            files::human_bytes(needed),
+            files::human_bytes(limit.bytes),
+            limit.source
+        )));
+    }
+    let outputs = planned_outputs(out_dir, &first.name, &first.output_settings, None, parts)?;
+    let placeholder = RenderOutput {
+        film: Film::new(1, 1).map_err(|e| RenderError::Options(e.to_string()))?,
         stats: TraceStats::default(),
         chunks: Vec::new(),
         beams: 0,
         seconds: 0.0,
     };
+    let mut merged = std::mem::replace(&mut first.output, placeholder);
     // Which part holds each chunk: coverage is checked by chunk identity, not by count.
-    let mut owner: std::collections::BTreeMap<u64, usize> = std::collections::BTreeMap::new();
-    for (index, (part, path)) in loaded.iter().zip(parts).enumerate() {
+    let mut owner: std::collections::BTreeMap<u64, usize> =
+        merged.chunks.iter().map(|&c| (c, 0)).collect();
+    let mut seconds = vec![merged.seconds];
+    for (index, path) in parts.iter().enumerate().skip(1) {
+        let part = read(path)?;
         let different = if part.scene_fingerprint != first.scene_fingerprint {
             Some("scene")
         } else if part.plan != first.plan {
@@ -593,7 +618,7 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
             return Err(RenderError::Options(format!(
                 "{}: belongs to another render: its {what} differs from {}",
                 path.display(),
-                parts[0].display()
+                first_path.display()
             )));
         }
         for &c in &part.output.chunks {
@@ -615,6 +640,7 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
         merged
             .merge(&part.output)
             .map_err(|e| RenderError::Options(format!("{}: {e}", path.display())))?;
+        seconds.push(part.output.seconds);
     }
     if first.plan.time_budget.is_none() {
         let expected = first.plan.chunks();
@@ -632,14 +658,14 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
     debug_assert!(
         written.files.iter().all(|f| outputs.iter().any(|o| o.display().to_string() == *f))
     );
-    let total_seconds: f64 = loaded.iter().map(|p| p.output.seconds).sum();
+    let total_seconds: f64 = seconds.iter().sum();
     let mut report = report(
         first.scene_path.clone(),
         (w, h),
         first.plan,
         first.effects,
         &merged,
-        loaded.iter().map(|p| p.output.seconds).fold(0.0, f64::max),
+        seconds.iter().copied().fold(0.0, f64::max),
         first.light_power,
         written,
     );

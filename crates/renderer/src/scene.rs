@@ -9,7 +9,7 @@ use spectrace_geometry::{Shape, Transform, World};
 use spectrace_lights::{LightSet, LightSource};
 use spectrace_materials::Material;
 use spectrace_tracer::{
-    DEFAULT_CHUNK_BEAMS, EffectsMode, LightTracerSettings, PinholeCamera, RenderPlan,
+    DEFAULT_CHUNK_BEAMS, EffectsMode, LightTracerSettings, MAX_DEPTH, PinholeCamera, RenderPlan,
 };
 
 use crate::files::{MAX_SCENE_BYTES, check_output_name, read_bounded};
@@ -291,6 +291,16 @@ impl Scene {
         let s = &file.settings;
         if s.beams == 0 {
             return Err(scene_error("settings.beams", "must be at least 1".to_owned()));
+        }
+        if s.max_depth > MAX_DEPTH {
+            return Err(scene_error(
+                "settings.max_depth",
+                format!(
+                    "{}: at most {MAX_DEPTH} bounces (longer paths carry no measurable light, \
+                     and one beam could outlast a time budget)",
+                    s.max_depth
+                ),
+            ));
         }
         if s.chunk_beams == 0 {
             return Err(scene_error("settings.chunk_beams", "must be at least 1".to_owned()));
