@@ -196,47 +196,6 @@ pub const MAX_MESH_VERTICES: usize = 1 << 25;
 /// The most triangles a mesh may have, inline or from an OBJ file: 2^25 (33,554,432).
 pub const MAX_MESH_TRIANGLES: usize = 1 << 25;
 
-/// `bytes` written for people: `"1 GiB"`, `"4 MiB"`, `"100 bytes"`.
-fn byte_size(bytes: u64) -> String {
-    const UNITS: [(u64, &str); 3] = [(1 << 30, "GiB"), (1 << 20, "MiB"), (1 << 10, "KiB")];
-    UNITS.iter().find(|&&(unit, _)| bytes >= unit && bytes.is_multiple_of(unit)).map_or_else(
-        || format!("{bytes} bytes"),
-        |&(unit, name)| format!("{} {name}", bytes / unit),
-    )
-}
-
-/// Reads the whole of a regular file of at most `limit` bytes. Devices, FIFOs and directories
-/// are refused before being opened (opening a FIFO would block, reading `/dev/zero` never ends);
-/// the read itself goes through `take(limit + 1)`, so a file that grows is refused too.
-fn read_bounded(path: &Path, limit: u64) -> Result<Vec<u8>, String> {
-    use std::io::Read;
-    let too_large = || format!("larger than the {} limit", byte_size(limit));
-    let not_regular =
-        |kind: &str| format!("not a regular file ({kind}); give the path of an .obj file");
-    let kind = |m: &std::fs::Metadata| {
-        let t = m.file_type();
-        if t.is_dir() { "a directory" } else { "a device, FIFO or socket" }
-    };
-    let meta = std::fs::metadata(path).map_err(|e| e.to_string())?;
-    if !meta.is_file() {
-        return Err(not_regular(kind(&meta)));
-    }
-    if meta.len() > limit {
-        return Err(too_large());
-    }
-    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
-    let meta = file.metadata().map_err(|e| e.to_string())?;
-    if !meta.is_file() {
-        return Err(not_regular(kind(&meta)));
-    }
-    let mut bytes = Vec::new();
-    file.take(limit.saturating_add(1)).read_to_end(&mut bytes).map_err(|e| e.to_string())?;
-    if bytes.len() as u64 > limit {
-        return Err(too_large());
-    }
-    Ok(bytes)
-}
-
 /// Reads an OBJ file into mesh data (all models merged), at most [`MAX_OBJ_BYTES`] long.
 fn read_obj(path: &Path, transform: Option<&Transform>) -> Result<MeshData, GeometryError> {
     read_obj_limited(path, transform, MAX_OBJ_BYTES)
@@ -250,7 +209,7 @@ fn read_obj_limited(
     limit: u64,
 ) -> Result<MeshData, GeometryError> {
     let err = |reason: String| GeometryError::Obj { path: path.to_path_buf(), reason };
-    let bytes = read_bounded(path, limit).map_err(err)?;
+    let bytes = crate::read_bounded(path, limit, "OBJ file").map_err(err)?;
     let (models, _materials) =
         tobj::load_obj_buf(&mut bytes.as_slice(), &tobj::GPU_LOAD_OPTIONS, |_mtl_path| {
             Ok((Vec::new(), Default::default()))
@@ -521,12 +480,5 @@ mod tests {
         assert!(e.contains(&format!("larger than the {} bytes limit", len - 1)), "{e}");
         assert!(e.contains("Mesh.obj"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn byte_sizes_are_written_in_the_largest_exact_unit() {
-        assert_eq!(byte_size(MAX_OBJ_BYTES), "1 GiB");
-        assert_eq!(byte_size(3 << 20), "3 MiB");
-        assert_eq!(byte_size(1000), "1000 bytes");
     }
 }

@@ -1,8 +1,9 @@
 //! Files the renderer reads and writes, handled so that hostile or careless input cannot hurt.
 //!
-//! - Every file read goes through [`read_bounded`]: it must be a regular file (not a device, FIFO or
-//!   directory) no larger than a documented limit, checked before and while reading, so
-//!   `/dev/zero` or a 100 GB file is refused at once instead of filling memory.
+//! - Every file read goes through [`read_bounded`] (from `spectrace-geometry`, which reads OBJ
+//!   files the same way): it must be a regular file (not a device, FIFO or directory) no larger
+//!   than a documented limit, checked before and while reading, so `/dev/zero` or a 100 GB file
+//!   is refused at once instead of filling memory.
 //! - Every output name is checked by [`check_output_name`] before any work starts: a plain file
 //!   name, never a path, so nothing lands outside the output folder.
 //! - [`check_no_input_replaced`] refuses, before rendering, any output that is the same file as an
@@ -10,9 +11,10 @@
 //! - [`write_atomically`] writes each output to a temporary name in the output folder and renames
 //!   it into place, so a failed write never leaves a partial file under the final name.
 
-use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
+
+pub use spectrace_geometry::read_bounded;
 
 /// Largest scene file read (256 MiB): inline meshes of a few million triangles fit.
 pub const MAX_SCENE_BYTES: u64 = 256 << 20;
@@ -24,48 +26,6 @@ pub const MAX_PART_BYTES: u64 = 2 << 30;
 /// (`.part-K-of-N.bin` with 20-digit numbers) within the 255-byte file-name limit of common file
 /// systems.
 pub const MAX_OUTPUT_NAME_BYTES: usize = 200;
-
-/// Reads a whole file of at most `limit` bytes; `what` names it in errors ("scene", "partial
-/// film").
-///
-/// # Errors
-/// A message saying why: not found, not a regular file, larger than the limit, or unreadable.
-pub fn read_bounded(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, String> {
-    let meta = std::fs::metadata(path).map_err(|e| format!("cannot read the {what}: {e}"))?;
-    if !meta.is_file() {
-        let kind =
-            if meta.is_dir() { "a directory" } else { "not a regular file (a device or pipe?)" };
-        return Err(format!("cannot read the {what}: {kind}"));
-    }
-    if meta.len() > limit {
-        return Err(format!(
-            "the {what} is {} bytes, more than the {} limit",
-            meta.len(),
-            human_bytes(limit)
-        ));
-    }
-    let file = std::fs::File::open(path).map_err(|e| format!("cannot read the {what}: {e}"))?;
-    // The file may grow between the check and the read: read at most one byte past the limit.
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
-    file.take(limit + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| format!("cannot read the {what}: {e}"))?;
-    if bytes.len() as u64 > limit {
-        return Err(format!("the {what} is larger than the {} limit", human_bytes(limit)));
-    }
-    Ok(bytes)
-}
-
-/// `2 GiB`, `256 MiB`, or a byte count.
-pub(crate) fn human_bytes(n: u64) -> String {
-    if n >= 1 << 30 && n.is_multiple_of(1 << 30) {
-        format!("{} GiB", n >> 30)
-    } else if n >= 1 << 20 && n.is_multiple_of(1 << 20) {
-        format!("{} MiB", n >> 20)
-    } else {
-        format!("{n} bytes")
-    }
-}
 
 /// Checks an output base name: a plain, non-empty file name of at most
 /// [`MAX_OUTPUT_NAME_BYTES`] bytes, with no directory separator, no NUL or other control
@@ -198,22 +158,6 @@ mod tests {
         assert!(check_output_name(&"x".repeat(200)).is_ok());
         let e = check_output_name(&"x".repeat(300)).unwrap_err();
         assert!(e.contains("300 bytes"), "{e}");
-    }
-
-    #[test]
-    fn bounded_reads_refuse_devices_directories_and_large_files() {
-        let d = temp("bounded");
-        let f = d.join("f.txt");
-        std::fs::write(&f, b"0123456789").unwrap();
-        assert_eq!(read_bounded(&f, 10, "scene").unwrap().len(), 10);
-        let e = read_bounded(&f, 9, "scene").unwrap_err();
-        assert!(e.contains("more than the 9 bytes limit"), "{e}");
-        assert!(read_bounded(&d, 100, "scene").unwrap_err().contains("directory"));
-        #[cfg(unix)]
-        {
-            let e = read_bounded(Path::new("/dev/zero"), 100, "scene").unwrap_err();
-            assert!(e.contains("not a regular file"), "{e}");
-        }
     }
 
     #[test]

@@ -579,8 +579,8 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
         return Err(RenderError::Options(format!(
             "merging {w}x{h} films needs {} (the merged film and one part), more than the {} \
              this machine may use ({})",
-            files::human_bytes(needed),
-            files::human_bytes(limit.bytes),
+            spectrace_geometry::human_bytes(needed),
+            spectrace_geometry::human_bytes(limit.bytes),
             limit.source
         )));
     }

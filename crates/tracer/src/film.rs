@@ -11,6 +11,7 @@
 use std::sync::{Mutex, PoisonError};
 
 use serde::{Deserialize, Serialize};
+use spectrace_geometry::human_bytes;
 use spectrace_spectrum::{Xyz, cmf};
 
 /// Fractional bits of the fixed-point sums.
@@ -115,18 +116,6 @@ pub enum FilmError {
         /// Where the limit comes from.
         limit_source: String,
     },
-}
-
-/// `bytes` in the largest binary unit that keeps a number >= 1, with one decimal (`1.5 GiB`).
-pub fn human_bytes(bytes: u64) -> String {
-    const UNITS: [&str; 5] = ["bytes", "KiB", "MiB", "GiB", "TiB"];
-    let mut value = bytes as f64;
-    let mut unit = 0;
-    while value >= 1024.0 && unit + 1 < UNITS.len() {
-        value /= 1024.0;
-        unit += 1;
-    }
-    if unit == 0 { format!("{bytes} bytes") } else { format!("{value:.1} {}", UNITS[unit]) }
 }
 
 /// Where contributions go: a [`Film`] directly, or a [`FilmWriter`] that buffers them for a
@@ -476,7 +465,5 @@ mod tests {
         let b = Film::bytes_for(8192, 4096);
         assert!((48 << 25..(48 << 25) + 1024).contains(&b), "{b}");
         assert_eq!(Film::bytes_for(u32::MAX, u32::MAX), u64::MAX);
-        assert_eq!(human_bytes(1536), "1.5 KiB");
-        assert_eq!(human_bytes(12), "12 bytes");
     }
 }

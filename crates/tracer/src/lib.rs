@@ -21,7 +21,7 @@ mod render;
 
 pub use camera::{CameraError, CameraRepr, FovAxis, PinholeCamera, Projection};
 pub use effects::{BUNDLE, Effects, EffectsMode, SceneFeatures};
-pub use film::{ExactSum, Film, FilmError, FilmWriter, MAX_PIXELS, Splat, human_bytes};
+pub use film::{ExactSum, Film, FilmError, FilmWriter, MAX_PIXELS, Splat};
 pub use light_tracer::{
     LightTracerScene, LightTracerSettings, MAX_DEPTH, TraceStats, chunk_rng, image_scale,
     trace_chunk, trace_chunk_until,

@@ -56,7 +56,7 @@ impl MemoryLimit {
                 bytes: available / 4 * 3,
                 source: format!(
                     "3/4 of the {} available according to /proc/meminfo",
-                    crate::human_bytes(available)
+                    spectrace_geometry::human_bytes(available)
                 ),
             },
             None => Self {
@@ -151,9 +151,9 @@ impl RenderPlan {
             needed,
             breakdown: format!(
                 "a film of {} at 48 bytes per pixel and {threads} thread buffer{} of {}",
-                crate::human_bytes(Film::bytes_for(width, height)),
+                spectrace_geometry::human_bytes(Film::bytes_for(width, height)),
                 if threads == 1 { "" } else { "s" },
-                crate::human_bytes(FilmWriter::BYTES)
+                spectrace_geometry::human_bytes(FilmWriter::BYTES)
             ),
             limit: limit.bytes,
             limit_source: limit.source.clone(),
@@ -347,7 +347,7 @@ mod tests {
                 && e.contains("camera.width")
                 && e.contains("1.5 GiB")
                 && e.contains("4 thread buffers")
-                && e.contains("1.0 GiB")
+                && e.contains("1 GiB")
                 && e.contains("a test limit"),
             "{e}"
         );
