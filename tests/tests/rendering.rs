@@ -362,23 +362,28 @@ fn every_shipped_scene_renders_without_rejected_contributions() {
     assert!(count >= 1, "no scenes found in {}", scenes_dir.display());
 }
 
-#[test]
-fn closed_white_box_loses_no_power() {
-    // Reflectance 1 everywhere and no way out: every beam must bounce until the depth limit, never
-    // escape through a seam, and never be ended by Russian roulette (its weight stays 1).
+/// The six walls of the closed box [-1, 1]^3 as scene objects, all of `material` (JSON).
+fn box_walls(material: &str) -> [String; 6] {
     let wall = |corner: [f64; 3], u: [f64; 3], v: [f64; 3]| {
         format!(
-            r#"{{"shape": {{"type": "Rectangle", "corner": {corner:?}, "edge_u": {u:?}, "edge_v": {v:?}}}, "material": {{"type": "Diffuse", "reflectance": 1.0}}}}"#
+            r#"{{"shape": {{"type": "Rectangle", "corner": {corner:?}, "edge_u": {u:?}, "edge_v": {v:?}}}, "material": {material}}}"#
         )
     };
-    let walls = [
+    [
         wall([-1.0, -1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 0.0, 2.0]),
         wall([-1.0, 1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 0.0, 2.0]),
         wall([-1.0, -1.0, -1.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]),
         wall([1.0, -1.0, -1.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]),
         wall([-1.0, -1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]),
         wall([-1.0, -1.0, 1.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]),
-    ];
+    ]
+}
+
+#[test]
+fn closed_white_box_loses_no_power() {
+    // Reflectance 1 everywhere and no way out: every beam must bounce until the depth limit, never
+    // escape through a seam, and never be ended by Russian roulette (its weight stays 1).
+    let walls = box_walls(r#"{"type": "Diffuse", "reflectance": 1.0}"#);
     let json = format!(
         r#"{{"camera": {{"position": [0, 0, 0.5], "look_at": [0, 0, -1], "fov": 90, "width": 8, "height": 8}},
             "objects": [{}],
@@ -609,19 +614,7 @@ fn the_same_seed_writes_the_same_files() {
 /// 8000`: every beam bounces 8000 times. The camera is inside (it sees the light directly) or
 /// outside (no light can reach it).
 fn mirror_box(camera_inside: bool) -> Scene {
-    let wall = |corner: [f64; 3], u: [f64; 3], v: [f64; 3]| {
-        format!(
-            r#"{{"shape": {{"type": "Rectangle", "corner": {corner:?}, "edge_u": {u:?}, "edge_v": {v:?}}}, "material": {{"type": "Mirror", "reflectance": 1.0}}}}"#
-        )
-    };
-    let walls = [
-        wall([-1.0, -1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 0.0, 2.0]),
-        wall([-1.0, 1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 0.0, 2.0]),
-        wall([-1.0, -1.0, -1.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]),
-        wall([1.0, -1.0, -1.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]),
-        wall([-1.0, -1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]),
-        wall([-1.0, -1.0, 1.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]),
-    ];
+    let walls = box_walls(r#"{"type": "Mirror", "reflectance": 1.0}"#);
     let z = if camera_inside { 0.5 } else { 3.0 };
     scene(&format!(
         r#"{{"camera": {{"position": [0, 0, {z}], "look_at": [0, 0, -1], "fov": 90, "width": 8, "height": 8}},

@@ -363,16 +363,22 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
         .map_err(|e| RenderError::Options(e.to_string()))?;
     bar.finish_and_clear();
     let wall = started.elapsed().as_secs_f64();
-    if let Some((k, n)) = plan.shard {
-        let path = options.out_dir.join(format!("{name}.part-{k}-of-{n}.bin"));
-        let shard_report = report(
+    let make_report = |output: &RenderOutput, written: Written| {
+        report(
             scene.path.display().to_string(),
             (scene.camera.width(), scene.camera.height()),
             plan,
             effects,
-            &output,
+            output,
             wall,
             scene.lights.power(),
+            written,
+        )
+    };
+    if let Some((k, n)) = plan.shard {
+        let path = options.out_dir.join(format!("{name}.part-{k}-of-{n}.bin"));
+        let shard_report = make_report(
+            &output,
             Written { files: vec![path.display().to_string()], ..Written::default() },
         );
         // The film moves into the part (no copy of what may be 1.5 GiB).
@@ -403,16 +409,7 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
             probed.beams, output.beams
         ));
     }
-    let report = report(
-        scene.path.display().to_string(),
-        (scene.camera.width(), scene.camera.height()),
-        plan,
-        effects,
-        &output,
-        wall,
-        scene.lights.power(),
-        written,
-    );
+    let report = make_report(&output, written);
     write_sidecar(&options.out_dir, &name, &report)?;
     Ok(report)
 }
