@@ -29,8 +29,8 @@ pub use files::{
     check_output_name, prepare_out_dir, read_bounded, same_file, write_atomically,
 };
 pub use output::{
-    EncodedImage, encode_image, linear_srgb, write_exr, write_exr_scaled, write_png,
-    write_png_scaled,
+    EncodedImage, OUTPUT_BYTES_PER_PIXEL, encode_image, linear_srgb, write_exr, write_exr_scaled,
+    write_png, write_png_scaled,
 };
 pub use part::{PARTIAL_VERSION, PartialFilm};
 pub use scene::{
@@ -253,7 +253,18 @@ pub fn probe(
     if u64::from(width) * u64::from(height) > spectrace_tracer::MAX_PIXELS {
         return Err(camera_error(FilmError::InvalidSize(width, height)));
     }
-    plan.check_memory(width, height, &MemoryLimit::system()).map_err(camera_error)?;
+    // The film stays allocated while the image is converted for writing: count that too.
+    let system = MemoryLimit::system();
+    let writing = OUTPUT_BYTES_PER_PIXEL * u64::from(width) * u64::from(height);
+    let limit = MemoryLimit {
+        bytes: system.bytes.saturating_sub(writing),
+        source: format!(
+            "{}, less {} to convert the image for writing",
+            system.source,
+            spectrace_geometry::human_bytes(writing)
+        ),
+    };
+    plan.check_memory(width, height, &limit).map_err(camera_error)?;
     let started = Instant::now();
     let limit = plan.time_budget.map_or(PROBE_SECONDS, |t| (t / 10.0).min(PROBE_SECONDS));
     let deadline = std::time::Duration::try_from_secs_f64(limit.max(0.0))

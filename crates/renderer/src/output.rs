@@ -128,6 +128,10 @@ pub struct EncodedImage {
     pub out_of_range_values: u64,
 }
 
+/// Bytes per pixel that writing an image needs beside the film: linear sRGB in f64 (made in place
+/// of the XYZ) and its f32 copy for the EXR.
+pub const OUTPUT_BYTES_PER_PIXEL: u64 = 24 + 12;
+
 /// Largest magnitude written unscaled: half of `f32::MAX`, so rounding to f32 cannot overflow.
 const F32_SAFE_MAX: f64 = 1.7e38;
 /// f32's smallest normal number.
@@ -156,8 +160,10 @@ fn exponent(x: f64) -> i64 {
 /// The image of a finished render (light power over beams times the film), as the EXR stores it;
 /// see the module docs for the scaling of images beyond the range of 32-bit floats.
 pub fn encode_image(output: &RenderOutput, light_power: f64) -> EncodedImage {
+    // `into_iter().map().collect()` reuses the XYZ allocation for the RGB (same layout): the
+    // conversion needs 24 bytes per pixel, plus 12 for the f32 copy.
     let exact = output.film.to_xyz(image_scale(light_power, output.beams));
-    let rgb: Vec<[f64; 3]> = exact.iter().map(|p| p.to_linear_srgb()).collect();
+    let rgb: Vec<[f64; 3]> = exact.into_iter().map(|p| p.to_linear_srgb()).collect();
     let largest =
         rgb.iter().flatten().try_fold(0.0f64, |m, &c| c.is_finite().then(|| m.max(c.abs())));
     // An image fits if nothing overflows and it is not so dim that 32-bit floats lose its

@@ -128,6 +128,14 @@ pub enum SceneError {
         /// Why.
         source: std::io::Error,
     },
+    /// The file cannot be read within its limits (missing, not a regular file, too large).
+    #[error("{path}: {message}")]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        message: String,
+    },
     /// The file is not valid JSON.
     #[error("{path}:{line}:{column}: syntax error: {message}")]
     Syntax {
@@ -217,9 +225,8 @@ impl Scene {
     /// # Errors
     /// As [`Scene::load`]; with `restrict_paths`, also a mesh outside the scene's folder.
     pub fn load_with(path: &Path, options: LoadOptions) -> Result<Self, SceneError> {
-        let bytes = read_bounded(path, MAX_SCENE_BYTES, "scene").map_err(|message| {
-            SceneError::Scene { path: path.to_owned(), field: "(file)".to_owned(), message }
-        })?;
+        let bytes = read_bounded(path, MAX_SCENE_BYTES, "scene")
+            .map_err(|message| SceneError::Read { path: path.to_owned(), message })?;
         let text = String::from_utf8(bytes).map_err(|e| {
             let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
             let line = valid.iter().filter(|&&b| b == b'\n').count() + 1;
