@@ -9,6 +9,7 @@
 //! xtask's `render` subcommand calls it. Nothing but `xtask` and the tests depend on this crate.
 
 pub mod accuracy;
+pub mod cli;
 mod files;
 mod output;
 mod part;

@@ -1,0 +1,303 @@
+//! The `spectrace` command line as a library: the `spectrace` binary is one call to [`main`], and a
+//! binary that links a plugin crate (a third-party light or SPD registered with typetag) is the same
+//! few lines, so the plugin's types are accepted in scene files:
+//!
+//! ```no_run
+//! // src/bin/spectrace-ring.rs of a crate depending on the plugin and on spectrace-renderer:
+//! // use spectrace_plugin_ring_light as _; // keep the plugin's typetag registrations linked
+//! fn main() -> std::process::ExitCode {
+//!     spectrace_renderer::cli::main()
+//! }
+//! ```
+//!
+//! ```sh
+//! spectrace render scenes/prism.json --beams 2000000 --out out/ --threads 2 --seed 7
+//! spectrace render scenes/prism.json --shard 0/4 --out parts/      # one of four machines
+//! spectrace merge parts/*.bin --out out/                           # the same image, bit for bit
+//! ```
+
+use std::ffi::OsString;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use spectrace_tracer::EffectsMode;
+
+use crate::{RenderOptions, merge_parts, render_file};
+
+/// Spectrace: a spectral Monte Carlo renderer built around light sources as beam generators.
+#[derive(Debug, Parser)]
+#[command(version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Render a scene file to EXR (linear), PNG (sRGB) and a JSON sidecar.
+    Render {
+        /// The scene file (JSON; see scenes/README.md).
+        scene: PathBuf,
+        /// Beams for the whole image (overrides settings.beams).
+        #[arg(long, conflicts_with = "time", allow_negative_numbers = true, value_parser = parse_count)]
+        beams: Option<u64>,
+        /// Render for this many seconds instead of a fixed number of beams.
+        #[arg(long, allow_negative_numbers = true, value_parser = parse_seconds)]
+        time: Option<f64>,
+        /// Output directory.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        /// Worker threads (0: one per core; overrides settings.threads).
+        #[arg(long, allow_negative_numbers = true, value_parser = parse_threads)]
+        threads: Option<usize>,
+        /// Seed of every random stream (overrides settings.seed).
+        #[arg(long, allow_negative_numbers = true, value_parser = parse_seed)]
+        seed: Option<u64>,
+        /// Render only the work chunks whose index is K mod N and write a partial film (K/N).
+        #[arg(long, value_parser = parse_shard)]
+        shard: Option<(u64, u64)>,
+        /// Effects analysis: auto, off or direct_only (overrides effects.mode).
+        #[arg(long, value_parser = parse_effects)]
+        effects: Option<EffectsMode>,
+        /// No progress bar or effects line.
+        #[arg(long)]
+        quiet: bool,
+        /// Refuse any file the scene names (OBJ meshes) outside the scene file's folder, symlinks
+        /// resolved: for scenes from others (see docs/robustness.md).
+        #[arg(long)]
+        restrict_paths: bool,
+    },
+    /// Measure beams/s of scenes, and what the effects analysis saves (auto against off).
+    Bench {
+        /// Scene files.
+        #[arg(required = true)]
+        scenes: Vec<PathBuf>,
+        /// Beams per render.
+        #[arg(long, default_value_t = 1_000_000, allow_negative_numbers = true, value_parser = parse_count)]
+        beams: u64,
+        /// Worker threads (0: one per core).
+        #[arg(long, default_value_t = 0, allow_negative_numbers = true, value_parser = parse_threads)]
+        threads: usize,
+    },
+    /// Error against time for every accuracy knob: writes docs/accuracy.md and docs/accuracy.svg.
+    Accuracy {
+        /// Scene files (default: scenes/fading_spot.json, scenes/cornell.json, scenes/prism.json).
+        scenes: Vec<PathBuf>,
+        /// Beams of the cached reference image.
+        #[arg(long)]
+        reference_beams: Option<u64>,
+        /// Beams of the first sweep point (doubled at each step).
+        #[arg(long)]
+        start_beams: Option<u64>,
+        /// Number of sweep points.
+        #[arg(long)]
+        steps: Option<u32>,
+        /// Largest image width (scenes are scaled down to it; 0 keeps their size).
+        #[arg(long)]
+        max_width: Option<u32>,
+        /// Where accuracy.md and accuracy.svg go.
+        #[arg(long, default_value = "docs")]
+        out: PathBuf,
+    },
+    /// Merge partial films (from `render --shard`) into the final outputs.
+    Merge {
+        /// The partial films (.bin).
+        #[arg(required = true)]
+        parts: Vec<PathBuf>,
+        /// Output directory.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+    },
+}
+
+/// A whole number of at least 1 (beams).
+fn parse_count(s: &str) -> Result<u64, String> {
+    match s.trim().parse::<u64>() {
+        Ok(0) => Err(format!("`{s}`: must be at least 1")),
+        Ok(n) => Ok(n),
+        Err(_) if s.trim().parse::<f64>().is_ok() => Err(format!(
+            "`{s}`: must be a whole number from 1 to {} (no sign, no decimals)",
+            u64::MAX
+        )),
+        Err(_) => Err(format!("`{s}`: not a whole number")),
+    }
+}
+
+/// A positive, finite number of seconds.
+fn parse_seconds(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(t) if t > 0.0 && t.is_finite() => Ok(t),
+        Ok(_) => Err(format!("`{s}`: must be a positive, finite number of seconds")),
+        Err(_) => Err(format!("`{s}`: not a number of seconds")),
+    }
+}
+
+/// A thread count (0: one per core).
+fn parse_threads(s: &str) -> Result<usize, String> {
+    s.trim().parse::<usize>().map_err(|_| {
+        format!("`{s}`: must be a whole number of threads, from 0 (one per core) to 256")
+    })
+}
+
+/// A 64-bit seed.
+fn parse_seed(s: &str) -> Result<u64, String> {
+    s.trim()
+        .parse::<u64>()
+        .map_err(|_| format!("`{s}`: must be a whole number from 0 to {}", u64::MAX))
+}
+
+fn parse_shard(s: &str) -> Result<(u64, u64), String> {
+    let (k, n) = s.split_once('/').ok_or_else(|| format!("`{s}`: expected K/N, e.g. 0/4"))?;
+    let k: u64 = k.trim().parse().map_err(|_| format!("`{s}`: K is not a number"))?;
+    let n: u64 = n.trim().parse().map_err(|_| format!("`{s}`: N is not a number"))?;
+    if n == 0 || k >= n {
+        return Err(format!("`{s}`: need 0 <= K < N"));
+    }
+    Ok((k, n))
+}
+
+fn parse_effects(s: &str) -> Result<EffectsMode, String> {
+    match s {
+        "auto" => Ok(EffectsMode::Auto),
+        "off" => Ok(EffectsMode::Off),
+        "direct_only" | "direct-only" => Ok(EffectsMode::DirectOnly),
+        _ => Err(format!("`{s}`: expected auto, off or direct_only")),
+    }
+}
+
+/// `spectrace bench`: a Markdown table of beams/s per scene with and without the effects
+/// analysis.
+fn bench(scenes: &[PathBuf], beams: u64, threads: usize) -> ExitCode {
+    println!(
+        "| scene | effects decision | beams/s (auto) | beams/s (off) | spectral samples on film per s, auto / off |"
+    );
+    println!("|---|---|---|---|---|");
+    for path in scenes {
+        let row = crate::Scene::load(path)
+            .map_err(crate::RenderError::from)
+            .and_then(|scene| crate::effects_benchmark(&scene, beams, threads));
+        match row {
+            Ok(r) => println!(
+                "| {} | {} | {:.3e} | {:.3e} | {:.2}x |",
+                r.scene,
+                r.effects,
+                r.beams as f64 / r.auto_seconds,
+                r.beams as f64 / r.off_seconds,
+                r.auto_spectral_samples_per_second / r.off_spectral_samples_per_second.max(1e-300)
+            ),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::from(2);
+            }
+        }
+    }
+    ExitCode::SUCCESS
+}
+
+/// Runs the `spectrace` command line on the process's arguments ([`std::env::args_os`]).
+pub fn main() -> ExitCode {
+    main_with_args(std::env::args_os())
+}
+
+/// Runs the `spectrace` command line on `args` (the first is the program name, as in
+/// [`std::env::args_os`]): parses them, runs the subcommand, prints its report or error, and returns
+/// the exit code (0 on success, 2 on a bad argument or a failed render).
+///
+/// `--help` and `--version` print to stdout and return 0; a bad argument prints clap's message,
+/// which names the option and the cause, to stderr and returns 2.
+pub fn main_with_args<I, T>(args: I) -> ExitCode
+where
+    I: IntoIterator<Item = T>,
+    T: Into<OsString> + Clone,
+{
+    let cli = match Cli::try_parse_from(args) {
+        Ok(cli) => cli,
+        Err(e) => return clap_exit(&e),
+    };
+    let result = match cli.command {
+        Command::Render {
+            scene,
+            beams,
+            time,
+            out,
+            threads,
+            seed,
+            shard,
+            effects,
+            quiet,
+            restrict_paths,
+        } => {
+            let options = RenderOptions {
+                beams,
+                time,
+                threads,
+                seed,
+                shard,
+                effects,
+                out_dir: out,
+                verbose: !quiet,
+                restrict_paths,
+            };
+            render_file(&scene, &options)
+        }
+        Command::Merge { parts, out } => merge_parts(&parts, &out),
+        Command::Bench { scenes, beams, threads } => return bench(&scenes, beams, threads),
+        Command::Accuracy { scenes, reference_beams, start_beams, steps, max_width, out } => {
+            let mut options = crate::accuracy::AccuracyOptions::default();
+            if !scenes.is_empty() {
+                options.scenes = scenes;
+            }
+            if let Some(b) = reference_beams {
+                options.reference_beams = b;
+            }
+            if let Some(b) = start_beams {
+                options.start_beams = b;
+            }
+            if let Some(n) = steps {
+                options.steps = n;
+            }
+            if let Some(w) = max_width {
+                options.max_width = (w > 0).then_some(w);
+            }
+            options.out_dir = out;
+            return match crate::accuracy::run(&options) {
+                Ok(report) => {
+                    println!("wrote {}", report.files.join(", "));
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::from(2)
+                }
+            };
+        }
+    };
+    match result {
+        Ok(report) => {
+            for w in &report.warnings {
+                eprintln!("warning: {w}");
+            }
+            println!(
+                "{} beams in {:.2} s ({:.3e} beams/s), {} rejected contributions; wrote {}",
+                report.beams,
+                report.wall_seconds,
+                report.beams_per_second,
+                report.rejected_contributions,
+                report.outputs.join(", ")
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// Prints a clap error (or help or version) as `Cli::parse` would and returns its exit code.
+fn clap_exit(e: &clap::Error) -> ExitCode {
+    // Printing fails only if the stream is closed; there is nobody left to tell.
+    let _ = e.print();
+    ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2))
+}
