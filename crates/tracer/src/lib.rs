@@ -16,12 +16,14 @@
 mod camera;
 mod effects;
 mod film;
+mod integrator;
 mod light_tracer;
 mod render;
 
 pub use camera::{CameraError, CameraRepr, FovAxis, PinholeCamera, Projection};
 pub use effects::{BUNDLE, Effects, EffectsMode, SceneFeatures};
 pub use film::{ExactSum, Film, FilmError, FilmWriter, MAX_PIXELS, Splat};
+pub use integrator::{Integrator, LightTracer};
 pub use light_tracer::{
     LightTracerScene, LightTracerSettings, MAX_DEPTH, TraceStats, chunk_rng, image_scale,
     trace_chunk, trace_chunk_until,
