@@ -72,7 +72,8 @@ fn exercise_scene(text: &str) -> Reached {
     let Ok(plan) = plan_for(&scene, &options) else { return Reached::Loaded };
     let effects = spectrace_renderer::decide_effects(&scene, None);
     let tracer = spectrace_renderer::tracer_scene(&scene);
-    if let Ok(output) = render(&tracer, &scene.tracer_settings(), &effects, &plan, &|_| {}) {
+    let tracer = spectrace_tracer::LightTracer::new(&tracer, scene.tracer_settings(), effects);
+    if let Ok(output) = render(&tracer, &plan, &|_| {}) {
         let image = encode_image(&output, scene.lights.power());
         assert!(
             image.rgb.iter().flatten().all(|c| c.is_finite()),

@@ -13,7 +13,7 @@ use spectrace_renderer::{
     tracer_scene,
 };
 use spectrace_spectrum::{CIE_Y_INTEGRAL, SpectralPowerDistribution, Uniform, xyz_of};
-use spectrace_tracer::{RenderOutput, render};
+use spectrace_tracer::{Integrator, LightTracer, RenderOutput, render};
 
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("spectrace-test-{}-{name}", std::process::id()));
@@ -41,8 +41,9 @@ fn render_inline(
     };
     let plan = plan_for(scene, &options).unwrap();
     let effects = decide_effects(scene, None);
-    let output =
-        render(&tracer_scene(scene), &scene.tracer_settings(), &effects, &plan, &|_| {}).unwrap();
+    let tracer_scene = tracer_scene(scene);
+    let tracer = LightTracer::new(&tracer_scene, scene.tracer_settings(), effects);
+    let output = render(&tracer, &plan, &|_| {}).unwrap();
     let image = spectrace_renderer::image(&output, scene.lights.power());
     (output, image)
 }
@@ -236,6 +237,35 @@ fn same_seed_same_image_with_one_two_or_four_threads() {
 }
 
 #[test]
+fn the_light_tracer_integrator_is_trace_chunk_normalised_by_power_over_beams() {
+    let s = scene(POINT_OVER_PLANE);
+    let effects = decide_effects(&s, None);
+    let tracer_scene = tracer_scene(&s);
+    let tracer = LightTracer::new(&tracer_scene, s.tracer_settings(), effects);
+    assert_eq!(tracer.name(), "light");
+    assert_eq!(tracer.resolution(), (s.camera.width(), s.camera.height()));
+    let (w, h) = tracer.resolution();
+    let mut direct = spectrace_tracer::Film::new(w, h).unwrap();
+    let mut through = spectrace_tracer::Film::new(w, h).unwrap();
+    let a = spectrace_tracer::trace_chunk(
+        &tracer_scene,
+        &s.tracer_settings(),
+        &effects,
+        5,
+        2,
+        3000,
+        &mut direct,
+    );
+    let b = tracer.render_chunk(5, 2, 3000, None, &mut through);
+    assert!(direct.accepted() > 100, "{}", direct.accepted());
+    assert_eq!((a, &direct), (b, &through));
+    assert_eq!(tracer.image_scale(3000), s.lights.power() / 3000.0);
+    assert_eq!(tracer.image_scale(0), 0.0);
+    let (output, image) = render_inline(&s, 20_000, 5, 2);
+    assert_eq!(image, output.film.to_xyz(tracer.image_scale(output.beams)));
+}
+
+#[test]
 fn sharded_renders_merge_bit_for_bit() {
     let dir = temp_dir("shards");
     let path = dir.join("plane.json");
@@ -266,6 +296,7 @@ fn sharded_renders_merge_bit_for_bit() {
     }
     let merged = merge_parts(&parts, &dir.join("merged")).unwrap();
     assert_eq!(merged.beams, 40_000);
+    assert_eq!((whole.integrator.as_str(), merged.integrator.as_str()), ("light", "light"));
     for ext in ["exr", "png"] {
         let a = std::fs::read(dir.join("whole").join(format!("plane.{ext}"))).unwrap();
         let b = std::fs::read(dir.join("merged").join(format!("plane.{ext}"))).unwrap();
@@ -657,9 +688,9 @@ fn a_closed_mirror_box_keeps_the_beam_count_and_the_time_budget() {
     assert_eq!(report.stats.beams, report.beams);
     assert_eq!(report.stats.depth_limited, report.beams);
     let plan = plan_for(&inside, &timed).unwrap();
-    let output =
-        render(&tracer_scene(&inside), &inside.tracer_settings(), &effects, &plan, &|_| {})
-            .unwrap();
+    let inside_scene = tracer_scene(&inside);
+    let tracer = LightTracer::new(&inside_scene, inside.tracer_settings(), effects);
+    let output = render(&tracer, &plan, &|_| {}).unwrap();
     assert!(output.seconds < budget + 5.0, "{} s", output.seconds);
     assert!(output.beams > 0 && output.beams < 16_384, "{}", output.beams);
     assert_eq!(output.stats.beams, output.beams);

@@ -35,7 +35,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 use spectrace_lights::LightSource;
 use spectrace_spectrum::{CieIlluminant, SpectralPowerDistribution, Xyz};
-use spectrace_tracer::{EffectsMode, render};
+use spectrace_tracer::{EffectsMode, LightTracer, render};
 
 use crate::{RenderOptions, Scene, decide_effects, image, plan_for, tracer_scene};
 
@@ -469,11 +469,11 @@ fn render_xyz(
     // depends on the beams alone, so a cached reference stays valid whatever the thread count.
     plan.chunk_beams = (beams / 16).clamp(1, plan.chunk_beams.max(1024)).min(plan.chunk_beams);
     let effects = decide_effects(scene, Some(mode));
-    let tracer = tracer_scene(scene);
-    let settings = scene.tracer_settings();
+    let tracer_scene = tracer_scene(scene);
+    let tracer = LightTracer::new(&tracer_scene, scene.tracer_settings(), effects);
     scene.lights.reset_count();
     let started = Instant::now();
-    let output = render(&tracer, &settings, &effects, &plan, &|_| {}).map_err(|e| e.to_string())?;
+    let output = render(&tracer, &plan, &|_| {}).map_err(|e| e.to_string())?;
     let seconds = started.elapsed().as_secs_f64();
     scene.lights.reset_count();
     Ok((image(&output, scene.lights.power()), seconds))

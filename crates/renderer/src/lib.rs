@@ -21,8 +21,8 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 use spectrace_lights::LightSource;
 use spectrace_tracer::{
-    Effects, EffectsMode, Film, FilmError, LightTracerScene, MemoryLimit, RenderOutput, RenderPlan,
-    TraceStats, image_scale, render, trace_chunk,
+    Effects, EffectsMode, Film, FilmError, Integrator, LightTracer, LightTracerScene, MemoryLimit,
+    RenderOutput, RenderPlan, TraceStats, image_scale, render,
 };
 
 pub use files::{
@@ -96,6 +96,9 @@ pub struct RenderReport {
     pub effects: Effects,
     /// The decision in words.
     pub effects_summary: String,
+    /// The estimator that rendered the image ([`Integrator::name`]): `"light"`, the light tracer.
+    #[serde(default = "light_integrator")]
+    pub integrator: String,
     /// Beams traced.
     pub beams: u64,
     /// Wall time (s).
@@ -121,6 +124,11 @@ pub struct RenderReport {
     pub outputs: Vec<String>,
     /// Spectrace version.
     pub version: String,
+}
+
+/// The integrator of sidecars written before the field existed: the light tracer.
+fn light_integrator() -> String {
+    LightTracer::NAME.to_owned()
 }
 
 /// Most worker threads a render accepts.
@@ -272,14 +280,14 @@ pub fn probe(
         .ok()
         .and_then(|d| started.checked_add(d));
     let max_beams = PROBE_BEAMS.min(plan.beams).max(1);
-    let tracer = tracer_scene(scene);
-    let settings = scene.tracer_settings();
+    let tracer_scene = tracer_scene(scene);
+    let tracer = LightTracer::new(&tracer_scene, scene.tracer_settings(), *effects);
     let mut sink = VisibleLight { width, height, lit: false };
     let mut stats = TraceStats::default();
     let mut timed_out = false;
     for beam in 0..max_beams {
         // One beam per chunk, so that the probe can stop after any beam.
-        stats.merge(&trace_chunk(&tracer, &settings, effects, u64::MAX, beam, 1, &mut sink));
+        stats.merge(&tracer.render_chunk(u64::MAX, beam, 1, None, &mut sink));
         if sink.lit {
             break;
         }
@@ -371,8 +379,10 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
     let bar = progress_bar(&plan, options.verbose);
     let started = Instant::now();
     let update = |done: u64| bar.set_position(done.min(bar.length().unwrap_or(u64::MAX)));
-    let output = render(&tracer_scene(scene), &scene.tracer_settings(), &effects, &plan, &update)
-        .map_err(|e| RenderError::Options(e.to_string()))?;
+    let tracer_scene = tracer_scene(scene);
+    let tracer = LightTracer::new(&tracer_scene, scene.tracer_settings(), effects);
+    let output =
+        render(&tracer, &plan, &update).map_err(|e| RenderError::Options(e.to_string()))?;
     bar.finish_and_clear();
     let wall = started.elapsed().as_secs_f64();
     let make_report = |output: &RenderOutput, written: Written| {
@@ -381,6 +391,7 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
             (scene.camera.width(), scene.camera.height()),
             plan,
             effects,
+            tracer.name(),
             output,
             wall,
             scene.lights.power(),
@@ -445,6 +456,7 @@ fn report(
     (width, height): (u32, u32),
     plan: RenderPlan,
     effects: Effects,
+    integrator: &str,
     output: &RenderOutput,
     wall: f64,
     light_power: f64,
@@ -461,6 +473,7 @@ fn report(
         plan,
         effects,
         effects_summary: effects.summary(),
+        integrator: integrator.to_owned(),
         beams: output.beams,
         wall_seconds: wall,
         beams_per_second: if wall > 0.0 { output.beams as f64 / wall } else { 0.0 },
@@ -673,6 +686,8 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
         (w, h),
         first.plan,
         first.effects,
+        // Parts are written by the light tracer alone, so far.
+        LightTracer::NAME,
         &merged,
         seconds.iter().copied().fold(0.0, f64::max),
         first.light_power,
@@ -739,8 +754,10 @@ pub fn effects_benchmark(
     let measure = |mode: EffectsMode| -> Result<(f64, f64, Effects), RenderError> {
         let effects = decide_effects(scene, Some(mode));
         let started = Instant::now();
-        let out = render(&tracer_scene(scene), &scene.tracer_settings(), &effects, &plan, &|_| {})
-            .map_err(|e| RenderError::Options(e.to_string()))?;
+        let tracer_scene = tracer_scene(scene);
+        let tracer = LightTracer::new(&tracer_scene, scene.tracer_settings(), effects);
+        let out =
+            render(&tracer, &plan, &|_| {}).map_err(|e| RenderError::Options(e.to_string()))?;
         let seconds = started.elapsed().as_secs_f64();
         scene.lights.reset_count();
         // Every splat carries `wavelengths_per_path` spectral samples.

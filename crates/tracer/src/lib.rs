@@ -4,7 +4,8 @@
 //! the renderer. Beams come from a [`spectrace_lights::LightSet`], travel through a
 //! [`spectrace_geometry::World`], scatter by each shape's [`spectrace_materials::Material`], and
 //! every non-specular hit (and every emission point) is connected to the [`PinholeCamera`] and
-//! splatted into the [`Film`] (see [`light_tracer`](trace_chunk) for the estimator).
+//! splatted into the [`Film`] (see [`light_tracer`](trace_chunk) for the estimator). The render
+//! loop ([`render`]) drives any [`Integrator`]; [`LightTracer`] is the light tracer behind it.
 //!
 //! The key design decisions: the film adds contributions in exact fixed point ([`ExactSum`]), so
 //! an image is bit-identical whatever the thread count, chunk order or number of machines
@@ -16,12 +17,14 @@
 mod camera;
 mod effects;
 mod film;
+mod integrator;
 mod light_tracer;
 mod render;
 
 pub use camera::{CameraError, CameraRepr, FovAxis, PinholeCamera, Projection};
 pub use effects::{BUNDLE, Effects, EffectsMode, SceneFeatures};
 pub use film::{ExactSum, Film, FilmError, FilmWriter, MAX_PIXELS, Splat};
+pub use integrator::{Integrator, LightTracer};
 pub use light_tracer::{
     LightTracerScene, LightTracerSettings, MAX_DEPTH, TraceStats, chunk_rng, image_scale,
     trace_chunk, trace_chunk_until,

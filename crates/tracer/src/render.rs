@@ -1,4 +1,4 @@
-//! Running the light tracer over work chunks on several threads (and, with shards, machines).
+//! Running an [`Integrator`] over work chunks on several threads (and, with shards, machines).
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Mutex, PoisonError};
@@ -6,8 +6,7 @@ use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
 
-use crate::light_tracer::{LightTracerScene, LightTracerSettings, TraceStats, trace_chunk_until};
-use crate::{Effects, Film, FilmError, FilmWriter};
+use crate::{Film, FilmError, FilmWriter, Integrator, TraceStats};
 
 /// Beams per work chunk by default: small enough to balance threads, large enough that the
 /// per-chunk cost (a generator, a film merge) is negligible.
@@ -164,14 +163,16 @@ impl RenderPlan {
 /// The result of a render (or of one shard).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RenderOutput {
-    /// The film: exact sums, not yet scaled by the light's power over the beams.
+    /// The film: exact sums, not yet scaled by [`Integrator::image_scale`] (for the light
+    /// tracer, the light's power over the beams).
     pub film: Film,
     /// Counters.
     pub stats: TraceStats,
     /// The chunks that were rendered, sorted. With a time budget, the chunks being traced when
     /// it ran out are listed too, though they were cut short.
     pub chunks: Vec<u64>,
-    /// Beams traced (exactly: the image is normalised by it); equals `stats.beams`.
+    /// Work items done (beams, for the light tracer; exactly: the image is normalised by it);
+    /// equals `stats.beams`.
     pub beams: u64,
     /// Wall time (s).
     pub seconds: f64,
@@ -193,29 +194,33 @@ impl RenderOutput {
     }
 }
 
-/// Renders the plan's chunks on `plan.threads` threads into one shared film; `progress(beams)`
-/// is called after every chunk (from worker threads) with the beams traced so far.
+/// Renders the plan's chunks with `integrator` on `plan.threads` threads into one shared film;
+/// `progress(items)` is called after every chunk (from worker threads) with the work items
+/// (beams, for the light tracer) done so far.
+///
+/// The loop does not know which estimator runs: it claims chunks, hands each to
+/// [`Integrator::render_chunk`] with the thread's [`FilmWriter`], and counts the items done. The
+/// output's film holds the exact, unscaled sums; [`Integrator::image_scale`] of
+/// [`RenderOutput::beams`] normalises them.
 ///
 /// Memory: one film for the whole render plus a small [`FilmWriter`] buffer per thread
 /// ([`RenderPlan::memory_bytes`]), checked against [`MemoryLimit::system`] before anything is
 /// allocated. The film is exact, so the image is bit-identical for any thread count.
 ///
 /// With a time budget, threads stop claiming chunks once it has passed (the first chunk is
-/// always claimed) and the chunks in progress stop between beams within a few microseconds of
-/// work; the output counts exactly the beams traced.
+/// always claimed) and the chunks in progress stop between items within a few microseconds of
+/// work; the output counts exactly the items done.
 ///
 /// # Errors
 /// [`FilmError::InvalidSize`] for a camera whose resolution is not a valid film;
 /// [`FilmError::TooLarge`] when the render would need more memory than it may use.
 pub fn render(
-    scene: &LightTracerScene<'_>,
-    settings: &LightTracerSettings,
-    effects: &Effects,
+    integrator: &dyn Integrator,
     plan: &RenderPlan,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<RenderOutput, FilmError> {
     let started = Instant::now();
-    let (w, h) = (scene.camera.width(), scene.camera.height());
+    let (w, h) = integrator.resolution();
     plan.check_memory(w, h, &MemoryLimit::system())?;
     let film = Mutex::new(Film::new(w, h)?);
     let next = AtomicU64::new(0);
@@ -242,16 +247,7 @@ pub fn render(
                     let i = next.fetch_add(1, Ordering::Relaxed);
                     let Some(c) = plan.shard_chunk(i) else { break };
                     let n = plan.beams_in_chunk(c);
-                    let s = trace_chunk_until(
-                        scene,
-                        settings,
-                        effects,
-                        plan.seed,
-                        c,
-                        n,
-                        deadline,
-                        &mut writer,
-                    );
+                    let s = integrator.render_chunk(plan.seed, c, n, deadline, &mut writer);
                     writer.flush();
                     stats.merge(&s);
                     mine.push(c);
