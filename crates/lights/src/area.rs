@@ -31,19 +31,24 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 use spectrace_spectrum::SpectralPowerDistribution;
 
-use crate::geometry::{Frame, concentric_disk, finite_point, positive, unit_direction};
+use spectrace_sampling::{
+    Frame, sample_cosine_hemisphere_concentric, sample_uniform_disk_concentric,
+};
+
+use crate::geometry::{finite_point, positive, unit_direction};
 use crate::sky::rectangle_normal;
 use crate::source::uniform;
 use crate::{Beam, LightError, LightFlags, LightSample, LightSource, SpdLight, WavelengthSampling};
 
-/// A cosine-weighted direction around `frame.n`, flipped to the back face with probability 1/2
+/// A cosine-weighted direction around `frame.n()`, flipped to the back face with probability 1/2
 /// when two-sided (the choice uses the top half of `u_side`).
 fn lambertian_direction(frame: &Frame, two_sided: bool, u1: f64, u2: f64, u_side: f64) -> DVec3 {
     // Malley's method: a uniform point on the disk lifted to the hemisphere.
-    let (x, y) = concentric_disk(u1, u2);
-    let z = (1.0 - x * x - y * y).max(0.0).sqrt();
-    let z = if two_sided && u_side >= 0.5 { -z } else { z };
-    frame.local_to_world(x, y, z).normalize()
+    let mut local = sample_cosine_hemisphere_concentric([u1, u2]);
+    if two_sided && u_side >= 0.5 {
+        local.z = -local.z;
+    }
+    frame.to_world(local).normalize()
 }
 
 /// Solid-angle density of a Lambertian emitter's directions: `cos / pi` on the emitting side,
@@ -158,7 +163,15 @@ impl RectangleLight {
             ));
         }
         let emission = SpdLight::new(L, spd, power, wavelength_sampling)?;
-        Ok(Self { emission, corner, edge_u, edge_v, two_sided, frame: Frame::new(normal), area })
+        Ok(Self {
+            emission,
+            corner,
+            edge_u,
+            edge_v,
+            two_sided,
+            frame: Frame::from_normal(normal),
+            area,
+        })
     }
 
     /// Emitted radiance (W m^-2 sr^-1, whole spectrum): `power / (pi * area)`, halved if two-sided.
@@ -168,7 +181,7 @@ impl RectangleLight {
 
     /// The unit normal of the emitting side.
     pub fn normal(&self) -> DVec3 {
-        self.frame.n
+        self.frame.n()
     }
 }
 
@@ -187,11 +200,11 @@ impl LightSource for RectangleLight {
         Some(LightFlags::default())
     }
     fn emission_density(&self, _origin: DVec3, direction: DVec3) -> f64 {
-        lambertian_density(self.frame.n, self.two_sided, direction)
+        lambertian_density(self.frame.n(), self.two_sided, direction)
     }
     fn sample_towards(&self, receiver: DVec3, u: [f64; 2]) -> Option<LightSample> {
         let position = self.corner + self.edge_u * u[0] + self.edge_v * u[1];
-        area_sample(position, self.frame.n, self.area, self.radiance(), self.two_sided, receiver)
+        area_sample(position, self.frame.n(), self.area, self.radiance(), self.two_sided, receiver)
     }
 }
 
@@ -279,7 +292,7 @@ impl DiskLight {
             ));
         }
         let emission = SpdLight::new(L, spd, power, wavelength_sampling)?;
-        Ok(Self { emission, center, normal, radius, two_sided, frame: Frame::new(normal) })
+        Ok(Self { emission, center, normal, radius, two_sided, frame: Frame::from_normal(normal) })
     }
 
     /// The disk's area (m^2).
@@ -293,8 +306,8 @@ impl DiskLight {
     }
 
     fn point(&self, u1: f64, u2: f64) -> DVec3 {
-        let (x, y) = concentric_disk(u1, u2);
-        self.center + self.frame.local_to_world(x, y, 0.0) * self.radius
+        let [x, y] = sample_uniform_disk_concentric([u1, u2]);
+        self.center + self.frame.to_world(DVec3::new(x, y, 0.0)) * self.radius
     }
 }
 

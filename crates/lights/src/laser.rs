@@ -21,7 +21,9 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 use spectrace_spectrum::SpectralPowerDistribution;
 
-use crate::geometry::{Frame, concentric_disk, finite_point, non_negative, unit_direction};
+use spectrace_sampling::{Frame, sample_uniform_disk_concentric};
+
+use crate::geometry::{finite_point, non_negative, unit_direction};
 use crate::source::uniform;
 use crate::{Beam, LightError, LightFlags, LightSource, SpdLight, WavelengthSampling};
 
@@ -88,7 +90,13 @@ impl Laser {
         let direction = unit_direction(L, "direction", direction)?;
         let beam_radius = non_negative(L, "beam_radius", beam_radius)?;
         let emission = SpdLight::new(L, spd, power, wavelength_sampling)?;
-        Ok(Self { emission, position, direction, beam_radius, frame: Frame::new(direction) })
+        Ok(Self {
+            emission,
+            position,
+            direction,
+            beam_radius,
+            frame: Frame::from_normal(direction),
+        })
     }
 
     /// The beams' direction (unit).
@@ -102,8 +110,8 @@ impl LightSource for Laser {
     fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
         let (lambda, scale) = self.emission.wavelength(uniform(rng));
         let origin = if self.beam_radius > 0.0 {
-            let (x, y) = concentric_disk(uniform(rng), uniform(rng));
-            self.position + self.frame.local_to_world(x, y, 0.0) * self.beam_radius
+            let [x, y] = sample_uniform_disk_concentric([uniform(rng), uniform(rng)]);
+            self.position + self.frame.to_world(DVec3::new(x, y, 0.0)) * self.beam_radius
         } else {
             self.position
         };

@@ -233,7 +233,7 @@ impl SpdLight {
 /// Draws a uniform in `[0, 1)` from a generator (53 random bits).
 #[inline]
 pub(crate) fn uniform(rng: &mut dyn Rng) -> f64 {
-    (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    spectrace_sampling::uniform(rng)
 }
 
 /// Implements the counting, power and spectrum methods of [`LightSource`] by delegating to an

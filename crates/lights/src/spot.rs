@@ -38,10 +38,13 @@ use std::sync::Arc;
 use glam::DVec3;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
-use spectrace_sampling::PiecewiseLinear;
+use spectrace_sampling::{
+    Frame, PiecewiseLinear, one_minus_cos, sample_uniform_cone, sample_uniform_sphere,
+    spherical_direction,
+};
 use spectrace_spectrum::SpectralPowerDistribution;
 
-use crate::geometry::{Frame, direction_from_cos, finite_point, positive, unit_direction};
+use crate::geometry::{finite_point, positive, unit_direction};
 use crate::source::uniform;
 use crate::{Beam, LightError, LightFlags, LightSample, LightSource, SpdLight, WavelengthSampling};
 
@@ -144,15 +147,14 @@ impl UniformSpotLight {
         let direction = unit_direction(L, "direction", direction)?;
         let cone_angle = cone(L, cone_angle)?;
         let emission = SpdLight::new(L, spd, power, wavelength_sampling)?;
-        let half = cone_angle.to_radians() / 2.0;
-        let one_minus_cos = 2.0 * half.sin() * half.sin();
+        let one_minus_cos = one_minus_cos(cone_angle.to_radians());
         Ok(Self {
             emission,
             position,
             direction,
             cone_angle,
             one_minus_cos,
-            frame: Frame::new(direction),
+            frame: Frame::from_normal(direction),
         })
     }
 
@@ -172,8 +174,8 @@ impl LightSource for UniformSpotLight {
     fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
         let (lambda, scale) = self.emission.wavelength(uniform(rng));
         // cos(theta) uniform on [cos(cone), 1]: uniform per solid angle inside the cone.
-        let cos_theta = 1.0 - uniform(rng) * self.one_minus_cos;
-        let direction = direction_from_cos(&self.frame, cos_theta, uniform(rng));
+        let local = sample_uniform_cone([uniform(rng), uniform(rng)], self.one_minus_cos);
+        let direction = self.frame.to_world(local).normalize();
         self.emission.count();
         Beam::new(self.position, direction, lambda, scale)
     }
@@ -335,7 +337,7 @@ impl FadingSpotLight {
             fade_per_angle,
             theta,
             peak_intensity,
-            frame: Frame::new(direction),
+            frame: Frame::from_normal(direction),
         })
     }
 
@@ -368,7 +370,7 @@ impl LightSource for FadingSpotLight {
         let theta = self.theta.sample(uniform(rng));
         let phi = TAU * uniform(rng);
         let (s, c) = theta.sin_cos();
-        let direction = self.frame.local_to_world(s * phi.cos(), s * phi.sin(), c).normalize();
+        let direction = self.frame.to_world(spherical_direction(s, c, phi)).normalize();
         self.emission.count();
         Beam::new(self.position, direction, lambda, scale)
     }
@@ -470,8 +472,7 @@ impl LightSource for PointLight {
     fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
         let (lambda, scale) = self.emission.wavelength(uniform(rng));
         // z = cos(theta) uniform on [-1, 1]: uniform on the sphere.
-        let z = 1.0 - 2.0 * uniform(rng);
-        let direction = direction_from_cos(&Frame::new(DVec3::Z), z, uniform(rng));
+        let direction = sample_uniform_sphere([uniform(rng), uniform(rng)]).normalize();
         self.emission.count();
         Beam::new(self.position, direction, lambda, scale)
     }

@@ -236,6 +236,28 @@ fn uniform_spot_cosines_are_uniform_in_the_cone() {
 }
 
 #[test]
+fn a_very_narrow_uniform_spot_still_fills_its_cone() {
+    // cos(1e-7 degrees) rounds to 1; the shared cone warp works from 1 - cos, so the beams spread
+    // over the whole cone instead of collapsing onto the axis: (theta / theta_max)^2, which is
+    // (1 - cos theta) / (1 - cos theta_max) to 1e-15 here, is uniform on [0, 1].
+    let cone = 1e-7_f64;
+    let spot =
+        UniformSpotLight::new(DVec3::ZERO, v(0.0, 0.0, 1.0), cone, 1.0, d65(), Default::default())
+            .unwrap();
+    let theta_max = cone.to_radians();
+    let mut rng = Pcg64::seed_from_u64(12);
+    let ratios: Vec<f64> = (0..N)
+        .map(|_| {
+            let d = spot.next_beam(&mut rng).direction;
+            (d.x.hypot(d.y).atan2(d.z) / theta_max).powi(2)
+        })
+        .collect();
+    assert!(ratios.iter().all(|&r| r <= 1.0 + 1e-9), "a beam outside the cone");
+    let p = chi2_uniform(ratios.iter().copied(), 0.0, 1.0 + 1e-9, 50, N);
+    assert!(p > ALPHA, "(theta / theta_max)^2 not uniform: p = {p}");
+}
+
+#[test]
 fn fading_spot_follows_its_profile_per_solid_angle() {
     let (cone, fade) = (40.0_f64, 0.05_f64); // full intensity to 20 degrees, zero at 40
     let spot = FadingSpotLight::new(

@@ -27,9 +27,11 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use spectrace_spectrum::Transmittance;
 
-use crate::frame::{normalise, unit_uniform};
+use spectrace_sampling::clamp_uniform;
+
 use crate::fresnel::{fresnel_dielectric, refract};
 use crate::ior::IorRepr;
+use crate::vectors::normalise;
 use crate::{Incoming, Ior, Material, MaterialError, ScatterKind, Scattered, Transport};
 
 /// A smooth dielectric boundary (glass) with a possibly dispersive index of refraction.
@@ -127,7 +129,7 @@ impl Material for Dielectric {
             kind: ScatterKind::Specular,
             pdf: 0.0,
         };
-        if unit_uniform(u[0]) < f {
+        if clamp_uniform(u[0]) < f {
             return Some(reflection);
         }
         let Some(direction) = refract(d, n, eta_t / eta_i) else {

@@ -19,7 +19,9 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use spectrace_spectrum::Reflectance;
 
-use crate::frame::{cosine_hemisphere, facing, unit_uniform};
+use spectrace_sampling::{Frame, clamp_uniform, pdf_cosine_hemisphere, sample_cosine_hemisphere};
+
+use crate::vectors::{facing, normalise};
 use crate::{Incoming, Material, ScatterKind, Scattered};
 
 /// A Lambertian (ideal diffuse) reflector, two-sided.
@@ -53,12 +55,13 @@ impl Material for Diffuse {
             return None;
         }
         let n = facing(incoming.direction, incoming.normal);
-        let (direction, cos_theta) = cosine_hemisphere(n, unit_uniform(u[1]), unit_uniform(u[2]));
+        // Malley's method with the polar map: cos theta = sqrt(1 - u[1]) > 0, never tangent.
+        let local = sample_cosine_hemisphere([clamp_uniform(u[1]), clamp_uniform(u[2])]);
         Some(Scattered {
-            direction,
+            direction: normalise(Frame::from_normal(n).to_world(local)),
             weight: albedo,
             kind: ScatterKind::Diffuse,
-            pdf: cos_theta * FRAC_1_PI,
+            pdf: pdf_cosine_hemisphere(local.z),
         })
     }
 

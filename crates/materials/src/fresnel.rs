@@ -7,7 +7,7 @@
 
 use glam::DVec3;
 
-use crate::frame::normalise;
+use crate::vectors::normalise;
 
 /// Fresnel reflectances of the two linear polarisations (see
 /// [`fresnel_dielectric_polarised`]).

@@ -42,12 +42,12 @@
 mod dielectric;
 mod diffuse;
 mod error;
-mod frame;
 mod fresnel;
 mod glass;
 mod ior;
 mod material;
 mod mirror;
+mod vectors;
 
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;

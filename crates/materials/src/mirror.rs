@@ -15,8 +15,8 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use spectrace_spectrum::Reflectance;
 
-use crate::frame::facing;
 use crate::fresnel::reflect;
+use crate::vectors::facing;
 use crate::{Incoming, Material, ScatterKind, Scattered};
 
 /// A perfect mirror, two-sided, with a wavelength-dependent reflectance.

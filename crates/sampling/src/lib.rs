@@ -25,20 +25,42 @@
 //! summed with compensation, and zero-mass entries and segments can never be returned. Bad tables
 //! produce a [`SamplingError`] naming the array and index at fault.
 //!
+//! Below the generators sit the geometric helpers that lights and materials share, so each exists
+//! once: [`Frame`], an orthonormal basis around a unit normal (Duff et al. 2017) with `to_world`
+//! and `to_local`; the [`warp`] module, pbrt-style triples of `sample_*` (unit square to disk,
+//! cosine-weighted or uniform hemisphere, sphere, cone; directions in a local space about `+z`),
+//! `pdf_*` and, where natural, `invert_*`; and the uniform helpers [`uniform`] (53 random bits from
+//! any generator) and [`clamp_uniform`] (a tolerant clamp into `[0, 1)`). Warps clamp their
+//! uniforms instead of asserting, and narrow cones are described by `1 - cos` (computed without
+//! cancellation by [`one_minus_cos`]) rather than by `cos`.
+//!
 //! The [`stats`] module holds the chi-square and Kolmogorov-Smirnov harness that every Spectrace
 //! crate uses in its statistical tests.
 
 mod alias;
 mod discrete;
 mod error;
+mod frame;
 mod piecewise_constant;
 mod piecewise_linear;
 pub mod stats;
 mod table;
+mod uniform;
+pub mod warp;
 
 pub use alias::AliasTable;
 pub use discrete::Discrete;
 pub use error::SamplingError;
+pub use frame::Frame;
 pub use piecewise_constant::PiecewiseConstant;
 pub use piecewise_linear::{PiecewiseLinear, linear_segment_inverse};
 pub use table::ONE_MINUS_EPSILON;
+pub use uniform::{clamp_uniform, uniform};
+pub use warp::{
+    invert_cosine_hemisphere, invert_cosine_hemisphere_concentric, invert_uniform_cone,
+    invert_uniform_disk_concentric, invert_uniform_hemisphere, invert_uniform_sphere,
+    one_minus_cos, pdf_cosine_hemisphere, pdf_uniform_cone, pdf_uniform_disk_concentric,
+    pdf_uniform_hemisphere, pdf_uniform_sphere, sample_cosine_hemisphere,
+    sample_cosine_hemisphere_concentric, sample_uniform_cone, sample_uniform_disk_concentric,
+    sample_uniform_hemisphere, sample_uniform_sphere, sin_from_cos, spherical_direction,
+};

@@ -11,7 +11,7 @@ pub const ONE_MINUS_EPSILON: f64 = 1.0 - f64::EPSILON / 2.0;
 #[inline(always)]
 pub(crate) fn unit(u: f64) -> f64 {
     debug_assert!((0.0..1.0).contains(&u), "uniform variate u = {u} is outside [0, 1)");
-    if u >= 0.0 { if u < 1.0 { u } else { ONE_MINUS_EPSILON } } else { 0.0 }
+    crate::clamp_uniform(u)
 }
 
 /// Multiplies `x` by `2^e` exactly (unless the result leaves the normal range), for any `e`.

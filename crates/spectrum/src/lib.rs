@@ -67,5 +67,5 @@ pub use tabulated::{Binned, Tabulated};
 #[inline]
 pub(crate) fn unit(u: f64) -> f64 {
     debug_assert!((0.0..1.0).contains(&u), "uniform variate u = {u} is outside [0, 1)");
-    if u >= 0.0 { u.min(spectrace_sampling::ONE_MINUS_EPSILON) } else { 0.0 }
+    spectrace_sampling::clamp_uniform(u)
 }

@@ -21,17 +21,14 @@ use spectrace_materials::Incoming;
 /// seed with probability 1e-3 (seeds are fixed, so the outcome is reproducible).
 pub const ALPHA: f64 = 1e-3;
 
-/// A uniform in `[0, 1)` (53 random bits).
+/// A uniform in `[0, 1)` (53 random bits), as the renderer draws them.
 pub fn uniform(rng: &mut impl Rng) -> f64 {
-    (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    spectrace_sampling::uniform(rng)
 }
 
 /// A unit vector from two uniforms (uniform on the sphere).
 pub fn sphere(u: f64, v: f64) -> DVec3 {
-    let z = 1.0 - 2.0 * u;
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let (s, c) = (std::f64::consts::TAU * v).sin_cos();
-    DVec3::new(r * c, r * s, z).normalize()
+    spectrace_sampling::sample_uniform_sphere([u, v]).normalize()
 }
 
 /// A random unit vector.
