@@ -242,9 +242,8 @@ fn shipped_scenes() -> Vec<String> {
 fn corpus(kind: &str) -> Vec<(PathBuf, Vec<u8>)> {
     let dir = workspace().join("tests/fuzz-corpus").join(kind);
     // A missing folder is an empty corpus (git does not keep empty folders).
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .map(|r| r.map(|e| e.unwrap().path()).collect())
-        .unwrap_or_default();
+    let mut files: Vec<PathBuf> =
+        std::fs::read_dir(&dir).map(|r| r.map(|e| e.unwrap().path()).collect()).unwrap_or_default();
     files.sort();
     files
         .into_iter()
