@@ -10,6 +10,8 @@ use spectrace_renderer::{
 use spectrace_spectrum::Xyz;
 use spectrace_tracer::Film;
 
+use crate::rendering::temp_dir;
+
 const PLANE: &str = r#"{
   "camera": {"position": [0, 3, 0.001], "look_at": [0, 0, 0], "up": [0, 0, -1], "fov": 60, "width": 16, "height": 16},
   "objects": [{"shape": {"type": "Rectangle", "corner": [-3, 0, 3], "edge_u": [6, 0, 0], "edge_v": [0, 0, -6]},
@@ -18,13 +20,6 @@ const PLANE: &str = r#"{
               "spd": {"type": "Uniform", "min_nm": 400, "max_nm": 700}}],
   "settings": {"chunk_beams": 1000}
 }"#;
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("spectrace-hostile-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 fn options(out: &Path) -> RenderOptions {
     RenderOptions {

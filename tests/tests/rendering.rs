@@ -15,7 +15,8 @@ use spectrace_renderer::{
 use spectrace_spectrum::{CIE_Y_INTEGRAL, SpectralPowerDistribution, Uniform, xyz_of};
 use spectrace_tracer::{Integrator, LightTracer, RenderOutput, render};
 
-fn temp_dir(name: &str) -> PathBuf {
+/// A fresh, empty folder for one test's files (also used by the hostile-input tests).
+pub(crate) fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("spectrace-test-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();

@@ -110,8 +110,8 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
     }
 }
 
-/// Writes `path` by calling `write` on a temporary file in the same folder and renaming it into
-/// place: readers never see a half-written file, and a failed write leaves nothing behind.
+/// Writes `path` by calling `write` on a new temporary file in the same folder (it may replace
+/// that file) and renaming it into place: readers never see a half-written file, and a failed write leaves nothing behind.
 ///
 /// # Errors
 /// The error of `write`, or of the rename.
@@ -121,11 +121,27 @@ pub fn write_atomically(
 ) -> Result<(), String> {
     static COUNTER: AtomicU64 = AtomicU64::new(0);
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let temp = path.with_file_name(format!(
-        ".{name}.tmp-{}-{}",
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
+    // The temporary name is reserved with `create_new`, so an existing file of that name (however
+    // unlikely) is never truncated or removed.
+    let mut reserved = None;
+    for _ in 0..100 {
+        let temp = path.with_file_name(format!(
+            ".{name}.tmp-{}-{}",
+            std::process::id(),
+            COUNTER.fetch_add(1, Ordering::Relaxed)
+        ));
+        match std::fs::OpenOptions::new().write(true).create_new(true).open(&temp) {
+            Ok(_) => {
+                reserved = Some(temp);
+                break;
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {}
+            Err(e) => return Err(format!("cannot create a temporary file beside it: {e}")),
+        }
+    }
+    let Some(temp) = reserved else {
+        return Err("cannot find a free temporary name beside it".to_owned());
+    };
     let result = write(&temp).and_then(|()| {
         std::fs::rename(&temp, path)
             .map_err(|e| format!("cannot move the finished file into place: {e}"))

@@ -29,10 +29,7 @@ pub use files::{
     MAX_OUTPUT_NAME_BYTES, MAX_PART_BYTES, MAX_SCENE_BYTES, check_no_input_replaced,
     check_output_name, prepare_out_dir, read_bounded, same_file, write_atomically,
 };
-pub use output::{
-    EncodedImage, OUTPUT_BYTES_PER_PIXEL, encode_image, linear_srgb, write_exr, write_exr_scaled,
-    write_png, write_png_scaled,
-};
+pub use output::{EncodedImage, OUTPUT_BYTES_PER_PIXEL, encode_image, write_exr, write_png};
 pub use part::{PARTIAL_VERSION, PartialFilm};
 pub use scene::{
     EffectsSettings, LoadOptions, Object, OutputSettings, Scene, SceneError, SceneFile, Settings,
@@ -180,7 +177,7 @@ pub fn plan_for(scene: &Scene, options: &RenderOptions) -> Result<RenderPlan, Re
     }
     if plan.threads > MAX_THREADS {
         return Err(RenderError::Options(format!(
-            "threads = {}: at most {MAX_THREADS}",
+            "settings.threads / --threads = {}: at most {MAX_THREADS}",
             plan.threads
         )));
     }
@@ -335,7 +332,7 @@ fn planned_outputs(
     settings: &OutputSettings,
     shard: Option<(u64, u64)>,
     inputs: &[PathBuf],
-) -> Result<Vec<PathBuf>, RenderError> {
+) -> Result<(), RenderError> {
     check_output_name(name).map_err(|e| RenderError::Options(format!("output name: {e}")))?;
     prepare_out_dir(out_dir).map_err(RenderError::Options)?;
     let outputs = match shard {
@@ -352,8 +349,7 @@ fn planned_outputs(
             v
         }
     };
-    check_no_input_replaced(&outputs, inputs).map_err(RenderError::Options)?;
-    Ok(outputs)
+    check_no_input_replaced(&outputs, inputs).map_err(RenderError::Options)
 }
 
 /// Renders a loaded scene with overrides and writes its outputs.
@@ -549,14 +545,14 @@ pub fn write_outputs(
     };
     if settings.exr {
         let path = dir.join(format!("{name}.exr"));
-        write_atomically(&path, |p| write_exr_scaled(p, w, h, &image.rgb, image.scale_log2))
+        write_atomically(&path, |p| write_exr(p, w, h, &image.rgb, image.scale_log2))
             .map_err(file_error(&path))?;
         written.files.push(path.display().to_string());
     }
     if settings.png {
         let path = dir.join(format!("{name}.png"));
         write_atomically(&path, |p| {
-            write_png_scaled(p, w, h, &image.rgb, settings.exposure, image.scale_log2)
+            write_png(p, w, h, &image.rgb, settings.exposure, image.scale_log2)
         })
         .map_err(file_error(&path))?;
         written.files.push(path.display().to_string());
@@ -606,7 +602,7 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
             limit.source
         )));
     }
-    let outputs = planned_outputs(out_dir, &first.name, &first.output_settings, None, parts)?;
+    planned_outputs(out_dir, &first.name, &first.output_settings, None, parts)?;
     let placeholder = RenderOutput {
         film: Film::new(1, 1).map_err(|e| RenderError::Options(e.to_string()))?,
         stats: TraceStats::default(),
@@ -677,9 +673,6 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
     }
     let written =
         write_outputs(out_dir, &first.name, &first.output_settings, first.light_power, &merged)?;
-    debug_assert!(
-        written.files.iter().all(|f| outputs.iter().any(|o| o.display().to_string() == *f))
-    );
     let total_seconds: f64 = seconds.iter().sum();
     let mut report = report(
         first.scene_path.clone(),

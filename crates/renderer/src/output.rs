@@ -10,34 +10,17 @@
 
 use std::path::Path;
 
-use spectrace_spectrum::{Xyz, srgb_encode};
+use spectrace_spectrum::srgb_encode;
 use spectrace_tracer::{RenderOutput, image_scale};
 
-/// Linear sRGB (Rec. 709 primaries, D65 white) of every pixel, row-major from the top-left.
-pub fn linear_srgb(xyz: &[Xyz]) -> Vec<[f32; 3]> {
-    xyz.iter()
-        .map(|p| {
-            let [r, g, b] = p.to_linear_srgb();
-            [r as f32, g as f32, b as f32]
-        })
-        .collect()
-}
-
 /// Writes a linear EXR (32-bit float R, G, B; ZIP compression, scan lines in increasing order,
-/// written sequentially so the same image always gives the same bytes).
+/// written sequentially so the same image always gives the same bytes) of values stored
+/// multiplied by `2^scale_log2` (0 for an image that fits f32, see [`encode_image`]); a non-zero
+/// exponent is recorded in the header attribute `spectraceScaleLog2`.
 ///
 /// # Errors
 /// Any error of the `exr` crate, as text.
-pub fn write_exr(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<(), String> {
-    write_exr_scaled(path, width, height, rgb, 0)
-}
-
-/// Writes a linear EXR of values stored multiplied by `2^scale_log2`; a non-zero exponent is
-/// recorded in the header attribute `spectraceScaleLog2`.
-///
-/// # Errors
-/// Any error of the `exr` crate, as text.
-pub fn write_exr_scaled(
+pub fn write_exr(
     path: &Path,
     width: u32,
     height: u32,
@@ -64,27 +47,13 @@ pub fn write_exr_scaled(
     image.write().non_parallel().to_file(path).map_err(|e| e.to_string())
 }
 
-/// Writes an 8-bit sRGB PNG of `linear * 2^exposure` (negative values, from out-of-gamut
-/// colours, become 0; values above 1 saturate).
+/// Writes an 8-bit sRGB PNG of the true values times `2^exposure` for values stored multiplied by
+/// `2^scale_log2` (as [`write_exr`]); negative values, from out-of-gamut colours, become 0;
+/// values above 1 saturate.
 ///
 /// # Errors
 /// Any error of the `image` crate, as text.
 pub fn write_png(
-    path: &Path,
-    width: u32,
-    height: u32,
-    rgb: &[[f32; 3]],
-    exposure: f64,
-) -> Result<(), String> {
-    write_png_scaled(path, width, height, rgb, exposure, 0)
-}
-
-/// As [`write_png`], for values stored multiplied by `2^scale_log2` (the PNG shows the true
-/// values times `2^exposure`).
-///
-/// # Errors
-/// Any error of the `image` crate, as text.
-pub fn write_png_scaled(
     path: &Path,
     width: u32,
     height: u32,
@@ -152,9 +121,11 @@ fn ldexp(mut x: f64, mut e: i64) -> f64 {
     x * 2f64.powi(e as i32)
 }
 
-/// The binary exponent of a positive finite `x` (`x = m 2^e`, `m` in `[1, 2)`).
+/// The binary exponent of a positive finite `x` (`x = m 2^e`, `m` in `[1, 2)`), exactly, read
+/// from its bits (subnormals included).
 fn exponent(x: f64) -> i64 {
-    x.log2().floor() as i64
+    let biased = ((x.to_bits() >> 52) & 0x7ff) as i64;
+    if biased == 0 { exponent(x * 2f64.powi(64)) - 64 } else { biased - 1023 }
 }
 
 /// The image of a finished render (light power over beams times the film), as the EXR stores it;
@@ -172,11 +143,13 @@ pub fn encode_image(output: &RenderOutput, light_power: f64) -> EncodedImage {
     if fits {
         return EncodedImage { rgb: to_f32(&rgb), scale_log2: 0, out_of_range_values: 0 };
     }
+    drop(rgb);
     // Recompute without overflow: the power's mantissa over the beams, then powers of two.
     let beams = output.beams.max(1) as f64;
     let power_exp = if light_power > 0.0 { exponent(light_power) } else { 0 };
     let base = ldexp(light_power, -power_exp) / beams;
-    let rgb: Vec<[f64; 3]> = output.film.to_xyz(base).iter().map(|p| p.to_linear_srgb()).collect();
+    let rgb: Vec<[f64; 3]> =
+        output.film.to_xyz(base).into_iter().map(|p| p.to_linear_srgb()).collect();
     let largest = rgb.iter().flatten().fold(0.0f64, |m, &c| m.max(c.abs()));
     if !(largest > 0.0 && largest.is_finite()) {
         return EncodedImage { rgb: to_f32(&rgb), scale_log2: 0, out_of_range_values: 0 };
@@ -196,9 +169,8 @@ pub fn encode_image(output: &RenderOutput, light_power: f64) -> EncodedImage {
             }
         })
         .count() as u64;
-    let stored: Vec<[f64; 3]> =
-        rgb.iter().map(|p| p.map(|c| ldexp(c, power_exp + scale))).collect();
-    EncodedImage { rgb: to_f32(&stored), scale_log2: scale as i32, out_of_range_values }
+    let stored = rgb.iter().map(|p| p.map(|c| ldexp(c, power_exp + scale) as f32)).collect();
+    EncodedImage { rgb: stored, scale_log2: scale as i32, out_of_range_values }
 }
 
 fn to_f32(rgb: &[[f64; 3]]) -> Vec<[f32; 3]> {

@@ -120,14 +120,6 @@ impl Default for OutputSettings {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum SceneError {
-    /// The file cannot be read.
-    #[error("{path}: cannot read the scene: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        source: std::io::Error,
-    },
     /// The file cannot be read within its limits (missing, not a regular file, too large).
     #[error("{path}: {message}")]
     Read {
