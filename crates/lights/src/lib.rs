@@ -46,7 +46,10 @@ pub use error::LightError;
 pub use laser::Laser;
 pub use set::LightSet;
 pub use sky::Sky;
-pub use source::{LightFlags, LightSample, LightSource, SpdLight, WavelengthSampling};
+pub use source::{
+    EmissionSample, LightFlags, LightSample, LightSource, LightSurface, SpdLight,
+    WavelengthSampling,
+};
 pub use spot::{FadingSpotLight, PointLight, UniformSpotLight};
 
 /// Vectors (`DVec3`) as used in [`Beam`], re-exported so plugins need no direct dependency.

@@ -113,6 +113,21 @@ impl LightSet {
         self.lights.get(id.0 as usize).map(|l| l.as_ref())
     }
 
+    /// The light sampler for next-event estimation: chooses a light with probability
+    /// proportional to its power from a uniform `u`, and returns it with its probability mass
+    /// ([`pmf`](Self::pmf)) and `u` remapped to a fresh uniform in `[0, 1)` for the light's own
+    /// use.
+    pub fn sample_light(&self, u: f64) -> (LightId, f64, f64) {
+        let (i, remapped) = self.choice.sample_remapped(u);
+        (LightId(i as u32), self.choice.pmf(i), remapped)
+    }
+
+    /// Probability mass with which [`sample_light`](Self::sample_light) (and beam emission)
+    /// chooses light `id`: its share of the total power.
+    pub fn pmf(&self, id: LightId) -> f64 {
+        self.choice.pmf(id.0 as usize)
+    }
+
     /// Probability that a beam comes from light `id`: its share of the total power.
     pub fn probability(&self, id: LightId) -> f64 {
         self.choice.pmf(id.0 as usize)

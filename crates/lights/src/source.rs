@@ -86,6 +86,89 @@ pub trait LightSource: Send + Sync + Debug {
         let _ = (receiver, u);
         None
     }
+
+    /// Solid-angle density (sr^-1, at `receiver`) with which
+    /// [`sample_towards`](Self::sample_towards)`(receiver, u)` returns the point `position` of
+    /// the light, for multiple importance sampling when a path from `receiver` hits the light by
+    /// itself. 0 for delta lights and by default.
+    fn pdf_towards(&self, receiver: DVec3, position: DVec3) -> f64 {
+        let _ = (receiver, position);
+        0.0
+    }
+
+    /// Radiance (W m^-2 sr^-1, whole spectrum: multiply by `spd().value(lambda)` for the
+    /// spectral radiance) leaving the point `position` of the light's surface towards the unit
+    /// `direction`: what a camera ray that hits an area light sees. 0 (the default) for lights
+    /// without a surface, and on the back of a one-sided light.
+    fn emitted_radiance(&self, position: DVec3, direction: DVec3) -> f64 {
+        let _ = (position, direction);
+        0.0
+    }
+
+    /// Samples an emission ray from four uniforms: a point of the light, its surface normal, a
+    /// direction, and their densities (see [`EmissionSample`]), as the light's beams are
+    /// distributed (a beam from [`next_beam`](Self::next_beam) and this sample have the same
+    /// density). `None` (the default) for lights that offer only the seed's methods.
+    fn sample_emission(&self, u: [f64; 4]) -> Option<EmissionSample> {
+        let _ = u;
+        None
+    }
+
+    /// The densities with which this light emits a beam from `position` along the unit
+    /// `direction`: `(pdf_position, pdf_direction)` as in [`EmissionSample`]. `None` (the default)
+    /// when the light does not say (only the light tracer can use it).
+    fn pdf_emission(&self, position: DVec3, direction: DVec3) -> Option<(f64, f64)> {
+        let _ = (position, direction);
+        None
+    }
+
+    /// The light's emitting surface, so a renderer can make it part of the scene: visible to
+    /// camera rays (with [`emitted_radiance`](Self::emitted_radiance)) and blocking light. `None`
+    /// (the default) for lights without one (points, parallel beams).
+    fn surface(&self) -> Option<LightSurface> {
+        None
+    }
+}
+
+/// An emission ray drawn by [`LightSource::sample_emission`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EmissionSample {
+    /// Where the ray starts.
+    pub position: DVec3,
+    /// The unit surface normal there (on the emitting side; for a two-sided light, on the side
+    /// the ray leaves), or zero for a light without a surface (points, spots).
+    pub normal: DVec3,
+    /// Unit direction of the ray.
+    pub direction: DVec3,
+    /// Area density of `position` (m^-2); 1 for a delta position.
+    pub pdf_position: f64,
+    /// Solid-angle density of `direction` given `position` (sr^-1); 1 for a delta direction.
+    pub pdf_direction: f64,
+}
+
+/// The emitting surface of an area light (see [`LightSource::surface`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum LightSurface {
+    /// The parallelogram `corner + s edge_u + t edge_v`, `s, t` in `[0, 1]`; its front is
+    /// `edge_u x edge_v`.
+    Rectangle {
+        /// A corner.
+        corner: DVec3,
+        /// First edge.
+        edge_u: DVec3,
+        /// Second edge.
+        edge_v: DVec3,
+    },
+    /// A disk; its front is `normal`.
+    Disk {
+        /// Centre.
+        center: DVec3,
+        /// Unit normal of the front.
+        normal: DVec3,
+        /// Radius (m).
+        radius: f64,
+    },
 }
 
 /// Which dimensions of a light's emission are Dirac deltas.

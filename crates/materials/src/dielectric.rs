@@ -128,6 +128,8 @@ impl Material for Dielectric {
             weight: 1.0,
             kind: ScatterKind::Specular,
             pdf: 0.0,
+            eta: 1.0,
+            transmission: false,
         };
         if clamp_uniform(u[0]) < f {
             return Some(reflection);
@@ -143,7 +145,14 @@ impl Material for Dielectric {
         if !(weight > 0.0) {
             return None;
         }
-        Some(Scattered { direction, weight, kind: ScatterKind::Specular, pdf: 0.0 })
+        Some(Scattered {
+            direction,
+            weight,
+            kind: ScatterKind::Specular,
+            pdf: 0.0,
+            eta: eta_t / eta_i,
+            transmission: true,
+        })
     }
 
     fn eval(&self, _wi: DVec3, _wo: DVec3, _normal: DVec3, _lambda: f64) -> f64 {

@@ -62,6 +62,8 @@ impl Material for Diffuse {
             weight: albedo,
             kind: ScatterKind::Diffuse,
             pdf: pdf_cosine_hemisphere(local.z),
+            eta: 1.0,
+            transmission: false,
         })
     }
 

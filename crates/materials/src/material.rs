@@ -56,6 +56,11 @@ pub struct Scattered {
     pub kind: ScatterKind,
     /// Solid-angle density of `direction` (sr^-1); 0 for a delta lobe.
     pub pdf: f64,
+    /// Relative index of refraction across the boundary as the path crossed it, `n_t / n_i`
+    /// (after over before); 1 for a reflection.
+    pub eta: f64,
+    /// `true` if the beam went through the surface (refraction), `false` if it was reflected.
+    pub transmission: bool,
 }
 
 /// What a surface does to a beam (seed 3.5): scatter it into a new direction with an updated
@@ -98,6 +103,22 @@ pub trait Material: Send + Sync + Debug {
     /// A light tracer that connects a hit to the camera adds `weight * f * |wo . normal|`
     /// times the camera's importance.
     fn eval(&self, wi: DVec3, wo: DVec3, normal: DVec3, lambda: f64) -> f64;
+
+    /// [`eval`](Self::eval) for a path carrying `transport`: the BSDF as radiance sees it
+    /// ([`Transport::Radiance`], camera paths) or its adjoint ([`Transport::Importance`], light
+    /// paths). The two differ only for non-delta transmission (by `eta^2`); the default ignores
+    /// `transport`, which is right for every material that has none.
+    fn eval_with(
+        &self,
+        wi: DVec3,
+        wo: DVec3,
+        normal: DVec3,
+        lambda: f64,
+        transport: Transport,
+    ) -> f64 {
+        let _ = transport;
+        self.eval(wi, wo, normal, lambda)
+    }
 
     /// Solid-angle density (sr^-1) with which [`scatter`](Self::scatter), given a beam arriving
     /// from `wi` (`Incoming::direction = -wi`), returns `wo`; 0 for delta lobes. The density of

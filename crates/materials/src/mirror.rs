@@ -49,6 +49,8 @@ impl Material for Mirror {
             weight: r,
             kind: ScatterKind::Specular,
             pdf: 0.0,
+            eta: 1.0,
+            transmission: false,
         })
     }
 
