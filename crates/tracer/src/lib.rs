@@ -19,16 +19,20 @@ mod effects;
 mod film;
 mod integrator;
 mod light_tracer;
+mod path_tracer;
 mod render;
+mod wavelengths;
 
 pub use camera::{CameraError, CameraRepr, FovAxis, PinholeCamera, Projection};
 pub use effects::{BUNDLE, Effects, EffectsMode, SceneFeatures};
 pub use film::{ExactSum, Film, FilmError, FilmWriter, MAX_PIXELS, Splat};
 pub use integrator::{Integrator, LightTracer};
 pub use light_tracer::{
-    LightTracerScene, LightTracerSettings, MAX_DEPTH, TraceStats, chunk_rng, image_scale,
+    Emitter, LightTracerScene, LightTracerSettings, MAX_DEPTH, TraceStats, chunk_rng, image_scale,
     trace_chunk, trace_chunk_until,
 };
+pub use path_tracer::{PathTracer, PathTracerSettings};
 pub use render::{
     DEFAULT_CHUNK_BEAMS, FALLBACK_MEMORY_LIMIT, MemoryLimit, RenderOutput, RenderPlan, render,
 };
+pub use wavelengths::{CAMERA_LAMBDA_MAX, CAMERA_LAMBDA_MIN, CameraWavelengths, HERO};

@@ -28,7 +28,7 @@ use rand::SeedableRng;
 use rand_pcg::Pcg64;
 use serde::{Deserialize, Serialize};
 use spectrace_geometry::{Ray, World};
-use spectrace_lights::{LightSet, LightSource, uniform};
+use spectrace_lights::{LightId, LightSet, LightSource, uniform};
 use spectrace_materials::{Incoming, Material};
 
 /// The factor that makes particle (importance) transport exact with shading normals:
@@ -89,6 +89,45 @@ pub struct LightTracerScene<'a> {
     /// The spectrum of each light of the set, cached (bundled wavelengths are drawn from the
     /// spectrum of the beam's own light).
     spds: Vec<Arc<dyn SpectralPowerDistribution>>,
+    /// What each shape emits, indexed like `materials` (empty: nothing emits).
+    emitters: Vec<Option<Emitter>>,
+    /// The shape that is the surface of each light of the set, if any.
+    light_shapes: Vec<Option<u32>>,
+    /// How many of the shapes are the scene's objects (the first ones); the rest are the
+    /// surfaces of area lights, which the effects analysis does not count.
+    object_shapes: usize,
+}
+
+/// Light leaving a shape's surface: which light of the set it belongs to, so that camera paths
+/// that hit the shape see it and weigh it against next-event estimation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Emitter {
+    /// The surface of an area light of the set (see [`spectrace_lights::LightSource::surface`]):
+    /// its radiance is the light's [`spectrace_lights::LightSource::emitted_radiance`].
+    Light(LightId),
+    /// An object made to glow (`objects[i].emission`): a Lambertian emitter of `radiance`
+    /// (W m^-2 sr^-1, whole spectrum: times the light's SPD) on the outward side of its
+    /// geometric normal (both sides when `two_sided`), sampled uniformly over its `area` (m^2)
+    /// by light `light` of the set.
+    Object {
+        /// The light of the set that emits beams from this shape.
+        light: LightId,
+        /// Radiance (whole spectrum).
+        radiance: f64,
+        /// Whether both sides emit.
+        two_sided: bool,
+        /// Area (m^2).
+        area: f64,
+    },
+}
+
+impl Emitter {
+    /// The light of the set this emitter belongs to.
+    pub fn light(&self) -> LightId {
+        match *self {
+            Emitter::Light(id) | Emitter::Object { light: id, .. } => id,
+        }
+    }
 }
 
 impl<'a> LightTracerScene<'a> {
@@ -100,7 +139,102 @@ impl<'a> LightTracerScene<'a> {
         camera: &'a PinholeCamera,
     ) -> Self {
         let spds = lights.lights().iter().map(|l| l.spd()).collect();
-        Self { world, materials, lights, camera, spds }
+        Self {
+            world,
+            materials,
+            lights,
+            camera,
+            spds,
+            emitters: Vec::new(),
+            light_shapes: Vec::new(),
+            object_shapes: materials.len(),
+        }
+    }
+
+    /// The same scene where shape `i` emits `emitters[i]` (missing entries emit nothing), and
+    /// only the first `object_shapes` shapes are the scene's objects (the rest are the surfaces
+    /// of area lights).
+    pub fn with_emitters(mut self, emitters: Vec<Option<Emitter>>, object_shapes: usize) -> Self {
+        let mut light_shapes = vec![None; self.lights.lights().len()];
+        for (shape, e) in emitters.iter().enumerate() {
+            if let Some(e) = e
+                && let Some(slot) = light_shapes.get_mut(e.light().0 as usize)
+            {
+                *slot = Some(shape as u32);
+            }
+        }
+        self.light_shapes = light_shapes;
+        self.emitters = emitters;
+        self.object_shapes = object_shapes.min(self.materials.len());
+        self
+    }
+
+    /// The first hit of a ray that starts on the surface of light `light` (a beam's emission
+    /// point): a hit of the light's own surface within rounding distance of the start is the
+    /// start itself, and is skipped by continuing from it with the geometry's robust offset.
+    pub fn intersect_from_light(
+        &self,
+        ray: &Ray,
+        light: LightId,
+        t_max: f64,
+    ) -> Option<spectrace_geometry::Hit> {
+        let hit = self.world.intersect(ray, t_max)?;
+        let own = self.light_shapes.get(light.0 as usize).copied().flatten();
+        let scale = 1.0 + ray.origin.abs().max_element();
+        if own == Some(hit.primitive) && hit.t <= 1e-9 * scale {
+            let next = hit.spawn_ray(ray.direction);
+            let travelled = (next.origin - ray.origin).length();
+            return self.world.intersect(&next, t_max - travelled);
+        }
+        Some(hit)
+    }
+
+    /// What shape `primitive` emits.
+    #[inline]
+    pub fn emitter(&self, primitive: u32) -> Option<&Emitter> {
+        self.emitters.get(primitive as usize).and_then(Option::as_ref)
+    }
+
+    /// The spectrum of light `id` of the set.
+    #[inline]
+    pub fn light_spd(&self, id: LightId) -> Option<&Arc<dyn SpectralPowerDistribution>> {
+        self.spds.get(id.0 as usize)
+    }
+
+    /// Radiance (whole spectrum; times the light's SPD) leaving `hit` towards the unit
+    /// `direction`, with the light it belongs to; `None` where the shape does not emit.
+    pub fn emitted(
+        &self,
+        hit: &spectrace_geometry::Hit,
+        direction: DVec3,
+    ) -> Option<(LightId, f64)> {
+        let emitter = self.emitter(hit.primitive)?;
+        let radiance = match *emitter {
+            Emitter::Light(id) => self.lights.light(id)?.emitted_radiance(hit.point, direction),
+            Emitter::Object { radiance, two_sided, .. } => {
+                let c = direction.dot(hit.geometric_normal);
+                if c > 0.0 || (two_sided && c < 0.0) { radiance } else { 0.0 }
+            }
+        };
+        (radiance > 0.0).then_some((emitter.light(), radiance))
+    }
+
+    /// Solid-angle density (at `receiver`) with which next-event estimation (light chosen by
+    /// [`LightSet::sample_light`], then its `sample_towards`) picks the emitting point `hit`.
+    pub fn emitter_pdf(&self, receiver: DVec3, hit: &spectrace_geometry::Hit) -> f64 {
+        let Some(emitter) = self.emitter(hit.primitive) else { return 0.0 };
+        let pmf = self.lights.pmf(emitter.light());
+        match *emitter {
+            Emitter::Light(id) => {
+                self.lights.light(id).map_or(0.0, |l| pmf * l.pdf_towards(receiver, hit.point))
+            }
+            Emitter::Object { area, .. } => {
+                let to = receiver - hit.point;
+                let d2 = to.length_squared();
+                let cos = (to.dot(hit.geometric_normal) / d2.sqrt()).abs();
+                if cos > 0.0 && area > 0.0 { pmf * d2 / (area * cos) } else { 0.0 }
+            }
+        }
     }
 
     /// What the scene contains, for the effects analysis.
@@ -109,7 +243,7 @@ impl<'a> LightTracerScene<'a> {
             light_spectra_vary: self.lights.lights().iter().any(|l| !l.uniform_spectrum()),
             ..SceneFeatures::default()
         };
-        for (i, m) in self.materials.iter().enumerate() {
+        for (i, m) in self.materials.iter().enumerate().take(self.object_shapes) {
             f.dispersive |= m.is_dispersive();
             if m.is_specular() {
                 f.specular = true;
@@ -236,7 +370,8 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
         }
         let mut ray = Ray { origin: beam.origin, direction: beam.direction };
         let mut depth = 0u32;
-        while let Some(hit) = scene.world.intersect(&ray, f64::INFINITY) {
+        let mut next_hit = scene.intersect_from_light(&ray, beam.parent, f64::INFINITY);
+        while let Some(hit) = next_hit.take() {
             stats.hits += 1;
             let Some(material) = scene.materials.get(hit.primitive as usize) else { break };
             let specular = material.is_specular();
@@ -310,6 +445,7 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
                 break;
             }
             ray = hit.spawn_ray(new_direction);
+            next_hit = scene.world.intersect(&ray, f64::INFINITY);
         }
     }
     stats
@@ -331,7 +467,7 @@ fn connect_emission(
         return None;
     }
     let shadow = Ray { origin: beam.origin, direction: projection.to_camera };
-    if scene.world.occluded(&shadow, projection.distance) {
+    if scene.intersect_from_light(&shadow, beam.parent, projection.distance).is_some() {
         return None;
     }
     Some((projection.x, projection.y, density * projection.importance))

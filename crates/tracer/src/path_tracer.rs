@@ -1,0 +1,342 @@
+//! The path tracer: paths from the camera, with next-event estimation and multiple importance
+//! sampling (pbrt's `PathIntegrator`, spectral with hero wavelengths).
+//!
+//! # Estimator
+//! A camera sample for pixel `p` is a ray through a uniform point of the pixel (and of the lens),
+//! carrying [`HERO`] wavelengths drawn by [`CameraWavelengths`]. At every surface hit `x`:
+//! - **Emission**: if `x` emits (an area light's surface or a glowing object), its radiance is
+//!   added, weighted by the power heuristic against the density with which next-event
+//!   estimation would have chosen `x` (full weight for the camera's own ray and after a specular
+//!   bounce, which next-event estimation cannot produce).
+//! - **Next-event estimation** (at non-specular surfaces): a light chosen by the light sampler
+//!   ([`spectrace_lights::LightSet::sample_light`], by power), a point on it by its
+//!   `sample_towards`, a shadow ray; weighted by the power heuristic against BSDF sampling, or
+//!   fully for delta lights (points, spots), which only this strategy reaches.
+//! - **BSDF sampling** chooses the next direction ([`spectrace_materials::Transport::Radiance`]:
+//!   refraction scales radiance by `(n_i / n_t)^2`); specular chains are followed, so glass and
+//!   mirrors show what they reflect and refract.
+//! - After `rr_depth` bounces, Russian roulette with survival `min(1, max_j beta_j)`.
+//!
+//! The film holds the sum of the samples' XYZ (`sum_j cmf(lambda_j) L_j / (HERO p(lambda_j))`,
+//! divided by the integral of `ybar`, as the light tracer's units); [`Integrator::image_scale`]
+//! divides by the samples per pixel.
+//!
+//! # Work items and determinism
+//! A work item is one camera sample; a chunk is one *pass*: one sample of every pixel, in pixel
+//! order, all drawn from the chunk's own random stream. A pass is never cut short (a time budget
+//! stops the render between passes), so every pixel has had the same number of samples and the
+//! image is the plain mean, bit-identical for any thread count or shard split.
+//!
+//! # What it cannot see
+//! Lights that have no `sample_towards` (lasers, parallel skies, lights that only implement the
+//! seed's beam generator) are never reached by a camera path: their light is missing from a
+//! path-traced image. The effects analysis does not choose this integrator for such scenes.
+
+use std::time::Instant;
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+use spectrace_geometry::{Hit, Ray};
+use spectrace_lights::uniform;
+use spectrace_materials::{Incoming, Material, ScatterKind, Transport};
+use spectrace_spectrum::{CIE_Y_INTEGRAL, Xyz, cmf};
+
+use crate::light_tracer::{LightTracerScene, TraceStats};
+use crate::{CameraWavelengths, Effects, HERO, Integrator, Splat, chunk_rng};
+
+/// Settings of the path tracer.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PathTracerSettings {
+    /// Most bounces a path may make (0: only what the camera sees directly and its direct light).
+    pub max_depth: u32,
+    /// Bounces after which Russian roulette may end a path.
+    pub rr_depth: u32,
+    /// How camera paths draw their wavelengths.
+    pub wavelengths: CameraWavelengths,
+}
+
+impl Default for PathTracerSettings {
+    fn default() -> Self {
+        Self { max_depth: 64, rr_depth: 4, wavelengths: CameraWavelengths::Visible }
+    }
+}
+
+/// The power heuristic (exponent 2) weight of a strategy with density `a` against one with
+/// density `b`.
+#[inline]
+pub(crate) fn power_heuristic(a: f64, b: f64) -> f64 {
+    let (a2, b2) = (a * a, b * b);
+    if !(a2 > 0.0) {
+        return 0.0;
+    }
+    if !b2.is_finite() {
+        return 0.0;
+    }
+    if !a2.is_finite() {
+        return 1.0;
+    }
+    a2 / (a2 + b2)
+}
+
+/// The path tracer as an [`Integrator`]; a work item is one camera sample, a chunk one pass over
+/// the image.
+#[derive(Debug, Clone)]
+pub struct PathTracer<'a> {
+    scene: &'a LightTracerScene<'a>,
+    settings: PathTracerSettings,
+    effects: Effects,
+}
+
+impl<'a> PathTracer<'a> {
+    /// The path tracer's [`Integrator::name`].
+    pub const NAME: &'static str = "path";
+
+    /// A path tracer of `scene`, following the `effects` decision (interreflection or not).
+    pub fn new(
+        scene: &'a LightTracerScene<'a>,
+        settings: PathTracerSettings,
+        effects: Effects,
+    ) -> Self {
+        Self { scene, settings, effects }
+    }
+
+    /// Pixels in the image: the work items of one pass (one chunk).
+    pub fn pass_samples(&self) -> u64 {
+        u64::from(self.scene.camera.width()) * u64::from(self.scene.camera.height())
+    }
+
+    /// The radiance estimate of one camera ray at the path's wavelengths, as XYZ.
+    fn sample_pixel(
+        &self,
+        px: u32,
+        py: u32,
+        rng: &mut dyn rand::Rng,
+        stats: &mut TraceStats,
+    ) -> Xyz {
+        let camera = self.scene.camera;
+        let u_film = [uniform(rng), uniform(rng)];
+        let direction = camera.direction(f64::from(px) + u_film[0], f64::from(py) + u_film[1]);
+        let ray = Ray { origin: camera.position(), direction };
+        let (mut lambdas, mut lambda_weights) = self.settings.wavelengths.sample_hero(uniform(rng));
+        let radiance = self.radiance(ray, &mut lambdas, &mut lambda_weights, rng, stats);
+        let mut xyz = Xyz::default();
+        let inv_y = 1.0 / *CIE_Y_INTEGRAL;
+        for j in 0..HERO {
+            if lambda_weights[j] > 0.0 && radiance[j] != 0.0 {
+                xyz += cmf(lambdas[j]) * (radiance[j] * lambda_weights[j] * inv_y);
+            }
+        }
+        xyz
+    }
+
+    /// Radiance arriving along `ray` at each of the path's wavelengths (spectral, W m^-2 sr^-1
+    /// nm^-1). A dispersive surface collapses the wavelengths to the hero (`lambda_weights[0]`
+    /// multiplied by [`HERO`], the others set to 0).
+    fn radiance(
+        &self,
+        mut ray: Ray,
+        lambdas: &mut [f64; HERO],
+        lambda_weights: &mut [f64; HERO],
+        rng: &mut dyn rand::Rng,
+        stats: &mut TraceStats,
+    ) -> [f64; HERO] {
+        let scene = self.scene;
+        let mut beta = [1.0; HERO];
+        let mut radiance = [0.0; HERO];
+        // The previous vertex and the density of the direction that left it, for MIS on
+        // emission; `specular` when it was a delta lobe (or the camera).
+        let mut prev_point = ray.origin;
+        let mut prev_pdf = 0.0;
+        let mut specular = true;
+        let mut depth = 0u32;
+        let mut last_bounce = false;
+        let mut collapsed = false;
+        while let Some(hit) = scene.world.intersect(&ray, f64::INFINITY) {
+            stats.hits += 1;
+            let wo = -ray.direction;
+            if let Some((light, le)) = scene.emitted(&hit, wo) {
+                let weight = if specular {
+                    1.0
+                } else {
+                    power_heuristic(prev_pdf, scene.emitter_pdf(prev_point, &hit))
+                };
+                if weight > 0.0
+                    && let Some(spd) = scene.light_spd(light)
+                {
+                    for j in 0..HERO {
+                        if beta[j] != 0.0 {
+                            radiance[j] += beta[j] * le * spd.value(lambdas[j]) * weight;
+                        }
+                    }
+                }
+            }
+            if last_bounce {
+                break;
+            }
+            let Some(material) = scene.materials.get(hit.primitive as usize) else { break };
+            let material: &dyn Material = material.as_ref();
+            if depth >= self.settings.max_depth {
+                stats.depth_limited += 1;
+                break;
+            }
+            if material.is_dispersive() && !collapsed {
+                // Directions now depend on the wavelength: the hero alone continues.
+                collapsed = true;
+                lambda_weights[0] *= HERO as f64;
+                for j in 1..HERO {
+                    lambda_weights[j] = 0.0;
+                    beta[j] = 0.0;
+                }
+            }
+            let non_specular = !material.is_specular();
+            if non_specular {
+                self.next_event(&hit, wo, material, lambdas, &beta, &mut radiance, rng, stats);
+                if !self.effects.continue_after_diffuse {
+                    // No light can come back to a non-specular surface by interreflection: only
+                    // an emitter seen by the BSDF-sampled ray remains (for MIS).
+                    last_bounce = true;
+                }
+            }
+            let u = [uniform(rng), uniform(rng), uniform(rng)];
+            let mut sampled: Option<(DVec3, ScatterKind, f64)> = None;
+            for j in 0..HERO {
+                if beta[j] == 0.0 {
+                    continue;
+                }
+                let incoming = Incoming {
+                    direction: ray.direction,
+                    normal: hit.shading_normal,
+                    lambda: lambdas[j],
+                };
+                match material.scatter_with(&incoming, u, Transport::Radiance) {
+                    Some(s) => match sampled {
+                        None => {
+                            sampled = Some((s.direction, s.kind, s.pdf));
+                            beta[j] *= s.weight;
+                        }
+                        Some((d, _, _)) if (s.direction - d).length_squared() < 1e-20 => {
+                            beta[j] *= s.weight;
+                        }
+                        Some(_) => beta[j] = 0.0,
+                    },
+                    None => beta[j] = 0.0,
+                }
+            }
+            let Some((direction, kind, pdf)) = sampled else { break };
+            specular = kind == ScatterKind::Specular;
+            prev_pdf = pdf;
+            prev_point = hit.point;
+            depth += 1;
+            if depth > self.settings.rr_depth && !last_bounce {
+                let survive = beta.iter().copied().fold(0.0, f64::max).min(1.0);
+                if !(uniform(rng) < survive) {
+                    stats.roulette_kills += 1;
+                    break;
+                }
+                for b in &mut beta {
+                    *b /= survive;
+                }
+            }
+            if beta.iter().all(|&b| b == 0.0) {
+                break;
+            }
+            ray = hit.spawn_ray(direction);
+        }
+        radiance
+    }
+
+    /// Next-event estimation at a non-specular `hit` seen from `wo`: one light sample, weighted
+    /// by the power heuristic against BSDF sampling, added to `radiance`.
+    #[allow(clippy::too_many_arguments)]
+    fn next_event(
+        &self,
+        hit: &Hit,
+        wo: DVec3,
+        material: &dyn Material,
+        lambdas: &[f64; HERO],
+        beta: &[f64; HERO],
+        radiance: &mut [f64; HERO],
+        rng: &mut dyn rand::Rng,
+        stats: &mut TraceStats,
+    ) {
+        let scene = self.scene;
+        let (id, pmf, u0) = scene.lights.sample_light(uniform(rng));
+        let u1 = uniform(rng);
+        let Some(light) = scene.lights.light(id) else { return };
+        let Some(sample) = light.sample_towards(hit.point, [u0, u1]) else { return };
+        if !(sample.intensity > 0.0 && pmf > 0.0 && sample.distance > 0.0) {
+            return;
+        }
+        let wi = -sample.direction;
+        let n = hit.shading_normal;
+        let cos = wi.dot(n).abs();
+        if !(cos > 0.0) {
+            return;
+        }
+        let weight = if sample.delta {
+            1.0
+        } else {
+            power_heuristic(pmf * sample.pdf, material.pdf(wo, wi, n, lambdas[0]))
+        };
+        if !(weight > 0.0) {
+            return;
+        }
+        let (shadow, distance) = hit.spawn_ray_to(sample.position);
+        // Stop short of the light's own surface.
+        if scene.world.occluded(&shadow, distance * (1.0 - 1e-9)) {
+            return;
+        }
+        stats.splats += 1;
+        let Some(spd) = scene.light_spd(id) else { return };
+        let g = sample.intensity * cos / (sample.distance * sample.distance * pmf) * weight;
+        for j in 0..HERO {
+            if beta[j] != 0.0 {
+                let f = material.eval(wi, wo, n, lambdas[j]);
+                if f > 0.0 {
+                    radiance[j] += beta[j] * f * g * spd.value(lambdas[j]);
+                }
+            }
+        }
+    }
+}
+
+impl Integrator for PathTracer<'_> {
+    fn name(&self) -> &'static str {
+        Self::NAME
+    }
+
+    fn resolution(&self) -> (u32, u32) {
+        (self.scene.camera.width(), self.scene.camera.height())
+    }
+
+    /// One pass: item `i` is a sample of pixel `i` (row-major); `samples` should be the image's
+    /// pixel count. The deadline is not looked at: a pass is never cut.
+    fn render_chunk(
+        &self,
+        seed: u64,
+        chunk: u64,
+        samples: u64,
+        _deadline: Option<Instant>,
+        film: &mut dyn Splat,
+    ) -> TraceStats {
+        let mut rng = chunk_rng(seed, chunk);
+        let mut stats = TraceStats::default();
+        let width = u64::from(self.scene.camera.width().max(1));
+        let pixels = self.pass_samples().max(1);
+        for i in 0..samples {
+            let p = i % pixels;
+            let (px, py) = ((p % width) as u32, (p / width) as u32);
+            let xyz = self.sample_pixel(px, py, &mut rng, &mut stats);
+            stats.beams += 1;
+            // A rejected (non-finite) sample is counted by the film, never added.
+            if xyz.x != 0.0 || xyz.y != 0.0 || xyz.z != 0.0 {
+                film.splat(px, py, xyz);
+            }
+        }
+        stats
+    }
+
+    fn image_scale(&self, samples_done: u64) -> f64 {
+        if samples_done == 0 { 0.0 } else { self.pass_samples() as f64 / samples_done as f64 }
+    }
+}
