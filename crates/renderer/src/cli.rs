@@ -21,7 +21,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use spectrace_tracer::EffectsMode;
+use spectrace_tracer::{EffectsMode, IntegratorChoice};
 
 use crate::{RenderOptions, merge_parts, render_file};
 
@@ -42,6 +42,14 @@ enum Command {
         /// Beams for the whole image (overrides settings.beams).
         #[arg(long, conflicts_with = "time", allow_negative_numbers = true, value_parser = parse_count)]
         beams: Option<u64>,
+        /// Camera samples per pixel for the camera integrators, path and bdpt (overrides
+        /// settings.spp).
+        #[arg(long, conflicts_with = "time", allow_negative_numbers = true, value_parser = parse_count)]
+        spp: Option<u64>,
+        /// The estimator: auto (the effects analysis chooses), light, path or bdpt (overrides
+        /// settings.integrator).
+        #[arg(long, value_parser = parse_integrator)]
+        integrator: Option<IntegratorChoice>,
         /// Render for this many seconds instead of a fixed number of beams.
         #[arg(long, allow_negative_numbers = true, value_parser = parse_seconds)]
         time: Option<f64>,
@@ -109,6 +117,12 @@ enum Command {
         #[arg(long, default_value = "out")]
         out: PathBuf,
     },
+}
+
+/// An integrator name.
+fn parse_integrator(s: &str) -> Result<IntegratorChoice, String> {
+    IntegratorChoice::from_name(s.trim())
+        .ok_or_else(|| format!("`{s}`: must be auto, light, path or bdpt"))
 }
 
 /// A whole number of at least 1 (beams).
@@ -227,8 +241,12 @@ where
             effects,
             quiet,
             restrict_paths,
+            spp,
+            integrator,
         } => {
             let options = RenderOptions {
+                spp,
+                integrator,
                 beams,
                 time,
                 threads,

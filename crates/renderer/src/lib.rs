@@ -21,8 +21,9 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 use spectrace_lights::LightSource;
 use spectrace_tracer::{
-    Effects, EffectsMode, Film, FilmError, Integrator, LightTracer, LightTracerScene, MemoryLimit,
-    RenderOutput, RenderPlan, TraceStats, image_scale, render,
+    Effects, EffectsMode, Film, FilmError, Integrator, IntegratorChoice, LightTracer,
+    LightTracerScene, MemoryLimit, PathTracer, RenderOutput, RenderPlan, TraceStats, image_scale,
+    render,
 };
 
 pub use files::{
@@ -32,7 +33,8 @@ pub use files::{
 pub use output::{EncodedImage, OUTPUT_BYTES_PER_PIXEL, encode_image, write_exr, write_png};
 pub use part::{PARTIAL_VERSION, PartialFilm};
 pub use scene::{
-    EffectsSettings, LoadOptions, Object, OutputSettings, Scene, SceneError, SceneFile, Settings,
+    DEFAULT_SPP, EffectsSettings, LoadOptions, Object, OutputSettings, Scene, SceneError,
+    SceneFile, Settings,
 };
 
 /// Command-line overrides of a scene's settings.
@@ -56,6 +58,10 @@ pub struct RenderOptions {
     pub verbose: bool,
     /// Refuse files (OBJ meshes) outside the scene file's folder (see [`LoadOptions`]).
     pub restrict_paths: bool,
+    /// The estimator (overrides `settings.integrator`).
+    pub integrator: Option<IntegratorChoice>,
+    /// Camera samples per pixel for `path` and `bdpt` (overrides `settings.spp`).
+    pub spp: Option<u64>,
 }
 
 /// Why a render failed.
@@ -93,9 +99,13 @@ pub struct RenderReport {
     pub effects: Effects,
     /// The decision in words.
     pub effects_summary: String,
-    /// The estimator that rendered the image ([`Integrator::name`]): `"light"`, the light tracer.
+    /// The estimator that rendered the image ([`Integrator::name`]): `"light"`, `"path"` or
+    /// `"bdpt"`.
     #[serde(default = "light_integrator")]
     pub integrator: String,
+    /// Why that estimator: asked for, or the effects analysis' reason.
+    #[serde(default)]
+    pub integrator_reason: String,
     /// Beams traced.
     pub beams: u64,
     /// Wall time (s).
@@ -137,6 +147,26 @@ pub const PROBE_BEAMS: u64 = 20_000;
 /// The tracer's view of a scene.
 pub fn tracer_scene(scene: &Scene) -> LightTracerScene<'_> {
     LightTracerScene::new(&scene.world, &scene.materials, &scene.lights, &scene.camera)
+        .with_emitters(scene.emitters.clone(), scene.object_shapes)
+}
+
+/// The estimator for a scene (with an optional override) and the reason, in words.
+pub fn choose_integrator(
+    scene: &Scene,
+    choice: Option<IntegratorChoice>,
+) -> (IntegratorChoice, String) {
+    let features = tracer_scene(scene).features(&scene.non_convex);
+    choice.unwrap_or(scene.settings.integrator).decide(&features)
+}
+
+/// What the film's sums are multiplied by, over the work items done, to make the image: the
+/// lights' power for the light tracer (items are beams), the pixel count for the camera
+/// integrators (items are camera samples, so the image is the mean per pixel).
+pub fn scale_numerator(integrator: IntegratorChoice, light_power: f64, pixels: u64) -> f64 {
+    match integrator {
+        IntegratorChoice::Path | IntegratorChoice::Bdpt => pixels as f64,
+        IntegratorChoice::Light | IntegratorChoice::Auto => light_power,
+    }
 }
 
 /// The effects decision for a scene (with an optional override).
@@ -150,6 +180,51 @@ pub fn decide_effects(scene: &Scene, mode: Option<EffectsMode>) -> Effects {
 /// # Errors
 /// [`RenderError::Options`] for zero beams, a non-positive time, or an invalid shard.
 pub fn plan_for(scene: &Scene, options: &RenderOptions) -> Result<RenderPlan, RenderError> {
+    let (integrator, _) = choose_integrator(scene, options.integrator);
+    plan_with(scene, options, integrator)
+}
+
+/// The plan for a given estimator. The light tracer's work items are beams (`--beams`,
+/// `settings.beams`, in chunks of `settings.chunk_beams`). A camera integrator's are camera
+/// samples in passes of one sample per pixel (a chunk is a pass): `--spp` / `settings.spp`
+/// passes, or with only `--beams N` given, `N / pixels` passes rounded up (the same number of
+/// paths).
+///
+/// # Errors
+/// As [`plan_for`].
+pub fn plan_with(
+    scene: &Scene,
+    options: &RenderOptions,
+    integrator: IntegratorChoice,
+) -> Result<RenderPlan, RenderError> {
+    let mut plan = plan_light(scene, options)?;
+    if matches!(integrator, IntegratorChoice::Path | IntegratorChoice::Bdpt) {
+        let pixels = u64::from(scene.camera.width()) * u64::from(scene.camera.height());
+        let pixels = pixels.max(1);
+        let spp = match (options.spp, options.beams) {
+            (Some(0), _) => {
+                return Err(RenderError::Options("--spp must be at least 1".to_owned()));
+            }
+            (Some(n), _) => n,
+            (None, Some(beams)) => beams.div_ceil(pixels),
+            (None, None) => scene.settings.spp,
+        };
+        plan.chunk_beams = pixels;
+        plan.beams = if options.time.is_some() && options.spp.is_none() && options.beams.is_none() {
+            (u64::MAX / 2 / pixels) * pixels
+        } else {
+            spp.checked_mul(pixels).ok_or_else(|| {
+                RenderError::Options(format!(
+                    "settings.spp / --spp = {spp}: {spp} samples of {pixels} pixels overflow"
+                ))
+            })?
+        };
+    }
+    Ok(plan)
+}
+
+/// The light tracer's plan after overrides.
+fn plan_light(scene: &Scene, options: &RenderOptions) -> Result<RenderPlan, RenderError> {
     let mut plan = scene.plan();
     if let Some(b) = options.beams {
         plan.beams = b;
@@ -315,6 +390,56 @@ pub fn probe(
     })
 }
 
+/// Checks, before a camera integrator renders, that the film is valid and fits in memory (as
+/// [`probe`] does for the light tracer).
+fn check_film(scene: &Scene, plan: &RenderPlan) -> Result<(), SceneError> {
+    let (width, height) = (scene.camera.width(), scene.camera.height());
+    let camera_error = |e: FilmError| SceneError::Scene {
+        path: scene.path.clone(),
+        field: "camera".to_owned(),
+        message: e.to_string(),
+    };
+    if u64::from(width) * u64::from(height) > spectrace_tracer::MAX_PIXELS {
+        return Err(camera_error(FilmError::InvalidSize(width, height)));
+    }
+    let system = MemoryLimit::system();
+    let writing = OUTPUT_BYTES_PER_PIXEL * u64::from(width) * u64::from(height);
+    let limit = MemoryLimit { bytes: system.bytes.saturating_sub(writing), ..system };
+    plan.check_memory(width, height, &limit).map_err(camera_error)?;
+    Ok(())
+}
+
+/// What a user should know about the chosen estimator: light a camera integrator cannot reach.
+fn integrator_warnings(scene: &Scene, choice: IntegratorChoice) -> Vec<String> {
+    let mut warnings = Vec::new();
+    if choice != IntegratorChoice::Path {
+        return warnings;
+    }
+    let features = tracer_scene(scene).features(&scene.non_convex);
+    if features.beam_only_lights + features.delta_direction_lights > 0 {
+        warnings.push(
+            "the path tracer cannot reach lasers, skies or lights that only generate beams: \
+             their light is missing from this image (use --integrator light or auto)"
+                .to_owned(),
+        );
+    }
+    if features.line_spectra {
+        warnings.push(
+            "the path tracer draws wavelengths from a density and misses spectral lines: \
+             their light is missing from this image (use --integrator light or auto)"
+                .to_owned(),
+        );
+    }
+    if features.delta_position_lights > 0 && features.specular {
+        warnings.push(
+            "the path tracer cannot see caustics of point or spot lights (their light through \
+             mirrors and glass onto other surfaces is missing; use --integrator light or auto)"
+                .to_owned(),
+        );
+    }
+    warnings
+}
+
 /// Renders a scene file with overrides and writes its outputs (or, with a shard, its partial film).
 ///
 /// # Errors
@@ -357,14 +482,31 @@ fn planned_outputs(
 /// # Errors
 /// As [`render_file`].
 pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderReport, RenderError> {
-    let plan = plan_for(scene, options)?;
+    let (choice, reason) = choose_integrator(scene, options.integrator);
+    let plan = plan_with(scene, options, choice)?;
     let name = scene.output_name();
     planned_outputs(&options.out_dir, &name, &scene.output, plan.shard, &scene.inputs)?;
     let effects = decide_effects(scene, options.effects);
     if options.verbose {
         eprintln!("{}", effects.summary());
+        eprintln!("integrator: {reason}");
     }
-    let probed = probe(scene, &effects, &plan)?;
+    let tracer_scene = tracer_scene(scene);
+    let light_tracer = LightTracer::new(&tracer_scene, scene.tracer_settings(), effects);
+    let path_tracer = PathTracer::new(&tracer_scene, scene.path_settings(), effects);
+    let tracer: &dyn Integrator = match choice {
+        IntegratorChoice::Path | IntegratorChoice::Bdpt => &path_tracer,
+        IntegratorChoice::Light | IntegratorChoice::Auto => &light_tracer,
+    };
+    let warnings = integrator_warnings(scene, choice);
+    // The light tracer's probe checks that light can reach the camera (for camera integrators a
+    // black image is reported after the render).
+    let probed = if tracer.name() == LightTracer::NAME {
+        probe(scene, &effects, &plan)?
+    } else {
+        check_film(scene, &plan)?;
+        ProbeOutcome { beams: 0, lit: false, seconds: 0.0 }
+    };
     if options.verbose && !probed.lit {
         eprintln!(
             "note: the pre-render probe ran out of time after {} beams without seeing light reach \
@@ -375,14 +517,14 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
     let bar = progress_bar(&plan, options.verbose);
     let started = Instant::now();
     let update = |done: u64| bar.set_position(done.min(bar.length().unwrap_or(u64::MAX)));
-    let tracer_scene = tracer_scene(scene);
-    let tracer = LightTracer::new(&tracer_scene, scene.tracer_settings(), effects);
-    let output =
-        render(&tracer, &plan, &update).map_err(|e| RenderError::Options(e.to_string()))?;
+    let output = render(tracer, &plan, &update).map_err(|e| RenderError::Options(e.to_string()))?;
+    let pixels = u64::from(scene.camera.width()) * u64::from(scene.camera.height());
+    let numerator = scale_numerator(choice, scene.lights.power(), pixels);
     bar.finish_and_clear();
     let wall = started.elapsed().as_secs_f64();
-    let make_report = |output: &RenderOutput, written: Written| {
-        report(
+    let make_report = |output: &RenderOutput, mut written: Written| {
+        written.warnings.append(&mut warnings.clone());
+        let mut r = report(
             scene.path.display().to_string(),
             (scene.camera.width(), scene.camera.height()),
             plan,
@@ -392,7 +534,9 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
             wall,
             scene.lights.power(),
             written,
-        )
+        );
+        r.integrator_reason = reason.clone();
+        r
     };
     if let Some((k, n)) = plan.shard {
         let path = options.out_dir.join(format!("{name}.part-{k}-of-{n}.bin"));
@@ -407,6 +551,7 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
             scene_path: scene.path.display().to_string(),
             plan: RenderPlan { shard: None, threads: 0, ..plan },
             light_power: scene.lights.power(),
+            integrator: choice,
             effects,
             output_settings: scene.output.clone(),
             name: name.clone(),
@@ -419,9 +564,14 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
             .map_err(|message| RenderError::File { path: path.clone(), message })?;
         return Ok(shard_report);
     }
-    let mut written =
-        write_outputs(&options.out_dir, &name, &scene.output, scene.lights.power(), &output)?;
-    if !probed.lit && output.film.accepted() == 0 {
+    let mut written = write_outputs(&options.out_dir, &name, &scene.output, numerator, &output)?;
+    if tracer.name() != LightTracer::NAME && output.film.accepted() == 0 {
+        written.warnings.push(format!(
+            "no light reached the camera: the image is black (none of the {} camera samples \
+             found light)",
+            output.beams
+        ));
+    } else if !probed.lit && output.film.accepted() == 0 {
         written.warnings.push(format!(
             "no light reached the camera: the image is black (the pre-render probe ran out of \
              time after {} beams, and none of the {} beams rendered lit a point the camera sees)",
@@ -470,6 +620,7 @@ fn report(
         effects,
         effects_summary: effects.summary(),
         integrator: integrator.to_owned(),
+        integrator_reason: String::new(),
         beams: output.beams,
         wall_seconds: wall,
         beams_per_second: if wall > 0.0 { output.beams as f64 / wall } else { 0.0 },
@@ -508,8 +659,10 @@ fn progress_bar(plan: &RenderPlan, visible: bool) -> indicatif::ProgressBar {
 }
 
 /// The final image of a render: XYZ per pixel in film units.
-pub fn image(output: &RenderOutput, light_power: f64) -> Vec<spectrace_spectrum::Xyz> {
-    output.film.to_xyz(image_scale(light_power, output.beams))
+/// `numerator` is the lights' power for the light tracer and the pixel count for camera
+/// integrators ([`scale_numerator`]).
+pub fn image(output: &RenderOutput, numerator: f64) -> Vec<spectrace_spectrum::Xyz> {
+    output.film.to_xyz(image_scale(numerator, output.beams))
 }
 
 /// Writes the EXR and PNG of a finished render (each to a temporary name, then renamed into
@@ -521,11 +674,11 @@ pub fn write_outputs(
     dir: &Path,
     name: &str,
     settings: &OutputSettings,
-    light_power: f64,
+    numerator: f64,
     output: &RenderOutput,
 ) -> Result<Written, RenderError> {
     let (w, h) = (output.film.width(), output.film.height());
-    let image = encode_image(output, light_power);
+    let image = encode_image(output, numerator);
     let mut written = Written {
         exr_scale_log2: image.scale_log2,
         out_of_range_values: image.out_of_range_values,
@@ -625,6 +778,8 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
             Some("effects decision")
         } else if part.name != first.name || part.output_settings != first.output_settings {
             Some("output settings")
+        } else if part.integrator != first.integrator {
+            Some("integrator")
         } else if part.light_power.to_bits() != first.light_power.to_bits() {
             Some("light power")
         } else if (part.output.film.width(), part.output.film.height()) != (w, h) {
@@ -671,16 +826,16 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
             )));
         }
     }
-    let written =
-        write_outputs(out_dir, &first.name, &first.output_settings, first.light_power, &merged)?;
+    let numerator =
+        scale_numerator(first.integrator, first.light_power, u64::from(w) * u64::from(h));
+    let written = write_outputs(out_dir, &first.name, &first.output_settings, numerator, &merged)?;
     let total_seconds: f64 = seconds.iter().sum();
     let mut report = report(
         first.scene_path.clone(),
         (w, h),
         first.plan,
         first.effects,
-        // Parts are written by the light tracer alone, so far.
-        LightTracer::NAME,
+        first.integrator.name(),
         &merged,
         seconds.iter().copied().fold(0.0, f64::max),
         first.light_power,

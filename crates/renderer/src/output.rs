@@ -128,9 +128,12 @@ fn exponent(x: f64) -> i64 {
     if biased == 0 { exponent(x * 2f64.powi(64)) - 64 } else { biased - 1023 }
 }
 
-/// The image of a finished render (light power over beams times the film), as the EXR stores it;
-/// see the module docs for the scaling of images beyond the range of 32-bit floats.
-pub fn encode_image(output: &RenderOutput, light_power: f64) -> EncodedImage {
+/// The image of a finished render (`numerator` over the work items done, times the film: the
+/// light power for the light tracer, the pixel count for camera integrators, see
+/// [`crate::scale_numerator`]), as the EXR stores it; see the module docs for the scaling of
+/// images beyond the range of 32-bit floats.
+pub fn encode_image(output: &RenderOutput, numerator: f64) -> EncodedImage {
+    let light_power = numerator;
     // `into_iter().map().collect()` reuses the XYZ allocation for the RGB (same layout): the
     // conversion needs 24 bytes per pixel, plus 12 for the f32 copy.
     let exact = output.film.to_xyz(image_scale(light_power, output.beams));

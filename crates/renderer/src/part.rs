@@ -11,7 +11,7 @@
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
-use spectrace_tracer::{Effects, RenderOutput, RenderPlan};
+use spectrace_tracer::{Effects, IntegratorChoice, RenderOutput, RenderPlan};
 
 use crate::OutputSettings;
 use crate::files::{MAX_PART_BYTES, check_output_name, read_bounded};
@@ -30,6 +30,8 @@ pub struct PartialFilm {
     pub plan: RenderPlan,
     /// Total power of the scene's lights (W), for the image's normalisation.
     pub light_power: f64,
+    /// The estimator that rendered the part (never `auto`): it decides the normalisation.
+    pub integrator: IntegratorChoice,
     /// The effects decision the parts were rendered with.
     pub effects: Effects,
     /// Output settings of the scene.
@@ -41,7 +43,7 @@ pub struct PartialFilm {
 }
 
 /// Current [`PartialFilm::version`].
-pub const PARTIAL_VERSION: u32 = 1;
+pub const PARTIAL_VERSION: u32 = 2;
 
 /// bincode's configuration for part files: the standard encoding, with every claimed length
 /// bounded by the file-size limit so a forged length cannot make the decoder reserve memory.

@@ -5,11 +5,16 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
+use spectrace_geometry::{Disk, Rectangle};
 use spectrace_geometry::{Shape, Transform, World};
+use spectrace_lights::{LightId, LightSurface};
 use spectrace_lights::{LightSet, LightSource};
+use spectrace_materials::Diffuse;
 use spectrace_materials::Material;
+use spectrace_spectrum::Reflectance;
 use spectrace_tracer::{
-    DEFAULT_CHUNK_BEAMS, EffectsMode, LightTracerSettings, MAX_DEPTH, PinholeCamera, RenderPlan,
+    DEFAULT_CHUNK_BEAMS, EffectsMode, Emitter, IntegratorChoice, LightTracerSettings, MAX_DEPTH,
+    PathTracerSettings, PinholeCamera, RenderPlan,
 };
 
 use crate::files::{MAX_SCENE_BYTES, check_output_name, read_bounded};
@@ -70,6 +75,11 @@ pub struct Settings {
     pub rr_depth: u32,
     /// Beams per work chunk (the unit of random streams and of sharding).
     pub chunk_beams: u64,
+    /// The estimator: `"auto"` (the effects analysis chooses), `"light"`, `"path"` or `"bdpt"`.
+    pub integrator: IntegratorChoice,
+    /// Camera samples per pixel for the camera integrators (`path`, `bdpt`); the upper limit
+    /// when `time_seconds` is set.
+    pub spp: u64,
 }
 
 impl Default for Settings {
@@ -82,9 +92,14 @@ impl Default for Settings {
             max_depth: 64,
             rr_depth: 4,
             chunk_beams: DEFAULT_CHUNK_BEAMS,
+            integrator: IntegratorChoice::Auto,
+            spp: DEFAULT_SPP,
         }
     }
 }
+
+/// Camera samples per pixel when a scene does not say (`settings.spp`).
+pub const DEFAULT_SPP: u64 = 64;
 
 /// The effects analysis' setting.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -182,6 +197,11 @@ pub struct Scene {
     /// Whether each shape can send light to itself (every shape but a flat one), for the
     /// effects analysis.
     pub non_convex: Vec<bool>,
+    /// What each shape emits (indexed like `materials`): the surfaces of area lights, which
+    /// follow the objects' shapes, and glowing objects.
+    pub emitters: Vec<Option<Emitter>>,
+    /// How many shapes are the scene's objects (the first ones; the rest are light surfaces).
+    pub object_shapes: usize,
     /// The lights.
     pub lights: LightSet,
     /// Render settings.
@@ -349,10 +369,31 @@ impl Scene {
             shapes.push(object.shape);
             materials.push(Arc::from(object.material));
         }
-        let world = World::with_base_dir(shapes, base)
-            .map_err(|e| scene_error("objects", e.to_string()))?;
         let lights =
             LightSet::new(file.lights).map_err(|e| scene_error("lights", e.to_string()))?;
+        // Area lights are part of the scene: their surfaces block light and camera paths, and
+        // camera paths that hit them see their radiance. They reflect nothing.
+        let object_shapes = shapes.len();
+        let mut emitters: Vec<Option<Emitter>> = vec![None; object_shapes];
+        for (index, light) in lights.lights().iter().enumerate() {
+            let Some(surface) = light.surface() else { continue };
+            let shape = match surface {
+                LightSurface::Rectangle { corner, edge_u, edge_v } => {
+                    Rectangle::new(corner, edge_u, edge_v).map(Shape::from)
+                }
+                LightSurface::Disk { center, normal, radius } => {
+                    Disk::new(center, normal, radius).map(Shape::from)
+                }
+                _ => continue,
+            }
+            .map_err(|e| scene_error(&format!("lights[{index}]"), e.to_string()))?;
+            shapes.push(shape);
+            materials.push(black().map_err(|e| scene_error(&format!("lights[{index}]"), e))?);
+            non_convex.push(false);
+            emitters.push(Some(Emitter::Light(LightId(index as u32))));
+        }
+        let world = World::with_base_dir(shapes, base)
+            .map_err(|e| scene_error("objects", e.to_string()))?;
         let canonical_json = serde_json::to_string(&value).unwrap_or_default();
         Ok(Self {
             path: path.to_owned(),
@@ -361,6 +402,8 @@ impl Scene {
             world,
             materials,
             non_convex,
+            emitters,
+            object_shapes,
             lights,
             settings: file.settings,
             effects: file.effects,
@@ -375,6 +418,16 @@ impl Scene {
     }
 
     /// The render plan from the settings, before command-line overrides.
+    /// The path tracer's settings.
+    pub fn path_settings(&self) -> PathTracerSettings {
+        PathTracerSettings {
+            max_depth: self.settings.max_depth,
+            rr_depth: self.settings.rr_depth,
+            ..PathTracerSettings::default()
+        }
+    }
+
+    /// The render plan of the scene's settings (light tracer work items: beams).
     pub fn plan(&self) -> RenderPlan {
         RenderPlan {
             beams: self.settings.beams,
@@ -407,6 +460,12 @@ impl Scene {
 
 /// The shape with `t` applied after its own transform (re-validated, since a curved shape only
 /// accepts similarities).
+/// The material of a light's own surface: it absorbs everything.
+fn black() -> Result<Arc<dyn Material>, String> {
+    let none = Reflectance::constant(0.0).map_err(|e| e.to_string())?;
+    Ok(Arc::new(Diffuse::new(none)))
+}
+
 fn apply_transform(shape: Shape, t: &Transform) -> Result<Shape, String> {
     let mut value = serde_json::to_value(&shape).map_err(|e| e.to_string())?;
     let own: Option<Transform> = match value.get("transform") {

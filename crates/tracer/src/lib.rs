@@ -24,7 +24,7 @@ mod render;
 mod wavelengths;
 
 pub use camera::{CameraError, CameraRepr, FovAxis, PinholeCamera, Projection};
-pub use effects::{BUNDLE, Effects, EffectsMode, SceneFeatures};
+pub use effects::{BUNDLE, Effects, EffectsMode, IntegratorChoice, SceneFeatures};
 pub use film::{ExactSum, Film, FilmError, FilmWriter, MAX_PIXELS, Splat};
 pub use integrator::{Integrator, LightTracer};
 pub use light_tracer::{

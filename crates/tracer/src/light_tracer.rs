@@ -243,6 +243,25 @@ impl<'a> LightTracerScene<'a> {
             light_spectra_vary: self.lights.lights().iter().any(|l| !l.uniform_spectrum()),
             ..SceneFeatures::default()
         };
+        for light in self.lights.lights() {
+            match light.flags() {
+                None => f.beam_only_lights += 1,
+                Some(flags) if flags.delta_direction => f.delta_direction_lights += 1,
+                Some(flags) if flags.delta_position => f.delta_position_lights += 1,
+                Some(_) => f.area_lights += 1,
+            }
+            let spd = light.spd();
+            let (lo, hi) = spd.range();
+            f.line_spectra |= !(hi > lo)
+                || (spectrace_spectrum::integrate_panels(
+                    &|l| spd.value(l),
+                    lo,
+                    hi,
+                    &spd.breakpoints(),
+                ) - 1.0)
+                    .abs()
+                    > 1e-6;
+        }
         for (i, m) in self.materials.iter().enumerate().take(self.object_shapes) {
             f.dispersive |= m.is_dispersive();
             if m.is_specular() {
