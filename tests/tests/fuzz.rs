@@ -18,7 +18,10 @@ use rand::{Rng, RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 use serde_json::Value;
 use spectrace_lights::LightSource;
-use spectrace_renderer::{PartialFilm, RenderOptions, Scene, encode_image, plan_for};
+use spectrace_renderer::{
+    PartialFilm, RenderOptions, Scene, encode_image, normalisation, plan_with, render_in_memory,
+};
+use spectrace_tracer::IntegratorChoice;
 use spectrace_tracer::render;
 
 /// Slowest acceptable case: loading plus a render of at most [`RENDER_BEAMS`] beams.
@@ -69,25 +72,38 @@ fn exercise_scene(text: &str) -> Reached {
     }
     let options =
         RenderOptions { beams: Some(RENDER_BEAMS), threads: Some(1), ..RenderOptions::default() };
-    let Ok(plan) = plan_for(&scene, &options) else { return Reached::Loaded };
+    let Ok(plan) = plan_with(&scene, &options, IntegratorChoice::Light) else {
+        return Reached::Loaded;
+    };
     let effects = spectrace_renderer::decide_effects(&scene, None);
     let tracer = spectrace_renderer::tracer_scene(&scene);
     let tracer = spectrace_tracer::LightTracer::new(&tracer, scene.tracer_settings(), effects);
-    if let Ok(output) = render(&tracer, &plan, &|_| {}) {
-        let image = encode_image(&output, scene.lights.power());
+    let Ok(output) = render(&tracer, &plan, &|_| {}) else { return Reached::Loaded };
+    let image =
+        encode_image(&output, normalisation(IntegratorChoice::Light, scene.lights.power(), 1));
+    assert!(
+        image.rgb.iter().flatten().all(|c| c.is_finite()),
+        "non-finite value in the encoded image"
+    );
+    // The estimator the effects analysis picks (the path tracer for most scenes) as well.
+    if let Ok(r) = render_in_memory(&scene, &RenderOptions { integrator: None, ..options }) {
+        let image =
+            encode_image(&r.output, normalisation(r.integrator, scene.lights.power(), pixels));
         assert!(
             image.rgb.iter().flatten().all(|c| c.is_finite()),
-            "non-finite value in the encoded image"
+            "non-finite value in the {} image",
+            r.integrator.name()
         );
-        return Reached::Rendered;
     }
-    Reached::Loaded
+    Reached::Rendered
 }
 
 /// Decodes part bytes; if they decode, the image they hold must encode to finite values.
 fn exercise_part(bytes: &[u8]) {
     if let Ok(part) = PartialFilm::decode(bytes) {
-        let image = encode_image(&part.output, part.light_power);
+        let (w, h) = (part.output.film.width(), part.output.film.height());
+        let norm = normalisation(part.integrator, part.light_power, u64::from(w) * u64::from(h));
+        let image = encode_image(&part.output, norm);
         assert!(image.rgb.iter().flatten().all(|c| c.is_finite()), "non-finite value");
     }
 }

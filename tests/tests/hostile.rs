@@ -27,6 +27,9 @@ fn options(out: &Path) -> RenderOptions {
         threads: Some(1),
         seed: Some(5),
         out_dir: out.to_owned(),
+        // These tests are about files and ranges; the light tracer's beams make the chunk
+        // counts they check.
+        integrator: Some(spectrace_tracer::IntegratorChoice::Light),
         ..RenderOptions::default()
     }
 }
@@ -119,10 +122,10 @@ fn outputs_never_replace_the_scene_a_mesh_or_a_part() {
 #[test]
 fn forged_lengths_and_endless_files_are_refused_without_allocating() {
     let dir = temp_dir("bounded");
-    // version 1, fingerprint 7, then a string whose length prefix claims 2^33 or 2^62 bytes
-    // (bincode's varint: 253 then 8 little-endian bytes).
+    // The current version, fingerprint 7, then a string whose length prefix claims 2^33 or 2^62
+    // bytes (bincode's varint: 253 then 8 little-endian bytes).
     for claimed in [1u64 << 33, 1 << 62, u64::MAX] {
-        let mut bytes = vec![1u8, 7, 253];
+        let mut bytes = vec![spectrace_renderer::PARTIAL_VERSION as u8, 7, 253];
         bytes.extend_from_slice(&claimed.to_le_bytes());
         bytes.extend_from_slice(b"scene.json");
         let e = PartialFilm::decode(&bytes).unwrap_err();

@@ -9,11 +9,11 @@ use spectrace_geometry::{Ray, Shape, World};
 use spectrace_lights::LightSource;
 use spectrace_materials::{Dielectric, Incoming, Material};
 use spectrace_renderer::{
-    PROBE_BEAMS, RenderOptions, Scene, decide_effects, merge_parts, plan_for, probe, render_scene,
+    PROBE_BEAMS, RenderOptions, Scene, decide_effects, merge_parts, plan_with, probe, render_scene,
     tracer_scene,
 };
 use spectrace_spectrum::{CIE_Y_INTEGRAL, SpectralPowerDistribution, Uniform, xyz_of};
-use spectrace_tracer::{Integrator, LightTracer, RenderOutput, render};
+use spectrace_tracer::{Integrator, IntegratorChoice, LightTracer, RenderOutput, render};
 
 /// A fresh, empty folder for one test's files (also used by the hostile-input tests).
 pub(crate) fn temp_dir(name: &str) -> PathBuf {
@@ -40,12 +40,15 @@ fn render_inline(
         threads: Some(threads),
         ..RenderOptions::default()
     };
-    let plan = plan_for(scene, &options).unwrap();
+    let plan = plan_with(scene, &options, IntegratorChoice::Light).unwrap();
     let effects = decide_effects(scene, None);
     let tracer_scene = tracer_scene(scene);
     let tracer = LightTracer::new(&tracer_scene, scene.tracer_settings(), effects);
     let output = render(&tracer, &plan, &|_| {}).unwrap();
-    let image = spectrace_renderer::image(&output, scene.lights.power());
+    let image = spectrace_renderer::image(
+        &output,
+        spectrace_renderer::normalisation(IntegratorChoice::Light, scene.lights.power(), 1),
+    );
     (output, image)
 }
 
@@ -280,6 +283,7 @@ fn sharded_renders_merge_bit_for_bit() {
         beams: Some(40_000),
         seed: Some(9),
         threads: Some(2),
+        integrator: Some(IntegratorChoice::Light),
         ..RenderOptions::default()
     };
     let whole =
@@ -665,7 +669,9 @@ fn a_closed_mirror_box_keeps_the_beam_count_and_the_time_budget() {
     // The probe stops at the first beam that lights the film (it used to trace 20,000 beams of
     // 8000 bounces: 55 s).
     let beams_100 = RenderOptions { beams: Some(100), out_dir: out.clone(), ..Default::default() };
-    let probed = probe(&inside, &effects, &plan_for(&inside, &beams_100).unwrap()).unwrap();
+    let probed =
+        probe(&inside, &effects, &plan_with(&inside, &beams_100, IntegratorChoice::Light).unwrap())
+            .unwrap();
     assert!(probed.lit);
     assert_eq!(probed.beams, 1);
     let started = std::time::Instant::now();
@@ -688,7 +694,7 @@ fn a_closed_mirror_box_keeps_the_beam_count_and_the_time_budget() {
     assert!(report.beams > 0 && report.beams < 16_384, "{}", report.beams);
     assert_eq!(report.stats.beams, report.beams);
     assert_eq!(report.stats.depth_limited, report.beams);
-    let plan = plan_for(&inside, &timed).unwrap();
+    let plan = plan_with(&inside, &timed, IntegratorChoice::Light).unwrap();
     let inside_scene = tracer_scene(&inside);
     let tracer = LightTracer::new(&inside_scene, inside.tracer_settings(), effects);
     let output = render(&tracer, &plan, &|_| {}).unwrap();
@@ -703,9 +709,11 @@ fn a_closed_mirror_box_keeps_the_beam_count_and_the_time_budget() {
     let started = std::time::Instant::now();
     let e = render_scene(&outside, &beams_100).unwrap_err().to_string();
     assert!(started.elapsed().as_secs_f64() < 30.0, "{:?}", started.elapsed());
-    assert!(e.contains("none of 100 probe beams"), "{e}");
+    assert!(e.contains("none of 100 probe paths"), "{e}");
     // ... and with a time budget it is inconclusive after a tenth of it, and the render goes on.
-    let probed = probe(&outside, &effects, &plan_for(&outside, &timed).unwrap()).unwrap();
+    let probed =
+        probe(&outside, &effects, &plan_with(&outside, &timed, IntegratorChoice::Light).unwrap())
+            .unwrap();
     assert!(!probed.lit);
     assert!(probed.beams > 0 && probed.beams < PROBE_BEAMS, "{}", probed.beams);
     assert!(probed.seconds < budget, "{} s", probed.seconds);

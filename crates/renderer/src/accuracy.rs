@@ -37,7 +37,8 @@ use spectrace_lights::LightSource;
 use spectrace_spectrum::{CieIlluminant, SpectralPowerDistribution, Xyz};
 use spectrace_tracer::{EffectsMode, LightTracer, render};
 
-use crate::{RenderOptions, Scene, decide_effects, image, plan_for, tracer_scene};
+use crate::{RenderOptions, Scene, decide_effects, image, normalisation, plan_with, tracer_scene};
+use spectrace_tracer::IntegratorChoice;
 
 /// Settings of an accuracy run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -464,7 +465,8 @@ fn render_xyz(
         effects: Some(mode),
         ..RenderOptions::default()
     };
-    let mut plan = plan_for(scene, &options).map_err(|e| e.to_string())?;
+    let mut plan =
+        plan_with(scene, &options, IntegratorChoice::Light).map_err(|e| e.to_string())?;
     // At least ~16 chunks per render, so small sweep points use every thread too; the chunk size
     // depends on the beams alone, so a cached reference stays valid whatever the thread count.
     plan.chunk_beams = (beams / 16).clamp(1, plan.chunk_beams.max(1024)).min(plan.chunk_beams);
@@ -476,7 +478,7 @@ fn render_xyz(
     let output = render(&tracer, &plan, &|_| {}).map_err(|e| e.to_string())?;
     let seconds = started.elapsed().as_secs_f64();
     scene.lights.reset_count();
-    Ok((image(&output, scene.lights.power()), seconds))
+    Ok((image(&output, normalisation(IntegratorChoice::Light, scene.lights.power(), 1)), seconds))
 }
 
 /// Relative RMSE of an XYZ image against a reference:

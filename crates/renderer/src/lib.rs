@@ -159,14 +159,33 @@ pub fn choose_integrator(
     choice.unwrap_or(scene.settings.integrator).decide(&features)
 }
 
-/// What the film's sums are multiplied by, over the work items done, to make the image: the
-/// lights' power for the light tracer (items are beams), the pixel count for the camera
-/// integrators (items are camera samples, so the image is the mean per pixel).
-pub fn scale_numerator(integrator: IntegratorChoice, light_power: f64, pixels: u64) -> f64 {
-    match integrator {
-        IntegratorChoice::Path | IntegratorChoice::Bdpt => pixels as f64,
-        IntegratorChoice::Light | IntegratorChoice::Auto => light_power,
+/// What turns a film's exact sums into the image: `light_power * factor / items`, where the
+/// items are the work items done (see [`normalisation`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Normalisation {
+    /// Total power of the lights (W): every integrator's film holds sums relative to it, so
+    /// that lights of any power keep the film's fixed point in range.
+    pub light_power: f64,
+    /// 1 for the light tracer (items are beams, each carrying `light_power / beams`); the pixel
+    /// count for camera integrators (items are camera samples: the image is the mean per pixel).
+    pub factor: f64,
+}
+
+impl Normalisation {
+    /// The factor for `items` work items (0 for none; may overflow to infinity, which
+    /// [`encode_image`] handles).
+    pub fn scale(&self, items: u64) -> f64 {
+        image_scale(self.light_power, items) * self.factor
     }
+}
+
+/// The normalisation of a render by `integrator` of an image of `pixels` pixels.
+pub fn normalisation(integrator: IntegratorChoice, light_power: f64, pixels: u64) -> Normalisation {
+    let factor = match integrator {
+        IntegratorChoice::Path | IntegratorChoice::Bdpt => pixels as f64,
+        IntegratorChoice::Light | IntegratorChoice::Auto => 1.0,
+    };
+    Normalisation { light_power, factor }
 }
 
 /// The effects decision for a scene (with an optional override).
@@ -325,6 +344,21 @@ pub fn probe(
     effects: &Effects,
     plan: &RenderPlan,
 ) -> Result<ProbeOutcome, SceneError> {
+    let tracer_scene = tracer_scene(scene);
+    let tracer = LightTracer::new(&tracer_scene, scene.tracer_settings(), *effects);
+    probe_with(scene, plan, &tracer)
+}
+
+/// [`probe`] with any estimator: its work items (beams, or camera samples spread over the
+/// image) are traced one per chunk until one puts visible light on the film.
+///
+/// # Errors
+/// As [`probe`].
+pub fn probe_with(
+    scene: &Scene,
+    plan: &RenderPlan,
+    tracer: &dyn Integrator,
+) -> Result<ProbeOutcome, SceneError> {
     let (width, height) = (scene.camera.width(), scene.camera.height());
     let camera_error = |e: FilmError| SceneError::Scene {
         path: scene.path.clone(),
@@ -352,8 +386,6 @@ pub fn probe(
         .ok()
         .and_then(|d| started.checked_add(d));
     let max_beams = PROBE_BEAMS.min(plan.beams).max(1);
-    let tracer_scene = tracer_scene(scene);
-    let tracer = LightTracer::new(&tracer_scene, scene.tracer_settings(), *effects);
     let mut sink = VisibleLight { width, height, lit: false };
     let mut stats = TraceStats::default();
     let mut timed_out = false;
@@ -381,32 +413,13 @@ pub fn probe(
         path: scene.path.clone(),
         field: "lights".to_owned(),
         message: format!(
-            "no light can reach the camera: none of {} probe beams lit a point the camera sees \
+            "no light can reach the camera: none of {} probe paths (beams or camera samples) lit a point the camera sees \
              with visible light ({} hit a surface, {} reached the film). Check that the lights face the \
              objects, that their spectra lie in 360-830 nm, that some surface is not a mirror or glass, and \
              that the camera looks at the lit objects.",
             stats.beams, stats.hits, stats.splats
         ),
     })
-}
-
-/// Checks, before a camera integrator renders, that the film is valid and fits in memory (as
-/// [`probe`] does for the light tracer).
-fn check_film(scene: &Scene, plan: &RenderPlan) -> Result<(), SceneError> {
-    let (width, height) = (scene.camera.width(), scene.camera.height());
-    let camera_error = |e: FilmError| SceneError::Scene {
-        path: scene.path.clone(),
-        field: "camera".to_owned(),
-        message: e.to_string(),
-    };
-    if u64::from(width) * u64::from(height) > spectrace_tracer::MAX_PIXELS {
-        return Err(camera_error(FilmError::InvalidSize(width, height)));
-    }
-    let system = MemoryLimit::system();
-    let writing = OUTPUT_BYTES_PER_PIXEL * u64::from(width) * u64::from(height);
-    let limit = MemoryLimit { bytes: system.bytes.saturating_sub(writing), ..system };
-    plan.check_memory(width, height, &limit).map_err(camera_error)?;
-    Ok(())
 }
 
 /// What a user should know about the chosen estimator: light a camera integrator cannot reach.
@@ -491,25 +504,80 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
         eprintln!("{}", effects.summary());
         eprintln!("integrator: {reason}");
     }
+    with_integrator(scene, choice, effects, |tracer| {
+        render_with(scene, options, choice, &reason, effects, plan, &name, tracer)
+    })
+}
+
+/// Runs `f` with the estimator `choice` for `scene`, following `effects`.
+pub fn with_integrator<R>(
+    scene: &Scene,
+    choice: IntegratorChoice,
+    effects: Effects,
+    f: impl FnOnce(&dyn Integrator) -> R,
+) -> R {
     let tracer_scene = tracer_scene(scene);
-    let light_tracer = LightTracer::new(&tracer_scene, scene.tracer_settings(), effects);
-    let path_tracer = PathTracer::new(&tracer_scene, scene.path_settings(), effects);
-    let tracer: &dyn Integrator = match choice {
-        IntegratorChoice::Path | IntegratorChoice::Bdpt => &path_tracer,
-        IntegratorChoice::Light | IntegratorChoice::Auto => &light_tracer,
-    };
+    match choice {
+        IntegratorChoice::Path | IntegratorChoice::Bdpt => {
+            f(&PathTracer::new(&tracer_scene, scene.path_settings(), effects))
+        }
+        IntegratorChoice::Light | IntegratorChoice::Auto => {
+            f(&LightTracer::new(&tracer_scene, scene.tracer_settings(), effects))
+        }
+    }
+}
+
+/// A render kept in memory: the film, the image and the estimator that made it.
+#[derive(Debug, Clone)]
+pub struct InMemoryRender {
+    /// The film and counters.
+    pub output: RenderOutput,
+    /// The image (XYZ per pixel, film units).
+    pub image: Vec<spectrace_spectrum::Xyz>,
+    /// The estimator.
+    pub integrator: IntegratorChoice,
+}
+
+/// Renders a scene with overrides without writing anything (no probe, no progress bar): for
+/// tests, benchmarks and the accuracy report.
+///
+/// # Errors
+/// [`RenderError::Options`] for invalid options or a film that cannot be made.
+pub fn render_in_memory(
+    scene: &Scene,
+    options: &RenderOptions,
+) -> Result<InMemoryRender, RenderError> {
+    let (choice, _) = choose_integrator(scene, options.integrator);
+    let plan = plan_with(scene, options, choice)?;
+    let effects = decide_effects(scene, options.effects);
+    let output = with_integrator(scene, choice, effects, |tracer| render(tracer, &plan, &|_| {}))
+        .map_err(|e| RenderError::Options(e.to_string()))?;
+    scene.lights.reset_count();
+    let pixels = u64::from(scene.camera.width()) * u64::from(scene.camera.height());
+    let image = image(&output, normalisation(choice, scene.lights.power(), pixels));
+    Ok(InMemoryRender { output, image, integrator: choice })
+}
+
+/// The rest of [`render_scene`], once the estimator is built.
+#[allow(clippy::too_many_arguments)]
+fn render_with(
+    scene: &Scene,
+    options: &RenderOptions,
+    choice: IntegratorChoice,
+    reason: &str,
+    effects: Effects,
+    plan: RenderPlan,
+    name: &str,
+    tracer: &dyn Integrator,
+) -> Result<RenderReport, RenderError> {
+    let name = name.to_owned();
     let warnings = integrator_warnings(scene, choice);
     // The light tracer's probe checks that light can reach the camera (for camera integrators a
     // black image is reported after the render).
-    let probed = if tracer.name() == LightTracer::NAME {
-        probe(scene, &effects, &plan)?
-    } else {
-        check_film(scene, &plan)?;
-        ProbeOutcome { beams: 0, lit: false, seconds: 0.0 }
-    };
+    let probed = probe_with(scene, &plan, tracer)?;
     if options.verbose && !probed.lit {
         eprintln!(
-            "note: the pre-render probe ran out of time after {} beams without seeing light reach \
+            "note: the pre-render probe ran out of time after {} paths without seeing light reach \
              the camera; rendering anyway",
             probed.beams
         );
@@ -519,7 +587,7 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
     let update = |done: u64| bar.set_position(done.min(bar.length().unwrap_or(u64::MAX)));
     let output = render(tracer, &plan, &update).map_err(|e| RenderError::Options(e.to_string()))?;
     let pixels = u64::from(scene.camera.width()) * u64::from(scene.camera.height());
-    let numerator = scale_numerator(choice, scene.lights.power(), pixels);
+    let numerator = normalisation(choice, scene.lights.power(), pixels);
     bar.finish_and_clear();
     let wall = started.elapsed().as_secs_f64();
     let make_report = |output: &RenderOutput, mut written: Written| {
@@ -535,7 +603,7 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
             scene.lights.power(),
             written,
         );
-        r.integrator_reason = reason.clone();
+        r.integrator_reason = reason.to_owned();
         r
     };
     if let Some((k, n)) = plan.shard {
@@ -565,16 +633,10 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
         return Ok(shard_report);
     }
     let mut written = write_outputs(&options.out_dir, &name, &scene.output, numerator, &output)?;
-    if tracer.name() != LightTracer::NAME && output.film.accepted() == 0 {
-        written.warnings.push(format!(
-            "no light reached the camera: the image is black (none of the {} camera samples \
-             found light)",
-            output.beams
-        ));
-    } else if !probed.lit && output.film.accepted() == 0 {
+    if !probed.lit && output.film.accepted() == 0 {
         written.warnings.push(format!(
             "no light reached the camera: the image is black (the pre-render probe ran out of \
-             time after {} beams, and none of the {} beams rendered lit a point the camera sees)",
+             time after {} paths, and none of the {} paths rendered lit a point the camera sees)",
             probed.beams, output.beams
         ));
     }
@@ -659,10 +721,8 @@ fn progress_bar(plan: &RenderPlan, visible: bool) -> indicatif::ProgressBar {
 }
 
 /// The final image of a render: XYZ per pixel in film units.
-/// `numerator` is the lights' power for the light tracer and the pixel count for camera
-/// integrators ([`scale_numerator`]).
-pub fn image(output: &RenderOutput, numerator: f64) -> Vec<spectrace_spectrum::Xyz> {
-    output.film.to_xyz(image_scale(numerator, output.beams))
+pub fn image(output: &RenderOutput, norm: Normalisation) -> Vec<spectrace_spectrum::Xyz> {
+    output.film.to_xyz(norm.scale(output.beams))
 }
 
 /// Writes the EXR and PNG of a finished render (each to a temporary name, then renamed into
@@ -674,7 +734,7 @@ pub fn write_outputs(
     dir: &Path,
     name: &str,
     settings: &OutputSettings,
-    numerator: f64,
+    numerator: Normalisation,
     output: &RenderOutput,
 ) -> Result<Written, RenderError> {
     let (w, h) = (output.film.width(), output.film.height());
@@ -826,8 +886,7 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
             )));
         }
     }
-    let numerator =
-        scale_numerator(first.integrator, first.light_power, u64::from(w) * u64::from(h));
+    let numerator = normalisation(first.integrator, first.light_power, u64::from(w) * u64::from(h));
     let written = write_outputs(out_dir, &first.name, &first.output_settings, numerator, &merged)?;
     let total_seconds: f64 = seconds.iter().sum();
     let mut report = report(

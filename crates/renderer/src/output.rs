@@ -11,7 +11,9 @@
 use std::path::Path;
 
 use spectrace_spectrum::srgb_encode;
-use spectrace_tracer::{RenderOutput, image_scale};
+use spectrace_tracer::RenderOutput;
+
+use crate::Normalisation;
 
 /// Writes a linear EXR (32-bit float R, G, B; ZIP compression, scan lines in increasing order,
 /// written sequentially so the same image always gives the same bytes) of values stored
@@ -128,15 +130,14 @@ fn exponent(x: f64) -> i64 {
     if biased == 0 { exponent(x * 2f64.powi(64)) - 64 } else { biased - 1023 }
 }
 
-/// The image of a finished render (`numerator` over the work items done, times the film: the
-/// light power for the light tracer, the pixel count for camera integrators, see
-/// [`crate::scale_numerator`]), as the EXR stores it; see the module docs for the scaling of
-/// images beyond the range of 32-bit floats.
-pub fn encode_image(output: &RenderOutput, numerator: f64) -> EncodedImage {
-    let light_power = numerator;
+/// The image of a finished render (the film times [`Normalisation::scale`] of the work items
+/// done), as the EXR stores it; see the module docs for the scaling of images beyond the range of
+/// 32-bit floats.
+pub fn encode_image(output: &RenderOutput, norm: Normalisation) -> EncodedImage {
+    let Normalisation { light_power, factor } = norm;
     // `into_iter().map().collect()` reuses the XYZ allocation for the RGB (same layout): the
     // conversion needs 24 bytes per pixel, plus 12 for the f32 copy.
-    let exact = output.film.to_xyz(image_scale(light_power, output.beams));
+    let exact = output.film.to_xyz(norm.scale(output.beams));
     let rgb: Vec<[f64; 3]> = exact.into_iter().map(|p| p.to_linear_srgb()).collect();
     let largest =
         rgb.iter().flatten().try_fold(0.0f64, |m, &c| c.is_finite().then(|| m.max(c.abs())));
@@ -150,7 +151,7 @@ pub fn encode_image(output: &RenderOutput, numerator: f64) -> EncodedImage {
     // Recompute without overflow: the power's mantissa over the beams, then powers of two.
     let beams = output.beams.max(1) as f64;
     let power_exp = if light_power > 0.0 { exponent(light_power) } else { 0 };
-    let base = ldexp(light_power, -power_exp) / beams;
+    let base = ldexp(light_power, -power_exp) / beams * factor;
     let rgb: Vec<[f64; 3]> =
         output.film.to_xyz(base).into_iter().map(|p| p.to_linear_srgb()).collect();
     let largest = rgb.iter().flatten().fold(0.0f64, |m, &c| m.max(c.abs()));

@@ -18,8 +18,9 @@
 //! - After `rr_depth` bounces, Russian roulette with survival `min(1, max_j beta_j)`.
 //!
 //! The film holds the sum of the samples' XYZ (`sum_j cmf(lambda_j) L_j / (HERO p(lambda_j))`,
-//! divided by the integral of `ybar`, as the light tracer's units); [`Integrator::image_scale`]
-//! divides by the samples per pixel.
+//! divided by the integral of `ybar`, as the light tracer's units) relative to the lights' total
+//! power; [`Integrator::image_scale`] multiplies by the power and divides by the samples per
+//! pixel.
 //!
 //! # Work items and determinism
 //! A work item is one camera sample; a chunk is one *pass*: one sample of every pixel, in pixel
@@ -37,7 +38,7 @@ use std::time::Instant;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use spectrace_geometry::{Hit, Ray};
-use spectrace_lights::uniform;
+use spectrace_lights::{LightSource, uniform};
 use spectrace_materials::{Incoming, Material, ScatterKind, Transport};
 use spectrace_spectrum::{CIE_Y_INTEGRAL, Xyz, cmf};
 
@@ -120,7 +121,8 @@ impl<'a> PathTracer<'a> {
         let (mut lambdas, mut lambda_weights) = self.settings.wavelengths.sample_hero(uniform(rng));
         let radiance = self.radiance(ray, &mut lambdas, &mut lambda_weights, rng, stats);
         let mut xyz = Xyz::default();
-        let inv_y = 1.0 / *CIE_Y_INTEGRAL;
+        // The film holds radiance relative to the lights' total power (see `image_scale`).
+        let inv_y = 1.0 / (*CIE_Y_INTEGRAL * self.scene.lights.power());
         for j in 0..HERO {
             if lambda_weights[j] > 0.0 && radiance[j] != 0.0 {
                 xyz += cmf(lambdas[j]) * (radiance[j] * lambda_weights[j] * inv_y);
@@ -300,6 +302,12 @@ impl<'a> PathTracer<'a> {
     }
 }
 
+/// The pixel a pass starts at: the chunk index scrambled (a Fibonacci hash), so that passes of
+/// one sample spread over the image.
+pub(crate) fn pass_start(chunk: u64, pixels: u64) -> u64 {
+    chunk.wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(32) % pixels.max(1)
+}
+
 impl Integrator for PathTracer<'_> {
     fn name(&self) -> &'static str {
         Self::NAME
@@ -309,8 +317,10 @@ impl Integrator for PathTracer<'_> {
         (self.scene.camera.width(), self.scene.camera.height())
     }
 
-    /// One pass: item `i` is a sample of pixel `i` (row-major); `samples` should be the image's
-    /// pixel count. The deadline is not looked at: a pass is never cut.
+    /// One pass: item `i` is a sample of pixel `(i + pass_start(chunk)) mod pixels`
+    /// (row-major), so a whole pass (`samples` = the pixel count) samples every pixel once, and
+    /// chunks of one item (the pre-render probe) spread over the image. The deadline is not
+    /// looked at: a pass is never cut.
     fn render_chunk(
         &self,
         seed: u64,
@@ -323,8 +333,9 @@ impl Integrator for PathTracer<'_> {
         let mut stats = TraceStats::default();
         let width = u64::from(self.scene.camera.width().max(1));
         let pixels = self.pass_samples().max(1);
+        let start = pass_start(chunk, pixels);
         for i in 0..samples {
-            let p = i % pixels;
+            let p = (i + start) % pixels;
             let (px, py) = ((p % width) as u32, (p / width) as u32);
             let xyz = self.sample_pixel(px, py, &mut rng, &mut stats);
             stats.beams += 1;
@@ -336,7 +347,14 @@ impl Integrator for PathTracer<'_> {
         stats
     }
 
+    /// The lights' power times the pixels over the samples: the film holds each sample's
+    /// radiance divided by the lights' total power (so that lights of any power keep the exact
+    /// film in range), and the image is the mean per pixel.
     fn image_scale(&self, samples_done: u64) -> f64 {
-        if samples_done == 0 { 0.0 } else { self.pass_samples() as f64 / samples_done as f64 }
+        if samples_done == 0 {
+            0.0
+        } else {
+            self.scene.lights.power() * self.pass_samples() as f64 / samples_done as f64
+        }
     }
 }
