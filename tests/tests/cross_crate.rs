@@ -3,6 +3,7 @@
 
 mod fuzz;
 mod hostile;
+mod integrators;
 mod rendering;
 
 use rand::SeedableRng;

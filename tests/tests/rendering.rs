@@ -23,7 +23,7 @@ pub(crate) fn temp_dir(name: &str) -> PathBuf {
     dir
 }
 
-fn scene(json: &str) -> Scene {
+pub(crate) fn scene(json: &str) -> Scene {
     Scene::from_json(json, Path::new("inline.json")).unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -52,13 +52,31 @@ fn render_inline(
     (output, image)
 }
 
+/// Renders in memory with `integrator` and `effort` paths (beams, or camera samples: `effort /
+/// pixels` per pixel, rounded up), 2 threads.
+pub(crate) fn render_with(
+    scene: &Scene,
+    integrator: IntegratorChoice,
+    effort: u64,
+    seed: u64,
+) -> spectrace_renderer::InMemoryRender {
+    let options = RenderOptions {
+        beams: Some(effort),
+        seed: Some(seed),
+        threads: Some(2),
+        integrator: Some(integrator),
+        ..RenderOptions::default()
+    };
+    spectrace_renderer::render_in_memory(scene, &options).unwrap()
+}
+
 /// Y of a constant total radiance `l` (W m^-2 sr^-1) with the spectrum of `spd`, in film units.
-fn y_of_radiance(l: f64, spd: &dyn SpectralPowerDistribution) -> f64 {
+pub(crate) fn y_of_radiance(l: f64, spd: &dyn SpectralPowerDistribution) -> f64 {
     l * xyz_of(spd).y / *CIE_Y_INTEGRAL
 }
 
 /// Mean and standard error, over seeds, of the Y of every block of `b x b` pixels.
-fn block_stats(
+pub(crate) fn block_stats(
     images: &[Vec<spectrace_spectrum::Xyz>],
     w: usize,
     h: usize,
@@ -96,9 +114,20 @@ fn block_stats(
 /// with probability 0.3%), plus 0.2% for evaluating the closed form at 4 points per pixel
 /// instead of integrating it.
 fn assert_lit_plane_matches(s: &Scene, first_seed: u64, cos_at: impl Fn(DVec3) -> f64) {
+    assert_lit_plane_matches_with(s, IntegratorChoice::Light, 100_000, first_seed, cos_at);
+}
+
+/// [`assert_lit_plane_matches`] with any estimator, `effort` beams (or camera paths) per seed.
+pub(crate) fn assert_lit_plane_matches_with(
+    s: &Scene,
+    integrator: IntegratorChoice,
+    effort: u64,
+    first_seed: u64,
+    cos_at: impl Fn(DVec3) -> f64,
+) {
     let spd = Uniform::new(400.0, 700.0).unwrap();
     let images: Vec<_> =
-        (0..16).map(|seed| render_inline(s, 100_000, first_seed + seed, 2).1).collect();
+        (0..16).map(|seed| render_with(s, integrator, effort, first_seed + seed).image).collect();
     let (w, h, b) = (32usize, 32usize, 8usize);
     let intensity = 100.0 / (4.0 * std::f64::consts::PI);
     let analytic_pixel = |px: f64, py: f64| {
@@ -127,9 +156,9 @@ fn assert_lit_plane_matches(s: &Scene, first_seed: u64, cos_at: impl Fn(DVec3) -
 }
 
 /// The point light of the lit-plane scenes: outside the view, so it is not in the image itself.
-const PLANE_LIGHT: DVec3 = DVec3::new(2.2, 1.0, 0.2);
+pub(crate) const PLANE_LIGHT: DVec3 = DVec3::new(2.2, 1.0, 0.2);
 
-const POINT_OVER_PLANE: &str = r#"{
+pub(crate) const POINT_OVER_PLANE: &str = r#"{
   "camera": {"position": [0, 3, 0.001], "look_at": [0, 0, 0], "up": [0, 0, -1], "fov": 60, "width": 32, "height": 32},
   "objects": [{"shape": {"type": "Rectangle", "corner": [-3, 0, 3], "edge_u": [6, 0, 0], "edge_v": [0, 0, -6]},
                "material": {"type": "Diffuse", "reflectance": 0.5}}],
@@ -399,7 +428,7 @@ fn every_shipped_scene_renders_without_rejected_contributions() {
 }
 
 /// The six walls of the closed box [-1, 1]^3 as scene objects, all of `material` (JSON).
-fn box_walls(material: &str) -> [String; 6] {
+pub(crate) fn box_walls(material: &str) -> [String; 6] {
     let wall = |corner: [f64; 3], u: [f64; 3], v: [f64; 3]| {
         format!(
             r#"{{"shape": {{"type": "Rectangle", "corner": {corner:?}, "edge_u": {u:?}, "edge_v": {v:?}}}, "material": {material}}}"#
