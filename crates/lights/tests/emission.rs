@@ -187,12 +187,15 @@ fn two_sample_p(a: &[f64], b: &[f64]) -> f64 {
     chi_square_sf(statistic, bins.saturating_sub(1).max(1) as f64)
 }
 
+/// A number computed from fixed axes, an origin and a direction.
+type Feature = fn(&[DVec3; 3], DVec3, DVec3) -> f64;
+
 #[test]
 fn sample_emission_draws_the_beams_distribution() {
     // Projections of origin and direction on fixed generic axes, and a mixed one, so that
     // position, direction and their pairing are all compared.
     let axes = [v(0.3, 0.8, -0.5).normalize(), v(-0.7, 0.2, 0.6).normalize(), v(0.1, -0.4, 0.9)];
-    let features: [(&str, fn(&[DVec3; 3], DVec3, DVec3) -> f64); 6] = [
+    let features: [(&str, Feature); 6] = [
         ("origin . a", |a, o, _| o.dot(a[0])),
         ("origin . b", |a, o, _| o.dot(a[1])),
         ("direction . a", |a, _, d| d.dot(a[0])),
