@@ -46,7 +46,7 @@ pub use mesh::{MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_OBJ_BYTES, Mesh};
 pub use prism::Prism;
 pub use ray::{Hit, Ray};
 pub use rectangle::Rectangle;
-pub use shape::Shape;
+pub use shape::{Shape, SurfacePoint};
 pub use sphere::Sphere;
 pub use torus::Torus;
 pub use transform::Transform;
