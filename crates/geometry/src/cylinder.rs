@@ -27,7 +27,7 @@ use crate::disk::circle_extent;
 use crate::float::{
     Frame, finite_point, gamma, positive, safe_length, stable_quadratic_roots, unit_direction,
 };
-use crate::shape::{Primitives, similarity};
+use crate::shape::{Primitives, SurfacePoint, similarity};
 use crate::{Bounds, GeometryError, Hit, Ray, Transform};
 
 /// An open cylinder.
@@ -107,6 +107,21 @@ impl Cylinder {
         radius: f64,
     ) -> Result<Self, GeometryError> {
         CylinderRepr { center, axis, height: Some(height), radius, transform: None }.try_into()
+    }
+
+    /// Area of the side `2 pi r h` (m^2; the cylinder is open).
+    pub(crate) fn area(&self) -> f64 {
+        2.0 * PI * self.radius * self.height
+    }
+
+    /// A point uniform by area on the side (height `u0 h`, angle `2 pi u1`: the side unrolls to
+    /// a rectangle), from uniforms already in `[0, 1)`; normal away from the axis.
+    pub(crate) fn sample_area(&self, u: [f64; 3]) -> SurfacePoint {
+        let fr = &self.frame;
+        let phi = 2.0 * PI * u[1];
+        let n = (fr.u * phi.cos() + fr.v * phi.sin()).normalize();
+        let point = self.center + fr.n * (u[0] * self.height) + n * self.radius;
+        SurfacePoint { point, normal: n }
     }
 }
 

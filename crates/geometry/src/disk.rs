@@ -21,7 +21,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::float::{Frame, finite_point, positive, unit_direction};
 use crate::rectangle::plane_hit;
-use crate::shape::{Primitives, similarity};
+use crate::shape::{Primitives, SurfacePoint, similarity};
 use crate::{Bounds, GeometryError, Hit, Ray, Transform};
 
 /// A disk.
@@ -79,6 +79,20 @@ impl Disk {
     /// Unit normal.
     pub fn normal(&self) -> DVec3 {
         self.frame.n
+    }
+
+    /// Area `pi r^2` (m^2).
+    pub(crate) fn area(&self) -> f64 {
+        PI * self.radius * self.radius
+    }
+
+    /// A point uniform by area (`rho = r sqrt(u0)`, angle `2 pi u1`), from uniforms already in
+    /// `[0, 1)`; normal the front face's.
+    pub(crate) fn sample_area(&self, u: [f64; 3]) -> SurfacePoint {
+        let rho = self.radius * u[0].sqrt();
+        let phi = 2.0 * PI * u[1];
+        let offset = self.frame.world(DVec3::new(rho * phi.cos(), rho * phi.sin(), 0.0));
+        SurfacePoint { point: self.center + offset, normal: self.frame.n }
     }
 }
 

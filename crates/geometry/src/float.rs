@@ -122,3 +122,12 @@ pub(crate) fn stable_quadratic_roots(a: f64, b: f64, c: f64, disc: f64) -> (f64,
     let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (c / q, q / a) };
     if t0 <= t1 { (t0, t1) } else { (t1, t0) }
 }
+
+/// The largest f64 below 1 (`1 - 2^-53`).
+const ONE_MINUS_EPSILON: f64 = 1.0 - f64::EPSILON / 2.0;
+
+/// A uniform variate clamped into `[0, 1)`: NaN and negative values become 0, values `>= 1`
+/// become `1 - 2^-53`; values already in `[0, 1)` are unchanged. Never panics.
+pub(crate) fn unit_uniform(u: f64) -> f64 {
+    if u >= 0.0 { u.min(ONE_MINUS_EPSILON) } else { 0.0 }
+}

@@ -19,6 +19,10 @@
 //! boxes rounded outwards from the exact f64 bounds; traversal is done here in f64, so the BVH can
 //! only cost time, never a hit.
 //!
+//! For emitting objects, [`Shape::area`] and [`Shape::sample_area`] draw a [`SurfacePoint`]
+//! uniformly by area on any shape (the torus by inverting its tube-angle CDF, meshes by a
+//! cumulative-area table built with the mesh).
+//!
 //! Layering: this crate depends on none of Spectrace's crates.
 
 mod bounds;
@@ -46,7 +50,7 @@ pub use mesh::{MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_OBJ_BYTES, Mesh};
 pub use prism::Prism;
 pub use ray::{Hit, Ray};
 pub use rectangle::Rectangle;
-pub use shape::Shape;
+pub use shape::{Shape, SurfacePoint};
 pub use sphere::Sphere;
 pub use torus::Torus;
 pub use transform::Transform;

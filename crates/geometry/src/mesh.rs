@@ -30,8 +30,8 @@ use std::sync::Arc;
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
-use crate::float::gamma;
-use crate::shape::Primitives;
+use crate::float::{gamma, safe_length};
+use crate::shape::{Primitives, SurfacePoint};
 use crate::{Bounds, GeometryError, Hit, Ray, Transform};
 
 /// The world-space data of a loaded mesh.
@@ -41,6 +41,9 @@ struct MeshData {
     triangles: Vec<[u32; 3]>,
     normals: Option<Vec<DVec3>>,
     uvs: Option<Vec<DVec2>>,
+    /// Running sums of the triangles' areas (`cumulative_area[i]` = area of triangles `0..=i`),
+    /// built once with the mesh, for sampling a triangle by area with a binary search.
+    cumulative_area: Vec<f64>,
 }
 
 /// A triangle mesh. One given by an OBJ path is loaded by [`Mesh::load`] (or
@@ -182,7 +185,38 @@ fn build(
             tri.swap(1, 2);
         }
     }
-    Ok(MeshData { positions, triangles, normals, uvs })
+    let cumulative_area = triangles
+        .iter()
+        .scan(0.0, |sum, tri| {
+            *sum += triangle_area(tri.map(|i| positions[i as usize]));
+            Some(*sum)
+        })
+        .collect();
+    Ok(MeshData { positions, triangles, normals, uvs, cumulative_area })
+}
+
+/// Area of a triangle (m^2): `|(p1 - p0) x (p2 - p0)| / 2`, the length taken without overflow in
+/// its squares; `+inf` if it does not fit in an f64, 0 for a degenerate triangle.
+fn triangle_area(p: [DVec3; 3]) -> f64 {
+    let area = 0.5 * safe_length((p[1] - p[0]).cross(p[2] - p[0]));
+    if area.is_nan() { f64::INFINITY } else { area }
+}
+
+/// The unit geometric normal of a triangle as [`Mesh`]'s hits report it,
+/// `normalize((p1 - p0) x (p2 - p0))`; computed from the edges scaled to unit size when the cross
+/// product over- or underflows, and `+z` for a degenerate triangle (which no ray hits).
+fn triangle_normal(p: [DVec3; 3]) -> DVec3 {
+    let n = (p[1] - p[0]).cross(p[2] - p[0]);
+    let len = n.length();
+    if len > 0.0 && len.is_finite() {
+        return n / len;
+    }
+    let scaled = |e: DVec3| {
+        let m = e.abs().max_element();
+        if m > 0.0 && m.is_finite() { e / m } else { e }
+    };
+    let n = scaled(p[1] - p[0]).cross(scaled(p[2] - p[0])).normalize_or_zero();
+    if n == DVec3::ZERO || !n.is_finite() { DVec3::Z } else { n }
 }
 
 /// The largest OBJ file [`Mesh::load`] reads: 1 GiB. A longer file, or a device that never ends,
@@ -331,6 +365,43 @@ impl Mesh {
     /// Vertex indices of each triangle (empty until loaded).
     pub fn triangles(&self) -> &[[u32; 3]] {
         self.data.as_ref().map_or(&[], |d| &d.triangles)
+    }
+
+    /// Total area of the triangles (m^2): 0 until loaded or if every triangle is degenerate,
+    /// `+inf` if it exceeds `f64::MAX`.
+    pub(crate) fn area(&self) -> f64 {
+        self.data.as_ref().and_then(|d| d.cumulative_area.last().copied()).unwrap_or(0.0)
+    }
+
+    /// A point uniform by area, from uniforms already in `[0, 1)`: the triangle by area (`u0`,
+    /// binary search of the cumulative areas; zero-area triangles are never chosen), then the
+    /// square-root warp on it (`u1`, `u2`); normal the triangle's geometric one. A mesh of zero
+    /// or infinite total area picks its triangle uniformly instead; an unloaded one gives the
+    /// origin.
+    pub(crate) fn sample_area(&self, u: [f64; 3]) -> SurfacePoint {
+        let Some(d) = self.data.as_ref() else {
+            return SurfacePoint { point: DVec3::ZERO, normal: DVec3::Z };
+        };
+        let cumulative = &d.cumulative_area;
+        let count = cumulative.len();
+        let total = cumulative.last().copied().unwrap_or(0.0);
+        let index = if total > 0.0 && total.is_finite() {
+            let x = u[0] * total;
+            let i = cumulative.partition_point(|&c| c <= x);
+            // `u0 * total` may round up to `total`: take the last triangle of non-zero area.
+            if i < count { i } else { cumulative.partition_point(|&c| c < total) }
+        } else {
+            (u[0] * count as f64) as usize
+        };
+        let index = index.min(count.saturating_sub(1));
+        let Some(tri) = d.triangles.get(index) else {
+            return SurfacePoint { point: DVec3::ZERO, normal: DVec3::Z };
+        };
+        let p = tri.map(|i| d.positions[i as usize]);
+        let su = u[1].sqrt();
+        let (b1, b2) = (su * (1.0 - u[2]), su * u[2]);
+        let point = p[0] * (1.0 - su) + p[1] * b1 + p[2] * b2;
+        SurfacePoint { point, normal: triangle_normal(p) }
     }
 
     /// The three vertices of triangle `index`.

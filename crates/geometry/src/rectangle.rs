@@ -23,7 +23,7 @@ use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 use crate::float::{finite_point, gamma, safe_length, unit_direction};
-use crate::shape::Primitives;
+use crate::shape::{Primitives, SurfacePoint};
 use crate::{Bounds, GeometryError, Hit, Ray, Transform};
 
 /// A parallelogram (a rectangle when the edges are perpendicular).
@@ -36,6 +36,7 @@ pub struct Rectangle {
     normal: DVec3,
     dual_u: DVec3,
     dual_v: DVec3,
+    area: f64,
     repr: Box<RectangleRepr>,
 }
 
@@ -86,6 +87,7 @@ impl TryFrom<RectangleRepr> for Rectangle {
             normal: f.normal,
             dual_u: f.unit_v.cross(f.normal) / (f.len_u * f.sin),
             dual_v: f.normal.cross(f.unit_u) / (f.len_v * f.sin),
+            area: f.len_u * f.len_v * f.sin,
             repr: Box::new(r),
         })
     }
@@ -172,6 +174,18 @@ impl Rectangle {
     /// Unit normal `edge_u x edge_v`, normalised.
     pub fn normal(&self) -> DVec3 {
         self.normal
+    }
+
+    /// Area `|edge_u x edge_v|` of the transformed edges (m^2; checked finite and `> 0`).
+    pub(crate) fn area(&self) -> f64 {
+        self.area
+    }
+
+    /// The point `corner + u0 edge_u + u1 edge_v` (uniform by area: the map is affine), from
+    /// uniforms already in `[0, 1)`; normal the front face's.
+    pub(crate) fn sample_area(&self, u: [f64; 3]) -> SurfacePoint {
+        let point = self.corner + self.edge_u * u[0] + self.edge_v * u[1];
+        SurfacePoint { point, normal: self.normal }
     }
 }
 

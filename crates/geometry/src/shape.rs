@@ -2,6 +2,7 @@
 
 use std::path::Path;
 
+use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 use crate::{
@@ -30,6 +31,16 @@ pub(crate) fn similarity(shape: &'static str, t: &Transform) -> Result<f64, Geom
             "must be a similarity (rotation, uniform scale, translation); use a Mesh otherwise",
         )
     })
+}
+
+/// A point on a shape's surface, as [`Shape::sample_area`] draws it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfacePoint {
+    /// The point (m, world space).
+    pub point: DVec3,
+    /// Unit outward geometric normal: the one [`Shape::intersect`] reports there as
+    /// [`Hit::geometric_normal`] (the front face of rectangles and disks).
+    pub normal: DVec3,
 }
 
 /// Any shape, as scene files name it: `{"type": "Sphere", ...}`.
@@ -111,6 +122,45 @@ impl Shape {
     pub fn bounds(&self) -> Bounds {
         let p = self.primitives();
         (0..p.count() as u32).fold(Bounds::EMPTY, |b, i| b.union(p.bounds(i)))
+    }
+
+    /// Total surface area (m^2), after the shape's transform; `> 0` for every valid shape.
+    ///
+    /// Closed forms: sphere `4 pi r^2`, rectangle `|edge_u x edge_v|`, disk `pi r^2`, open
+    /// cylinder `2 pi r h` (side only), torus `4 pi^2 R r`, mesh and prism the sum of their
+    /// triangles' areas. Two edge cases a caller that emits from the shape must refuse: a mesh
+    /// whose triangles are all degenerate (or an OBJ mesh not yet loaded) has area 0, and an
+    /// area beyond `f64::MAX` is `+inf`.
+    pub fn area(&self) -> f64 {
+        match self {
+            Shape::Sphere(s) => s.area(),
+            Shape::Rectangle(s) => s.area(),
+            Shape::Disk(s) => s.area(),
+            Shape::Cylinder(s) => s.area(),
+            Shape::Torus(s) => s.area(),
+            Shape::Mesh(s) => s.area(),
+            Shape::Prism(s) => s.mesh().area(),
+        }
+    }
+
+    /// A point drawn uniformly by area from three uniforms in `[0, 1)` (each clamped into
+    /// `[0, 1)` first, NaN to 0, so any input is accepted and nothing panics).
+    ///
+    /// The density is `1 / area()` per m^2. Meshes pick a triangle by area from a cumulative
+    /// table built when the mesh is built or loaded (`u[0]`), then a point on it by the
+    /// square-root warp (`u[1]`, `u[2]`). A mesh of zero or overflowing total area is sampled
+    /// uniformly by triangle instead; an OBJ mesh not yet loaded returns the origin.
+    pub fn sample_area(&self, u: [f64; 3]) -> SurfacePoint {
+        let u = u.map(crate::float::unit_uniform);
+        match self {
+            Shape::Sphere(s) => s.sample_area(u),
+            Shape::Rectangle(s) => s.sample_area(u),
+            Shape::Disk(s) => s.sample_area(u),
+            Shape::Cylinder(s) => s.sample_area(u),
+            Shape::Torus(s) => s.sample_area(u),
+            Shape::Mesh(s) => s.sample_area(u),
+            Shape::Prism(s) => s.mesh().sample_area(u),
+        }
     }
 
     /// The nearest hit in `(0, t_max)` by testing every primitive (no BVH), `primitive = 0`.

@@ -25,7 +25,7 @@ use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 use crate::float::{Frame, finite_point, gamma, positive, stable_quadratic_roots};
-use crate::shape::{Primitives, similarity};
+use crate::shape::{Primitives, SurfacePoint, similarity};
 use crate::{Bounds, GeometryError, Hit, Ray, Transform};
 
 /// A sphere.
@@ -95,6 +95,21 @@ impl Sphere {
     /// Radius in world space (m).
     pub fn radius(&self) -> f64 {
         self.radius
+    }
+
+    /// Surface area `4 pi r^2` (m^2).
+    pub(crate) fn area(&self) -> f64 {
+        4.0 * PI * self.radius * self.radius
+    }
+
+    /// A point uniform by area (Archimedes: `z = 1 - 2 u0` along the pole is uniform), from
+    /// uniforms already in `[0, 1)`.
+    pub(crate) fn sample_area(&self, u: [f64; 3]) -> SurfacePoint {
+        let z = 1.0 - 2.0 * u[0];
+        let s = (1.0 - z * z).max(0.0).sqrt();
+        let phi = 2.0 * PI * u[1];
+        let n = self.frame.world(DVec3::new(s * phi.cos(), s * phi.sin(), z)).normalize();
+        SurfacePoint { point: self.center + n * self.radius, normal: n }
     }
 }
 
