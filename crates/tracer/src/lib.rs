@@ -21,7 +21,9 @@ mod integrator;
 mod light_tracer;
 mod render;
 
-pub use camera::{CameraError, CameraRepr, FovAxis, PinholeCamera, Projection};
+pub use camera::{
+    CameraError, CameraRay, CameraRepr, CameraSample, FovAxis, PinholeCamera, Projection,
+};
 pub use effects::{BUNDLE, Effects, EffectsMode, SceneFeatures};
 pub use film::{ExactSum, Film, FilmError, FilmWriter, MAX_PIXELS, Splat};
 pub use integrator::{Integrator, LightTracer};
