@@ -23,7 +23,9 @@ mod path_tracer;
 mod render;
 mod wavelengths;
 
-pub use camera::{CameraError, CameraRepr, FovAxis, PinholeCamera, Projection};
+pub use camera::{
+    CameraError, CameraRay, CameraRepr, CameraSample, FovAxis, PinholeCamera, Projection,
+};
 pub use effects::{BUNDLE, Effects, EffectsMode, IntegratorChoice, SceneFeatures};
 pub use film::{ExactSum, Film, FilmError, FilmWriter, MAX_PIXELS, Splat};
 pub use integrator::{Integrator, LightTracer};
