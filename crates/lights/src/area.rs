@@ -32,13 +32,16 @@ use serde::{Deserialize, Serialize};
 use spectrace_spectrum::SpectralPowerDistribution;
 
 use spectrace_sampling::{
-    Frame, sample_cosine_hemisphere_concentric, sample_uniform_disk_concentric,
+    Frame, clamp_uniform, sample_cosine_hemisphere_concentric, sample_uniform_disk_concentric,
 };
 
 use crate::geometry::{finite_point, positive, unit_direction};
 use crate::sky::rectangle_normal;
 use crate::source::uniform;
-use crate::{Beam, LightError, LightFlags, LightSample, LightSource, SpdLight, WavelengthSampling};
+use crate::{
+    Beam, EmissionSample, LightError, LightFlags, LightSample, LightSource, LightSurface, SpdLight,
+    WavelengthSampling,
+};
 
 /// A cosine-weighted direction around `frame.n()`, flipped to the back face with probability 1/2
 /// when two-sided (the choice uses the top half of `u_side`).
@@ -56,6 +59,65 @@ fn lambertian_direction(frame: &Frame, two_sided: bool, u1: f64, u2: f64, u_side
 fn lambertian_density(normal: DVec3, two_sided: bool, direction: DVec3) -> f64 {
     let c = direction.dot(normal);
     if two_sided { c.abs() / (2.0 * PI) } else { c.max(0.0) / PI }
+}
+
+/// Radiance `radiance` of a Lambertian face with front `normal` seen from the unit `direction`
+/// leaving it: the front, and the back too when two-sided; 0 edge-on.
+fn lambertian_radiance(normal: DVec3, two_sided: bool, radiance: f64, direction: DVec3) -> f64 {
+    let c = direction.dot(normal);
+    if c > 0.0 || (two_sided && c < 0.0) { radiance } else { 0.0 }
+}
+
+/// Solid-angle density (at `receiver`) with which an area light of front `normal` and area
+/// `area`, sampled uniformly over its surface, gives the point `position`: `d^2 / (area |cos|)`,
+/// 0 where [`area_sample`] gives pdf 0 (the back of a one-sided light, edge-on, or `receiver` on
+/// the light).
+fn area_pdf_towards(
+    position: DVec3,
+    normal: DVec3,
+    area: f64,
+    two_sided: bool,
+    receiver: DVec3,
+) -> f64 {
+    let to = receiver - position;
+    let distance = to.length();
+    if !(distance > 0.0 && distance.is_finite()) {
+        return 0.0;
+    }
+    let cos = (to / distance).dot(normal);
+    let cos = if two_sided { cos.abs() } else { cos.max(0.0) };
+    if cos > 0.0 { distance * distance / (area * cos) } else { 0.0 }
+}
+
+/// An emission ray of a Lambertian area light from `position` (drawn with area density
+/// `1 / area`), its direction from `u_dir` as [`lambertian_direction`] distributes them; when
+/// two-sided, the side is the top half of `u_dir[1]`, which is then stretched back to `[0, 1)`.
+/// `None` for a grazing direction of density 0 (only at the rim of the uniforms' range).
+fn area_emission(
+    frame: &Frame,
+    two_sided: bool,
+    area: f64,
+    position: DVec3,
+    u_dir: [f64; 2],
+) -> Option<EmissionSample> {
+    let (u1, mut u2) = (u_dir[0], u_dir[1]);
+    let back = two_sided && u2 >= 0.5;
+    if two_sided {
+        // Exact in binary floating point: 2 u is a doubling, 2 u - 1 an exact subtraction.
+        u2 = if back { 2.0 * u2 - 1.0 } else { 2.0 * u2 };
+    }
+    let direction = lambertian_direction(frame, two_sided, u1, u2, if back { 1.0 } else { 0.0 });
+    let pdf_direction = lambertian_density(frame.n(), two_sided, direction);
+    if !(pdf_direction > 0.0) {
+        return None;
+    }
+    Some(EmissionSample {
+        position,
+        normal: if back { -frame.n() } else { frame.n() },
+        direction,
+        pdf_position: 1.0 / area,
+        pdf_direction,
+    })
 }
 
 /// The sample of an area light at `position` (normal `normal`, area `area`, radiance `radiance`)
@@ -183,6 +245,16 @@ impl RectangleLight {
     pub fn normal(&self) -> DVec3 {
         self.frame.n()
     }
+
+    /// The rectangle's area (m^2).
+    pub fn area(&self) -> f64 {
+        self.area
+    }
+
+    /// The point `corner + s edge_u + t edge_v`, `s` and `t` clamped into `[0, 1)` (NaN to 0).
+    fn point(&self, s: f64, t: f64) -> DVec3 {
+        self.corner + self.edge_u * clamp_uniform(s) + self.edge_v * clamp_uniform(t)
+    }
 }
 
 #[typetag::serde]
@@ -203,8 +275,28 @@ impl LightSource for RectangleLight {
         lambertian_density(self.frame.n(), self.two_sided, direction)
     }
     fn sample_towards(&self, receiver: DVec3, u: [f64; 2]) -> Option<LightSample> {
-        let position = self.corner + self.edge_u * u[0] + self.edge_v * u[1];
+        let position = self.point(u[0], u[1]);
         area_sample(position, self.frame.n(), self.area, self.radiance(), self.two_sided, receiver)
+    }
+    fn pdf_towards(&self, receiver: DVec3, position: DVec3) -> f64 {
+        area_pdf_towards(position, self.frame.n(), self.area, self.two_sided, receiver)
+    }
+    fn emitted_radiance(&self, _position: DVec3, direction: DVec3) -> f64 {
+        lambertian_radiance(self.frame.n(), self.two_sided, self.radiance(), direction)
+    }
+    fn sample_emission(&self, u: [f64; 4]) -> Option<EmissionSample> {
+        let position = self.point(u[0], u[1]);
+        area_emission(&self.frame, self.two_sided, self.area, position, [u[2], u[3]])
+    }
+    fn pdf_emission(&self, _position: DVec3, direction: DVec3) -> Option<(f64, f64)> {
+        Some((1.0 / self.area, lambertian_density(self.frame.n(), self.two_sided, direction)))
+    }
+    fn surface(&self) -> Option<LightSurface> {
+        Some(LightSurface::Rectangle {
+            corner: self.corner,
+            edge_u: self.edge_u,
+            edge_v: self.edge_v,
+        })
     }
 }
 
@@ -337,5 +429,21 @@ impl LightSource for DiskLight {
             self.two_sided,
             receiver,
         )
+    }
+    fn pdf_towards(&self, receiver: DVec3, position: DVec3) -> f64 {
+        area_pdf_towards(position, self.normal, self.area(), self.two_sided, receiver)
+    }
+    fn emitted_radiance(&self, _position: DVec3, direction: DVec3) -> f64 {
+        lambertian_radiance(self.normal, self.two_sided, self.radiance(), direction)
+    }
+    fn sample_emission(&self, u: [f64; 4]) -> Option<EmissionSample> {
+        let position = self.point(u[0], u[1]);
+        area_emission(&self.frame, self.two_sided, self.area(), position, [u[2], u[3]])
+    }
+    fn pdf_emission(&self, _position: DVec3, direction: DVec3) -> Option<(f64, f64)> {
+        Some((1.0 / self.area(), lambertian_density(self.normal, self.two_sided, direction)))
+    }
+    fn surface(&self) -> Option<LightSurface> {
+        Some(LightSurface::Disk { center: self.center, normal: self.normal, radius: self.radius })
     }
 }

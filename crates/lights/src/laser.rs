@@ -23,9 +23,15 @@ use spectrace_spectrum::SpectralPowerDistribution;
 
 use spectrace_sampling::{Frame, sample_uniform_disk_concentric};
 
+/// How far (in `1 - cos` of the angle between them) a direction may be from a laser's or a sky's
+/// and still count as its direction in `pdf_emission`: about 4.5e-5 rad.
+pub(crate) const SAME_DIRECTION: f64 = 1e-9;
+
 use crate::geometry::{finite_point, non_negative, unit_direction};
 use crate::source::uniform;
-use crate::{Beam, LightError, LightFlags, LightSource, SpdLight, WavelengthSampling};
+use crate::{
+    Beam, EmissionSample, LightError, LightFlags, LightSource, SpdLight, WavelengthSampling,
+};
 
 /// A laser: parallel beams from a point (or a disk of `beam_radius`) along one direction.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -103,6 +109,29 @@ impl Laser {
     pub fn direction(&self) -> DVec3 {
         self.direction
     }
+
+    /// A beam origin from two uniforms: the position, or a point uniform on the disk of
+    /// `beam_radius` around it, perpendicular to the direction.
+    fn origin_from(&self, u: [f64; 2]) -> DVec3 {
+        if self.beam_radius > 0.0 {
+            let [x, y] = sample_uniform_disk_concentric(u);
+            self.position + self.frame.to_world(DVec3::new(x, y, 0.0)) * self.beam_radius
+        } else {
+            self.position
+        }
+    }
+
+    /// Area density of the beam origins (m^-2): 1 (a delta) for a beam of radius 0, else
+    /// `1 / (pi beam_radius^2)`, or 0 when that area is not a positive finite number (a radius
+    /// so small that it underflows, or so large that it overflows).
+    fn pdf_position(&self) -> f64 {
+        if self.beam_radius > 0.0 {
+            let area = std::f64::consts::PI * self.beam_radius * self.beam_radius;
+            if area > 0.0 && area.is_finite() { 1.0 / area } else { 0.0 }
+        } else {
+            1.0
+        }
+    }
 }
 
 #[typetag::serde]
@@ -110,8 +139,7 @@ impl LightSource for Laser {
     fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
         let (lambda, scale) = self.emission.wavelength(uniform(rng));
         let origin = if self.beam_radius > 0.0 {
-            let [x, y] = sample_uniform_disk_concentric([uniform(rng), uniform(rng)]);
-            self.position + self.frame.to_world(DVec3::new(x, y, 0.0)) * self.beam_radius
+            self.origin_from([uniform(rng), uniform(rng)])
         } else {
             self.position
         };
@@ -121,5 +149,26 @@ impl LightSource for Laser {
     crate::delegate_to_spd_light!(emission);
     fn flags(&self) -> Option<LightFlags> {
         Some(LightFlags { delta_position: self.beam_radius == 0.0, delta_direction: true })
+    }
+    /// The direction is always the laser's, with `pdf_direction` 1 standing for the delta; the
+    /// origin as [`next_beam`](LightSource::next_beam) draws it (from `u[0]`, `u[1]`). The normal
+    /// is the direction for a beam of finite radius (the disk the beams start from faces it), zero
+    /// for a point. `None` when the beam is so wide or narrow that its area is not representable.
+    fn sample_emission(&self, u: [f64; 4]) -> Option<EmissionSample> {
+        let pdf_position = self.pdf_position();
+        (pdf_position > 0.0).then(|| EmissionSample {
+            position: self.origin_from([u[0], u[1]]),
+            normal: if self.beam_radius > 0.0 { self.direction } else { DVec3::ZERO },
+            direction: self.direction,
+            pdf_position,
+            pdf_direction: 1.0,
+        })
+    }
+    /// `(pdf_position, 1)` along the laser's direction (1 standing for the delta: the caller
+    /// learns that it is one from [`flags`](LightSource::flags)), `(pdf_position, 0)` along any
+    /// other. `pdf_position` is 1 (a delta) for a beam of radius 0, else `1 / (pi beam_radius^2)`.
+    fn pdf_emission(&self, _position: DVec3, direction: DVec3) -> Option<(f64, f64)> {
+        let along = direction.dot(self.direction) >= 1.0 - SAME_DIRECTION;
+        Some((self.pdf_position(), if along { 1.0 } else { 0.0 }))
     }
 }

@@ -13,7 +13,7 @@ use std::sync::Arc;
 use glam::DVec3;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
-use spectrace_sampling::Discrete;
+use spectrace_sampling::{Discrete, clamp_uniform};
 use spectrace_spectrum::{Component, Mixture, SpectralPowerDistribution};
 
 use crate::source::uniform;
@@ -28,6 +28,14 @@ use crate::{Beam, BeamCounter, LightError, LightFlags, LightId, LightSample, Lig
 /// lights keep their own beam counts, so a beam's power can be computed from its parent
 /// (`lights()[parent].power() / lights()[parent].number_of_beams() * scale`) or, equivalently in
 /// expectation, from the set (`power() / number_of_beams() * scale`).
+///
+/// For next-event estimation and bidirectional methods, choose a light with
+/// [`sample_light`](Self::sample_light) (probability [`pmf`](Self::pmf)) and ask that light,
+/// [`light(id)`](Self::light), for its densities: the set itself keeps the trait's defaults for
+/// the per-light methods (`emission_density`, `pdf_towards` and `emitted_radiance` 0,
+/// `sample_emission`, `pdf_emission` and `surface` `None`), since its lights differ in kind.
+/// Only [`sample_towards`](LightSource::sample_towards) is offered on the set, choosing the light
+/// by power.
 #[derive(Debug, Deserialize)]
 #[serde(try_from = "LightSetRepr")]
 pub struct LightSet {
@@ -116,9 +124,9 @@ impl LightSet {
     /// The light sampler for next-event estimation: chooses a light with probability
     /// proportional to its power from a uniform `u`, and returns it with its probability mass
     /// ([`pmf`](Self::pmf)) and `u` remapped to a fresh uniform in `[0, 1)` for the light's own
-    /// use.
+    /// use. A `u` outside `[0, 1)` or NaN is clamped into it.
     pub fn sample_light(&self, u: f64) -> (LightId, f64, f64) {
-        let (i, remapped) = self.choice.sample_remapped(u);
+        let (i, remapped) = self.choice.sample_remapped(clamp_uniform(u));
         (LightId(i as u32), self.choice.pmf(i), remapped)
     }
 
@@ -179,7 +187,7 @@ impl LightSource for LightSet {
     }
     fn sample_towards(&self, receiver: DVec3, u: [f64; 2]) -> Option<LightSample> {
         // Choose a light by power with the first uniform, remapped to drive the light's own choice.
-        let (i, remapped) = self.choice.sample_remapped(u[0]);
+        let (i, remapped) = self.choice.sample_remapped(clamp_uniform(u[0]));
         let p = self.choice.pmf(i);
         let mut s = self.lights[i].sample_towards(receiver, [remapped, u[1]])?;
         s.intensity /= p;

@@ -27,7 +27,10 @@ use spectrace_spectrum::SpectralPowerDistribution;
 
 use crate::geometry::{finite_point, safe_length, unit_direction};
 use crate::source::uniform;
-use crate::{Beam, LightError, LightFlags, LightSource, SpdLight, WavelengthSampling};
+use crate::{
+    Beam, EmissionSample, LightError, LightFlags, LightSource, SpdLight, WavelengthSampling,
+};
+use spectrace_sampling::clamp_uniform;
 
 /// Parallel beams starting uniformly over a rectangle.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -38,6 +41,10 @@ pub struct Sky {
     edge_u: DVec3,
     edge_v: DVec3,
     direction: DVec3,
+    /// The rectangle's unit normal on the side the beams leave (`normal . direction > 0`).
+    normal: DVec3,
+    /// The rectangle's area (m^2).
+    area: f64,
 }
 
 /// Scene-file form of [`Sky`].
@@ -136,7 +143,7 @@ impl Sky {
     ) -> Result<Self, LightError> {
         const L: &str = "Sky";
         let corner = finite_point(L, "corner", corner)?;
-        let (normal, _area) = rectangle_normal(L, edge_u, edge_v)?;
+        let (normal, area) = rectangle_normal(L, edge_u, edge_v)?;
         let direction = unit_direction(L, "direction", direction)?;
         if direction.dot(normal).abs() < 1e-9 {
             return Err(LightError::parameter(
@@ -147,12 +154,18 @@ impl Sky {
             ));
         }
         let emission = SpdLight::new(L, spd, power, wavelength_sampling)?;
-        Ok(Self { emission, corner, edge_u, edge_v, direction })
+        let normal = if direction.dot(normal) > 0.0 { normal } else { -normal };
+        Ok(Self { emission, corner, edge_u, edge_v, direction, normal, area })
     }
 
     /// Where `(s, t)` in the unit square lands on the rectangle.
     pub fn point(&self, s: f64, t: f64) -> DVec3 {
         self.corner + self.edge_u * s + self.edge_v * t
+    }
+
+    /// The rectangle's area (m^2).
+    pub fn area(&self) -> f64 {
+        self.area
     }
 }
 
@@ -167,5 +180,24 @@ impl LightSource for Sky {
     crate::delegate_to_spd_light!(emission);
     fn flags(&self) -> Option<LightFlags> {
         Some(LightFlags { delta_position: false, delta_direction: true })
+    }
+    /// An origin uniform on the rectangle (from `u[0]`, `u[1]`, as
+    /// [`next_beam`](LightSource::next_beam) draws them), the sky's direction with
+    /// `pdf_direction` 1 standing for the delta, `pdf_position = 1 / area`. The normal is the
+    /// rectangle's, on the side the beams leave.
+    fn sample_emission(&self, u: [f64; 4]) -> Option<EmissionSample> {
+        Some(EmissionSample {
+            position: self.point(clamp_uniform(u[0]), clamp_uniform(u[1])),
+            normal: self.normal,
+            direction: self.direction,
+            pdf_position: 1.0 / self.area,
+            pdf_direction: 1.0,
+        })
+    }
+    /// `(1 / area, 1)` along the sky's direction (1 standing for the delta: the caller learns
+    /// that it is one from [`flags`](LightSource::flags)), `(1 / area, 0)` along any other.
+    fn pdf_emission(&self, _position: DVec3, direction: DVec3) -> Option<(f64, f64)> {
+        let along = direction.dot(self.direction) >= 1.0 - crate::laser::SAME_DIRECTION;
+        Some((1.0 / self.area, if along { 1.0 } else { 0.0 }))
     }
 }

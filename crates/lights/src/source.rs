@@ -108,15 +108,25 @@ pub trait LightSource: Send + Sync + Debug {
     /// Samples an emission ray from four uniforms: a point of the light, its surface normal, a
     /// direction, and their densities (see [`EmissionSample`]), as the light's beams are
     /// distributed (a beam from [`next_beam`](Self::next_beam) and this sample have the same
-    /// density). `None` (the default) for lights that offer only the seed's methods.
+    /// density). `None` (the default) for lights that offer only the seed's methods, and also
+    /// for a draw of zero density (a grazing direction at the very rim of the uniforms' range),
+    /// which the caller counts as no contribution. Uniforms outside `[0, 1)` or NaN are clamped.
+    ///
+    /// With it, `emitted_radiance * |cos(normal, direction)| / (pdf_position * pdf_direction)`
+    /// is `power()` for every sample of an area light (each ray carries the whole power, as a
+    /// beam does); for delta lights the deltas stand as densities of 1 (see
+    /// [`flags`](Self::flags)).
     fn sample_emission(&self, u: [f64; 4]) -> Option<EmissionSample> {
         let _ = u;
         None
     }
 
     /// The densities with which this light emits a beam from `position` along the unit
-    /// `direction`: `(pdf_position, pdf_direction)` as in [`EmissionSample`]. `None` (the default)
-    /// when the light does not say (only the light tracer can use it).
+    /// `direction`: `(pdf_position, pdf_direction)` as in [`EmissionSample`]. `position` is taken
+    /// to be a point the light emits from (it is not checked). A delta stands as a density of 1
+    /// where the direction is the light's own (lasers, sky) and 0 elsewhere; the caller knows
+    /// from [`flags`](Self::flags) which densities are deltas. `None` (the default) when the
+    /// light does not say (only the light tracer can use it).
     fn pdf_emission(&self, position: DVec3, direction: DVec3) -> Option<(f64, f64)> {
         let _ = (position, direction);
         None
@@ -136,7 +146,9 @@ pub struct EmissionSample {
     /// Where the ray starts.
     pub position: DVec3,
     /// The unit surface normal there (on the emitting side; for a two-sided light, on the side
-    /// the ray leaves), or zero for a light without a surface (points, spots).
+    /// the ray leaves), or zero for a light without a surface (points, spots, a laser of radius
+    /// 0). A sky gives its rectangle's normal on the side the beams leave, a laser of finite
+    /// radius its direction (the disk its beams start from faces it).
     pub normal: DVec3,
     /// Unit direction of the ray.
     pub direction: DVec3,

@@ -39,14 +39,17 @@ use glam::DVec3;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 use spectrace_sampling::{
-    Frame, PiecewiseLinear, one_minus_cos, sample_uniform_cone, sample_uniform_sphere,
-    spherical_direction,
+    Frame, PiecewiseLinear, clamp_uniform, one_minus_cos, sample_uniform_cone,
+    sample_uniform_sphere, spherical_direction,
 };
 use spectrace_spectrum::SpectralPowerDistribution;
 
 use crate::geometry::{finite_point, positive, unit_direction};
 use crate::source::uniform;
-use crate::{Beam, LightError, LightFlags, LightSample, LightSource, SpdLight, WavelengthSampling};
+use crate::{
+    Beam, EmissionSample, LightError, LightFlags, LightSample, LightSource, SpdLight,
+    WavelengthSampling,
+};
 
 /// Checks a cone half-angle in degrees: inside (0, 180).
 fn cone(light: &'static str, cone_angle: f64) -> Result<f64, LightError> {
@@ -78,6 +81,19 @@ fn point_sample(
         intensity: intensity(direction.dot(axis)),
         pdf: 1.0,
         delta: true,
+    })
+}
+
+/// The emission ray of a light at the point `position` along `direction`, whose directions have
+/// solid-angle density `pdf_direction` there; `None` when that density is 0 (a direction drawn
+/// exactly on a fading spot's rim).
+fn point_emission(position: DVec3, direction: DVec3, pdf_direction: f64) -> Option<EmissionSample> {
+    (pdf_direction > 0.0).then_some(EmissionSample {
+        position,
+        normal: DVec3::ZERO,
+        direction,
+        pdf_position: 1.0,
+        pdf_direction,
     })
 }
 
@@ -167,15 +183,19 @@ impl UniformSpotLight {
     pub fn cos_cone(&self) -> f64 {
         1.0 - self.one_minus_cos
     }
+
+    /// A beam direction from two uniforms: `cos(theta)` uniform on `[cos(cone), 1]`, uniform per
+    /// solid angle inside the cone.
+    fn direction_from(&self, u: [f64; 2]) -> DVec3 {
+        self.frame.to_world(sample_uniform_cone(u, self.one_minus_cos)).normalize()
+    }
 }
 
 #[typetag::serde]
 impl LightSource for UniformSpotLight {
     fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
         let (lambda, scale) = self.emission.wavelength(uniform(rng));
-        // cos(theta) uniform on [cos(cone), 1]: uniform per solid angle inside the cone.
-        let local = sample_uniform_cone([uniform(rng), uniform(rng)], self.one_minus_cos);
-        let direction = self.frame.to_world(local).normalize();
+        let direction = self.direction_from([uniform(rng), uniform(rng)]);
         self.emission.count();
         Beam::new(self.position, direction, lambda, scale)
     }
@@ -199,6 +219,13 @@ impl LightSource for UniformSpotLight {
             |c| if c >= cos_cone { i } else { 0.0 },
         )
     }
+    fn sample_emission(&self, u: [f64; 4]) -> Option<EmissionSample> {
+        let direction = self.direction_from([u[0], u[1]]);
+        point_emission(self.position, direction, self.emission_density(self.position, direction))
+    }
+    fn pdf_emission(&self, position: DVec3, direction: DVec3) -> Option<(f64, f64)> {
+        Some((1.0, self.emission_density(position, direction)))
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -220,6 +247,9 @@ pub struct FadingSpotLight {
     theta: PiecewiseLinear,
     /// Intensity at the centre (W/sr).
     peak_intensity: f64,
+    /// Solid-angle density of the beam directions along the axis (sr^-1): the peak intensity per
+    /// watt, kept apart so that a light of zero power still has a density.
+    peak_density: f64,
     frame: Frame,
 }
 
@@ -328,7 +358,8 @@ impl FadingSpotLight {
             })
             .sum();
         let z = 2.0 * half.sin() * half.sin() + ring;
-        let peak_intensity = power / (TAU * z);
+        let peak_density = 1.0 / (TAU * z);
+        let peak_intensity = power * peak_density;
         Ok(Self {
             emission,
             position,
@@ -337,6 +368,7 @@ impl FadingSpotLight {
             fade_per_angle,
             theta,
             peak_intensity,
+            peak_density,
             frame: Frame::from_normal(direction),
         })
     }
@@ -361,16 +393,22 @@ impl FadingSpotLight {
     pub fn polar_sampler(&self) -> &PiecewiseLinear {
         &self.theta
     }
+
+    /// A beam direction from two uniforms: the polar angle from the tabulated density, the
+    /// azimuth uniform.
+    fn direction_from(&self, u: [f64; 2]) -> DVec3 {
+        let theta = self.theta.sample(clamp_uniform(u[0]));
+        let phi = TAU * clamp_uniform(u[1]);
+        let (s, c) = theta.sin_cos();
+        self.frame.to_world(spherical_direction(s, c, phi)).normalize()
+    }
 }
 
 #[typetag::serde]
 impl LightSource for FadingSpotLight {
     fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
         let (lambda, scale) = self.emission.wavelength(uniform(rng));
-        let theta = self.theta.sample(uniform(rng));
-        let phi = TAU * uniform(rng);
-        let (s, c) = theta.sin_cos();
-        let direction = self.frame.to_world(spherical_direction(s, c, phi)).normalize();
+        let direction = self.direction_from([uniform(rng), uniform(rng)]);
         self.emission.count();
         Beam::new(self.position, direction, lambda, scale)
     }
@@ -380,16 +418,19 @@ impl LightSource for FadingSpotLight {
     }
     fn emission_density(&self, _origin: DVec3, direction: DVec3) -> f64 {
         let theta = direction.dot(self.direction).clamp(-1.0, 1.0).acos().to_degrees();
-        if self.emission.power() > 0.0 {
-            self.peak_intensity * self.profile(theta) / self.emission.power()
-        } else {
-            0.0
-        }
+        self.peak_density * self.profile(theta)
     }
     fn sample_towards(&self, receiver: DVec3, _u: [f64; 2]) -> Option<LightSample> {
         point_sample(self.position, self.direction, receiver, |c| {
             self.peak_intensity * self.profile(c.clamp(-1.0, 1.0).acos().to_degrees())
         })
+    }
+    fn sample_emission(&self, u: [f64; 4]) -> Option<EmissionSample> {
+        let direction = self.direction_from([u[0], u[1]]);
+        point_emission(self.position, direction, self.emission_density(self.position, direction))
+    }
+    fn pdf_emission(&self, position: DVec3, direction: DVec3) -> Option<(f64, f64)> {
+        Some((1.0, self.emission_density(position, direction)))
     }
 }
 
@@ -472,7 +513,7 @@ impl LightSource for PointLight {
     fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
         let (lambda, scale) = self.emission.wavelength(uniform(rng));
         // z = cos(theta) uniform on [-1, 1]: uniform on the sphere.
-        let direction = sample_uniform_sphere([uniform(rng), uniform(rng)]).normalize();
+        let direction = sphere_direction([uniform(rng), uniform(rng)]);
         self.emission.count();
         Beam::new(self.position, direction, lambda, scale)
     }
@@ -487,4 +528,16 @@ impl LightSource for PointLight {
         let i = self.intensity();
         point_sample(self.position, DVec3::Z, receiver, |_| i)
     }
+    fn sample_emission(&self, u: [f64; 4]) -> Option<EmissionSample> {
+        let direction = sphere_direction([u[0], u[1]]);
+        point_emission(self.position, direction, self.emission_density(self.position, direction))
+    }
+    fn pdf_emission(&self, position: DVec3, direction: DVec3) -> Option<(f64, f64)> {
+        Some((1.0, self.emission_density(position, direction)))
+    }
+}
+
+/// A direction uniform on the sphere from two uniforms, as a point light emits them.
+fn sphere_direction(u: [f64; 2]) -> DVec3 {
+    sample_uniform_sphere(u).normalize()
 }
