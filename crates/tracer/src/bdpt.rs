@@ -288,7 +288,8 @@ impl<'a> Bdpt<'a> {
     /// The light `id` as a path end for wavelength `wl`.
     fn light_end(&self, id: LightId, wl: &Wavelength) -> Option<LightEnd> {
         let light = self.scene.lights.light(id)?;
-        let flags = light.flags().unwrap_or(LightFlags { delta_position: true, delta_direction: true });
+        let flags =
+            light.flags().unwrap_or(LightFlags { delta_position: true, delta_direction: true });
         let spd = self.scene.light_spd(id)?;
         let pmf = if wl.density > 0.0 {
             self.scene.lights.pmf(id) * spd.value(wl.lambda) / wl.density
@@ -370,7 +371,8 @@ impl<'a> Bdpt<'a> {
             let area = surface_area(light);
             if area > 0.0 { 1.0 / area } else { 0.0 }
         };
-        let dir = if flags.delta_direction { 1.0 } else { light.emission_density(point, direction) };
+        let dir =
+            if flags.delta_direction { 1.0 } else { light.emission_density(point, direction) };
         (position, dir)
     }
 
@@ -488,7 +490,19 @@ fn generate_camera_subpath(
     let pdf_dir = if cos > 0.0 { 1.0 / (bdpt.image_area * cos * cos * cos) } else { 0.0 };
     let first = bdpt.scene.world.intersect(&ray, f64::INFINITY);
     let max = bdpt.max_vertices().0;
-    random_walk(bdpt, ray, first, 1.0, pdf_dir, Transport::Radiance, wl, max, &mut buffers.camera, rng, stats);
+    random_walk(
+        bdpt,
+        ray,
+        first,
+        1.0,
+        pdf_dir,
+        Transport::Radiance,
+        wl,
+        max,
+        &mut buffers.camera,
+        rng,
+        stats,
+    );
 }
 
 /// The light subpath of `beam` into `buffers.light`: the beam's origin on its light, then a
@@ -522,7 +536,19 @@ fn generate_light_subpath(
     let first = scene.intersect_from_light(&ray, light.id, f64::INFINITY);
     let pdf_dir = if light.flags.delta_direction { 0.0 } else { pdf_dir };
     let max = bdpt.max_vertices().1;
-    random_walk(bdpt, ray, first, beta, pdf_dir, Transport::Importance, wl, max, &mut buffers.light, rng, stats);
+    random_walk(
+        bdpt,
+        ray,
+        first,
+        beta,
+        pdf_dir,
+        Transport::Importance,
+        wl,
+        max,
+        &mut buffers.light,
+        rng,
+        stats,
+    );
 }
 
 /// Follows `ray` (whose first hit is `first`) through the scene, appending a vertex per surface
@@ -558,7 +584,8 @@ fn random_walk(
         }
         let Some(material) = scene.materials.get(hit.primitive as usize) else { return };
         let u = [uniform(rng), uniform(rng), uniform(rng)];
-        let incoming = Incoming { direction: ray.direction, normal: hit.shading_normal, lambda: wl.lambda };
+        let incoming =
+            Incoming { direction: ray.direction, normal: hit.shading_normal, lambda: wl.lambda };
         let Some(s) = material.scatter_with(&incoming, u, transport) else { return };
         let wp = -ray.direction;
         let mut weight = s.weight;
@@ -597,11 +624,24 @@ fn random_walk(
 struct Contribution {
     value: f64,
     raster: Option<(u32, u32)>,
+    /// The MIS weight applied (included in `value`).
+    #[cfg_attr(not(test), allow(dead_code))]
+    weight: f64,
+    /// Whether the path's light cannot be hit by a camera path (for tests of the weights).
+    #[cfg_attr(not(test), allow(dead_code))]
+    light_is_delta: bool,
 }
 
 /// The BSDF at surface vertex `v` for light arriving from `from` and leaving towards `to`, with
 /// `transport`'s adjoint; 0 for other vertices.
-fn bsdf(bdpt: &Bdpt<'_>, v: &Vertex, from: DVec3, to: DVec3, transport: Transport, wl: &Wavelength) -> f64 {
+fn bsdf(
+    bdpt: &Bdpt<'_>,
+    v: &Vertex,
+    from: DVec3,
+    to: DVec3,
+    transport: Transport,
+    wl: &Wavelength,
+) -> f64 {
     let VertexKind::Surface(hit) = v.kind else { return 0.0 };
     let Some(material) = bdpt.scene.materials.get(hit.primitive as usize) else { return 0.0 };
     let wi = (from - v.point).normalize();
@@ -707,8 +747,7 @@ fn connect(
         if scene.world.occluded(&shadow, distance * (1.0 - 1e-9)) {
             return None;
         }
-        value = pt.beta * f * cos * sample.intensity
-            / (sample.distance * sample.distance * pmf);
+        value = pt.beta * f * cos * sample.intensity / (sample.distance * sample.distance * pmf);
         let (pdf_pos, _) = bdpt.light_pdfs(id, sample.position, sample.direction);
         sampled = Some(Vertex {
             kind: VertexKind::Light(id),
@@ -757,12 +796,13 @@ fn connect(
     if !(value > 0.0 && value.is_finite()) {
         return None;
     }
-    let weight = if camera_strategies {
-        path_mis_weight(bdpt, light, camera, s, t, sampled.as_ref(), &end, wl, mis)
+    let (weight, light_is_delta) = if camera_strategies {
+        let delta = build_mis_path(bdpt, light, camera, s, t, sampled.as_ref(), &end, wl, mis);
+        (mis_weight(mis, s, delta), delta)
     } else {
-        1.0
+        (1.0, true)
     };
-    Some(Contribution { value: value * weight, raster })
+    Some(Contribution { value: value * weight, raster, weight, light_is_delta })
 }
 
 /// Chooses a light with probability `pmf(l | lambda)` from a uniform `u`.
@@ -794,10 +834,11 @@ fn choose_light(bdpt: &Bdpt<'_>, wl: &Wavelength, u: f64) -> Option<LightId> {
     last
 }
 
-/// The MIS weight of strategy `(s, t)`: the full path's densities from both ends (updated at
-/// the connection, pbrt's `MISWeight`), handed to [`mis_weight`].
+/// The full path of strategy `(s, t)` as [`MisVertex`]es into `mis`, from the light to the
+/// camera, with the densities at the connection updated; returns whether its light cannot be
+/// hit by a camera path.
 #[allow(clippy::too_many_arguments)]
-fn path_mis_weight(
+fn build_mis_path(
     bdpt: &Bdpt<'_>,
     light: &[Vertex],
     camera: &[Vertex],
@@ -807,9 +848,15 @@ fn path_mis_weight(
     end: &LightEnd,
     wl: &Wavelength,
     mis: &mut Vec<MisVertex>,
-) -> f64 {
+) -> bool {
     mis.clear();
-    let qs = if s == 1 { sampled.copied().or_else(|| light.first().copied()) } else if s > 0 { Some(light[s - 1]) } else { None };
+    let qs = if s == 1 {
+        sampled.copied().or_else(|| light.first().copied())
+    } else if s > 0 {
+        Some(light[s - 1])
+    } else {
+        None
+    };
     let pt = camera[t - 1];
     let qs_minus = if s >= 2 { Some(light[s - 2]) } else { None };
     let pt_minus = if t >= 2 { Some(camera[t - 2]) } else { None };
@@ -849,7 +896,7 @@ fn path_mis_weight(
         1 => qs.is_some_and(|q| q.ng != DVec3::ZERO),
         _ => light[0].ng != DVec3::ZERO,
     };
-    mis_weight(mis, s, end.is_delta(on_surface))
+    end.is_delta(on_surface)
 }
 
 impl Integrator for Bdpt<'_> {
@@ -892,5 +939,385 @@ impl Integrator for Bdpt<'_> {
 
     fn image_scale(&self, samples_done: u64) -> f64 {
         if samples_done == 0 { 0.0 } else { self.pass_samples() as f64 / samples_done as f64 }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+
+    use rand::SeedableRng;
+    use rand_pcg::Pcg64;
+    use spectrace_geometry::{Rectangle, Shape, Sphere, World};
+    use spectrace_lights::LightSet;
+    use spectrace_materials::Material;
+
+    use super::*;
+    use crate::light_tracer::Emitter;
+    use crate::{
+        CameraRepr, EffectsMode, FovAxis, LightTracer, LightTracerSettings, PathTracer,
+        PathTracerSettings, PinholeCamera, RenderPlan, render,
+    };
+
+    /// A scene built in code: shapes (with their materials), lights, camera, emitters.
+    struct Fixture {
+        world: World,
+        materials: Vec<Arc<dyn Material>>,
+        lights: LightSet,
+        camera: PinholeCamera,
+        emitters: Vec<Option<Emitter>>,
+        objects: usize,
+    }
+
+    impl Fixture {
+        fn scene(&self) -> LightTracerScene<'_> {
+            LightTracerScene::new(&self.world, &self.materials, &self.lights, &self.camera)
+                .with_emitters(self.emitters.clone(), self.objects)
+        }
+    }
+
+    fn material(json: &str) -> Arc<dyn Material> {
+        let m: Box<dyn Material> = serde_json::from_str(json).unwrap();
+        Arc::from(m)
+    }
+
+    fn light(json: &str) -> Box<dyn LightSource> {
+        serde_json::from_str(json).unwrap()
+    }
+
+    fn rect(corner: [f64; 3], u: [f64; 3], v: [f64; 3]) -> Shape {
+        Shape::Rectangle(
+            Rectangle::new(DVec3::from(corner), DVec3::from(u), DVec3::from(v)).unwrap(),
+        )
+    }
+
+    fn camera(position: [f64; 3], look_at: [f64; 3]) -> PinholeCamera {
+        PinholeCamera::new(CameraRepr {
+            position: DVec3::from(position),
+            look_at: DVec3::from(look_at),
+            up: DVec3::Y,
+            fov: 50.0,
+            fov_axis: FovAxis::Horizontal,
+            width: 16,
+            height: 16,
+        })
+        .unwrap()
+    }
+
+    const DIFFUSE: &str = r#"{"type": "Diffuse", "reflectance": 0.7}"#;
+    const SPOT: &str = r#"{"type": "FadingSpotLight", "position": [0, 1.5, 0], "direction": [0, -1, 0],
+        "cone_angle": 35, "fade_per_angle": 0.2, "power": 10, "spd": {"type": "Blackbody", "kelvin": 4000}}"#;
+
+    /// A fading spot over a diffuse floor.
+    fn spot_scene() -> Fixture {
+        let shapes = vec![rect([-2.0, 0.0, -2.0], [0.0, 0.0, 4.0], [4.0, 0.0, 0.0])];
+        Fixture {
+            world: World::new(shapes).unwrap(),
+            materials: vec![material(DIFFUSE)],
+            lights: LightSet::new(vec![light(SPOT)]).unwrap(),
+            camera: camera([0.0, 1.2, 2.0], [0.0, 0.0, 0.0]),
+            emitters: Vec::new(),
+            objects: 1,
+        }
+    }
+
+    /// A Cornell-like box (open at the front) lit by a rectangle under its ceiling, which the
+    /// camera sees.
+    fn box_scene() -> Fixture {
+        let shapes = vec![
+            rect([-1.0, 0.0, -1.0], [0.0, 0.0, 2.0], [2.0, 0.0, 0.0]), // floor
+            rect([-1.0, 2.0, -1.0], [2.0, 0.0, 0.0], [0.0, 0.0, 2.0]), // ceiling
+            rect([-1.0, 0.0, -1.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]), // back
+            rect([-1.0, 0.0, -1.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]), // left
+            rect([1.0, 0.0, -1.0], [0.0, 0.0, 2.0], [0.0, 2.0, 0.0]),  // right
+            // The light's surface, just below the ceiling.
+            rect([-0.3, 1.98, -0.3], [0.6, 0.0, 0.0], [0.0, 0.0, 0.6]),
+        ];
+        let materials = vec![
+            material(DIFFUSE),
+            material(DIFFUSE),
+            material(DIFFUSE),
+            material(r#"{"type": "Diffuse", "reflectance": 0.5}"#),
+            material(r#"{"type": "Diffuse", "reflectance": 0.3}"#),
+            material(r#"{"type": "Diffuse", "reflectance": 0.0}"#),
+        ];
+        let area = light(
+            r#"{"type": "RectangleLight", "corner": [-0.3, 1.98, -0.3], "edge_u": [0.6, 0, 0],
+            "edge_v": [0, 0, 0.6], "power": 20, "spd": {"type": "Blackbody", "kelvin": 5000}}"#,
+        );
+        let mut emitters = vec![None; 6];
+        emitters[5] = Some(Emitter::Light(LightId(0)));
+        Fixture {
+            world: World::new(shapes).unwrap(),
+            materials,
+            lights: LightSet::new(vec![area]).unwrap(),
+            camera: camera([0.0, 1.0, 3.2], [0.0, 1.0, 0.0]),
+            emitters,
+            objects: 5,
+        }
+    }
+
+    /// A glass sphere under the spot, over the floor: a caustic.
+    fn caustic_scene() -> Fixture {
+        let shapes = vec![
+            rect([-2.0, 0.0, -2.0], [0.0, 0.0, 4.0], [4.0, 0.0, 0.0]),
+            Shape::Sphere(Sphere::new(DVec3::new(0.0, 0.6, 0.0), 0.35).unwrap()),
+        ];
+        Fixture {
+            world: World::new(shapes).unwrap(),
+            materials: vec![material(DIFFUSE), material(r#"{"type": "Dielectric", "ior": 1.5}"#)],
+            lights: LightSet::new(vec![light(SPOT)]).unwrap(),
+            camera: camera([0.0, 1.4, 1.6], [0.0, 0.2, 0.0]),
+            emitters: Vec::new(),
+            objects: 2,
+        }
+    }
+
+    fn effects(scene: &LightTracerScene<'_>) -> Effects {
+        Effects::decide(scene.features(&[false; 8]), EffectsMode::Off)
+    }
+
+    /// Mean Y over the image (the pixels `mask` keeps) of `runs` independent renders (seeds
+    /// 1..=runs) of `items` work items each (chunks of `chunk`), and its standard error.
+    fn mean_y(
+        integrator: &dyn Integrator,
+        runs: u64,
+        items: u64,
+        chunk: u64,
+        mask: &[bool],
+    ) -> (f64, f64) {
+        let means: Vec<f64> = (1..=runs)
+            .map(|seed| {
+                let plan = RenderPlan {
+                    beams: items,
+                    chunk_beams: chunk,
+                    seed,
+                    threads: 2,
+                    shard: None,
+                    time_budget: None,
+                };
+                let out = render(integrator, &plan, &|_| {}).unwrap();
+                let image = out.film.to_xyz(integrator.image_scale(out.beams));
+                let kept = image.iter().zip(mask).filter(|(_, keep)| **keep);
+                let n = kept.clone().count();
+                kept.map(|(p, _)| p.y).sum::<f64>() / n as f64
+            })
+            .collect();
+        let k = means.len() as f64;
+        let mean = means.iter().sum::<f64>() / k;
+        let var = means.iter().map(|m| (m - mean) * (m - mean)).sum::<f64>() / (k - 1.0);
+        (mean, (var / k).sqrt())
+    }
+
+    fn assert_agree(name: &str, a: (f64, f64), b: (f64, f64)) {
+        let combined = (a.1 * a.1 + b.1 * b.1).sqrt();
+        assert!(a.0 > 0.0 && b.0 > 0.0, "{name}: {a:?} {b:?}");
+        // The test is only meaningful if the estimates are precise.
+        assert!(combined < 0.05 * a.0, "{name}: standard errors too large: {a:?} {b:?}");
+        assert!((a.0 - b.0).abs() < 3.0 * combined, "{name}: {a:?} vs {b:?}");
+    }
+
+    const ALL: [bool; 256] = [true; 256];
+
+    fn bdpt_mean(
+        scene: &LightTracerScene<'_>,
+        runs: u64,
+        passes: u64,
+        mask: &[bool],
+    ) -> (f64, f64) {
+        let bdpt = Bdpt::new(scene, BdptSettings::default(), effects(scene));
+        let pixels = bdpt.pass_samples();
+        mean_y(&bdpt, runs, passes * pixels, pixels, mask)
+    }
+
+    fn light_mean(
+        scene: &LightTracerScene<'_>,
+        runs: u64,
+        beams: u64,
+        mask: &[bool],
+    ) -> (f64, f64) {
+        let lt = LightTracer::new(scene, LightTracerSettings::default(), effects(scene));
+        mean_y(&lt, runs, beams, 20_000, mask)
+    }
+
+    fn path_mean(scene: &LightTracerScene<'_>, runs: u64, passes: u64) -> (f64, f64) {
+        let pt = PathTracer::new(scene, PathTracerSettings::default(), effects(scene));
+        let pixels = pt.pass_samples();
+        mean_y(&pt, runs, passes * pixels, pixels, &ALL)
+    }
+
+    /// The pixels in which no camera ray (on an 8 x 8 grid) sees shape `shape` first.
+    fn pixels_not_seeing(fixture: &Fixture, shape: u32) -> Vec<bool> {
+        let camera = &fixture.camera;
+        let mut mask = vec![true; 256];
+        for (p, keep) in mask.iter_mut().enumerate() {
+            let (px, py) = ((p % 16) as f64, (p / 16) as f64);
+            for k in 0..64 {
+                let (u, v) = ((k % 8) as f64 / 7.0, (k / 8) as f64 / 7.0);
+                let ray =
+                    Ray { origin: camera.position(), direction: camera.direction(px + u, py + v) };
+                if fixture
+                    .world
+                    .intersect(&ray, f64::INFINITY)
+                    .is_some_and(|h| h.primitive == shape)
+                {
+                    *keep = false;
+                }
+            }
+        }
+        mask
+    }
+
+    #[test]
+    fn mis_weight_counts_only_possible_strategies() {
+        let v = |from_light, from_camera, delta| MisVertex { from_light, from_camera, delta };
+        // Light, one diffuse vertex, camera: strategies s = 0, 1, 2 with densities
+        // p0 = 2 * 3, p1 = 1 * 3, p2 = 1 * 4 (products of the chosen sides' densities).
+        let path = [v(1.0, 2.0, false), v(4.0, 3.0, false), v(0.0, 0.0, false)];
+        let (p0, p1, p2) = (6.0f64, 3.0f64, 4.0f64);
+        let total = p0 * p0 + p1 * p1 + p2 * p2;
+        for (s, p) in [(0, p0), (1, p1), (2, p2)] {
+            assert!((mis_weight(&path, s, false) - p * p / total).abs() < 1e-15, "s = {s}");
+        }
+        // A delta light: s = 0 is impossible.
+        let total = p1 * p1 + p2 * p2;
+        assert!((mis_weight(&path, 1, true) - p1 * p1 / total).abs() < 1e-15);
+        // A specular middle vertex: only s = 0 (the camera path hits the light) remains.
+        let path = [v(1.0, 2.0, false), v(0.0, 0.0, true), v(0.0, 0.0, false)];
+        assert_eq!(mis_weight(&path, 0, false), 1.0);
+        assert_eq!(mis_weight(&[], 0, false), 0.0);
+    }
+
+    #[test]
+    fn mis_weights_of_all_strategies_of_sampled_paths_sum_to_one() {
+        for fixture in [box_scene(), caustic_scene(), spot_scene()] {
+            let scene = fixture.scene();
+            let bdpt = Bdpt::new(&scene, BdptSettings::default(), effects(&scene));
+            let mut rng = Pcg64::seed_from_u64(11);
+            let mut buffers = Buffers { light: Vec::new(), camera: Vec::new(), mis: Vec::new() };
+            let mut stats = TraceStats::default();
+            let mut checked = 0;
+            let mut strategies = [0usize; 4];
+            for i in 0..4000u32 {
+                let beam = LightSource::next_beam(scene.lights, &mut rng);
+                let density = bdpt.set_spd.value(beam.lambda);
+                let wl = Wavelength { lambda: beam.lambda, density };
+                let end = bdpt.light_end(beam.parent, &wl).unwrap();
+                generate_light_subpath(
+                    &bdpt,
+                    &beam,
+                    &end,
+                    &wl,
+                    true,
+                    &mut rng,
+                    &mut buffers,
+                    &mut stats,
+                );
+                buffers.camera.clear();
+                generate_camera_subpath(
+                    &bdpt,
+                    i % 16,
+                    (i / 16) % 16,
+                    &wl,
+                    &mut rng,
+                    &mut buffers,
+                    &mut stats,
+                );
+                let (lv, cv) = (buffers.light.clone(), buffers.camera.clone());
+                for t in 1..=cv.len() {
+                    for s in 0..=lv.len() {
+                        if s + t < 2 {
+                            continue;
+                        }
+                        let mis = &mut buffers.mis;
+                        let Some(c) =
+                            connect(&bdpt, &lv, &cv, s, t, &end, &wl, true, &mut rng, mis)
+                        else {
+                            continue;
+                        };
+                        let n = mis.len();
+                        assert_eq!(n, s + t);
+                        let valid = |k: usize| {
+                            if k == 0 {
+                                !mis[0].delta && !c.light_is_delta
+                            } else {
+                                !mis[k - 1].delta && !mis[k].delta
+                            }
+                        };
+                        assert!(valid(s), "strategy ({s}, {t}) gave light but is not counted");
+                        assert!(c.weight > 0.0 && c.weight <= 1.0);
+                        assert_eq!(c.weight, mis_weight(mis, s, c.light_is_delta));
+                        let sum: f64 = (0..n)
+                            .filter(|&k| valid(k))
+                            .map(|k| mis_weight(mis, k, c.light_is_delta))
+                            .sum();
+                        assert!((sum - 1.0).abs() < 1e-9, "({s}, {t}): weights sum to {sum}");
+                        checked += 1;
+                        strategies[match (s, t) {
+                            (0, _) => 0,
+                            (1, _) => 1,
+                            (_, 1) => 2,
+                            _ => 3,
+                        }] += 1;
+                    }
+                }
+            }
+            assert!(checked > 1000, "only {checked} connections");
+            assert!(strategies[1] > 0 && strategies[2] > 0, "{strategies:?}");
+            // Only the box has two diffuse surfaces that see each other, and a visible emitter.
+            if fixture.objects == 5 {
+                assert!(strategies[0] > 0 && strategies[3] > 0, "{strategies:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn spot_over_a_plane_matches_the_light_and_path_tracers() {
+        let fixture = spot_scene();
+        let scene = fixture.scene();
+        let bdpt = bdpt_mean(&scene, 8, 16, &ALL);
+        assert_agree("bdpt vs light", bdpt, light_mean(&scene, 8, 200_000, &ALL));
+        assert_agree("bdpt vs path", bdpt, path_mean(&scene, 8, 32));
+    }
+
+    #[test]
+    fn cornell_box_matches_the_light_and_path_tracers() {
+        let fixture = box_scene();
+        let scene = fixture.scene();
+        let bdpt = bdpt_mean(&scene, 8, 16, &ALL);
+        assert_agree("bdpt vs light", bdpt, light_mean(&scene, 8, 200_000, &ALL));
+        assert_agree("bdpt vs path", bdpt, path_mean(&scene, 8, 32));
+    }
+
+    #[test]
+    fn glass_caustic_matches_the_light_tracer() {
+        let fixture = caustic_scene();
+        let scene = fixture.scene();
+        // The light tracer cannot see anything through the glass (its paths end at a diffuse
+        // vertex connected to the pinhole): compare the pixels where the sphere is not seen.
+        let mask = pixels_not_seeing(&fixture, 1);
+        let kept = mask.iter().filter(|k| **k).count();
+        assert!((100..240).contains(&kept), "{kept} pixels kept");
+        let bdpt = bdpt_mean(&scene, 8, 16, &mask);
+        assert_agree("bdpt vs light", bdpt, light_mean(&scene, 8, 200_000, &mask));
+        // The caustic is there: the floor under the sphere is brighter than without it.
+        let plain = spot_scene();
+        let plain_scene = plain.scene();
+        let without = light_mean(&plain_scene, 4, 100_000, &mask);
+        assert!(bdpt.0 > without.0 + 3.0 * (bdpt.1 + without.1), "{bdpt:?} vs {without:?}");
+    }
+
+    #[test]
+    fn passes_are_normalised_per_pixel() {
+        let fixture = spot_scene();
+        let scene = fixture.scene();
+        let bdpt = Bdpt::new(&scene, BdptSettings::default(), effects(&scene));
+        assert_eq!(bdpt.name(), "bdpt");
+        assert_eq!(bdpt.pass_samples(), 256);
+        assert_eq!(bdpt.image_scale(0), 0.0);
+        assert_eq!(bdpt.image_scale(512), 0.5);
+        let s: BdptSettings = serde_json::from_str(r#"{"max_depth": 3, "rr_depth": 1}"#).unwrap();
+        assert_eq!(s, BdptSettings { max_depth: 3, rr_depth: 1 });
+        assert!(serde_json::from_str::<BdptSettings>(r#"{"max_depth": 3, "rr": 1}"#).is_err());
     }
 }
