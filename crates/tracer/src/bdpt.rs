@@ -1284,9 +1284,9 @@ mod tests {
     fn cornell_box_matches_the_light_and_path_tracers() {
         let fixture = box_scene();
         let scene = fixture.scene();
-        let bdpt = bdpt_mean(&scene, 8, 16, &ALL);
-        assert_agree("bdpt vs light", bdpt, light_mean(&scene, 8, 200_000, &ALL));
-        assert_agree("bdpt vs path", bdpt, path_mean(&scene, 8, 32));
+        let bdpt = bdpt_mean(&scene, 8, 10, &ALL);
+        assert_agree("bdpt vs light", bdpt, light_mean(&scene, 8, 80_000, &ALL));
+        assert_agree("bdpt vs path", bdpt, path_mean(&scene, 8, 12));
     }
 
     #[test]
@@ -1298,12 +1298,12 @@ mod tests {
         let mask = pixels_not_seeing(&fixture, 1);
         let kept = mask.iter().filter(|k| **k).count();
         assert!((100..240).contains(&kept), "{kept} pixels kept");
-        let bdpt = bdpt_mean(&scene, 8, 16, &mask);
-        assert_agree("bdpt vs light", bdpt, light_mean(&scene, 8, 200_000, &mask));
+        let bdpt = bdpt_mean(&scene, 8, 10, &mask);
+        assert_agree("bdpt vs light", bdpt, light_mean(&scene, 8, 80_000, &mask));
         // The caustic is there: the floor under the sphere is brighter than without it.
         let plain = spot_scene();
         let plain_scene = plain.scene();
-        let without = light_mean(&plain_scene, 4, 100_000, &mask);
+        let without = light_mean(&plain_scene, 4, 40_000, &mask);
         assert!(bdpt.0 > without.0 + 3.0 * (bdpt.1 + without.1), "{bdpt:?} vs {without:?}");
     }
 
