@@ -14,6 +14,7 @@
 //! of wavelengths per path when nothing is dispersive; beams that stop at the first diffuse hit
 //! when no interreflection is possible), reports it, and can be overridden.
 
+mod bdpt;
 mod camera;
 mod effects;
 mod film;
@@ -23,6 +24,7 @@ mod path_tracer;
 mod render;
 mod wavelengths;
 
+pub use bdpt::{Bdpt, BdptSettings, MisVertex, mis_weight};
 pub use camera::{
     CameraError, CameraRay, CameraRepr, CameraSample, FovAxis, PinholeCamera, Projection,
 };
