@@ -111,3 +111,40 @@ fn light_and_path_agree_on_a_spot_over_a_plane() {
     assert_eq!(choose_integrator(&s, None).0, IntegratorChoice::Path);
     assert_agree(&s, (IntegratorChoice::Light, 200_000), (IntegratorChoice::Path, 32 * 32 * 8), 8);
 }
+
+/// A closed diffuse sphere of reflectance `a` whose inside glows with radiance `L`: every point
+/// sees `L / (1 - a)` (the emission plus every interreflection: the white furnace).
+fn furnace(a: f64) -> Scene {
+    scene(&format!(
+        r#"{{
+      "camera": {{"position": [0.3, -0.2, 0.1], "look_at": [0, 0, -1], "fov": 100, "width": 16, "height": 16}},
+      "objects": [{{"shape": {{"type": "Sphere", "center": [0, 0, 0], "radius": 1.5}},
+                   "material": {{"type": "Diffuse", "reflectance": {a}}},
+                   "emission": {{"power": 30, "spd": {{"type": "Uniform", "min_nm": 400, "max_nm": 700}}, "two_sided": true}}}}],
+      "settings": {{"max_depth": 400, "rr_depth": 3}}
+    }}"#
+    ))
+}
+
+#[test]
+fn every_integrator_passes_the_furnace_test() {
+    // L = P / (2 pi A) on each side of the two-sided sphere; inside, the camera sees L / (1 - a)
+    // in every pixel. Tolerance: 5 standard errors over 6 seeds; the test must be sharp (3%).
+    let a = 0.6;
+    let s = furnace(a);
+    let spd = Uniform::new(400.0, 700.0).unwrap();
+    let area = 4.0 * std::f64::consts::PI * 1.5 * 1.5;
+    let l = 30.0 / (2.0 * std::f64::consts::PI * area);
+    let expected = y_of_radiance(l / (1.0 - a), &spd);
+    for (integrator, effort) in
+        [(IntegratorChoice::Light, 100_000), (IntegratorChoice::Path, 16 * 16 * 16)]
+    {
+        let (mean, se) = mean_and_error(&s, integrator, effort, 6);
+        let name = integrator.name();
+        assert!(
+            (mean - expected).abs() < 5.0 * se,
+            "{name}: {mean} vs {expected} (standard error {se})"
+        );
+        assert!(se < 0.03 * expected, "{name}: standard error {se} vs {expected}");
+    }
+}

@@ -291,6 +291,9 @@ impl LightSource for RectangleLight {
     fn pdf_emission(&self, _position: DVec3, direction: DVec3) -> Option<(f64, f64)> {
         Some((1.0 / self.area, lambertian_density(self.frame.n(), self.two_sided, direction)))
     }
+    fn normal_at(&self, _position: DVec3) -> Option<DVec3> {
+        Some(self.frame.n())
+    }
     fn surface(&self) -> Option<LightSurface> {
         Some(LightSurface::Rectangle {
             corner: self.corner,
@@ -442,6 +445,9 @@ impl LightSource for DiskLight {
     }
     fn pdf_emission(&self, _position: DVec3, direction: DVec3) -> Option<(f64, f64)> {
         Some((1.0 / self.area(), lambertian_density(self.normal, self.two_sided, direction)))
+    }
+    fn normal_at(&self, _position: DVec3) -> Option<DVec3> {
+        Some(self.normal)
     }
     fn surface(&self) -> Option<LightSurface> {
         Some(LightSurface::Disk { center: self.center, normal: self.normal, radius: self.radius })

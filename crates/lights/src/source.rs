@@ -132,6 +132,14 @@ pub trait LightSource: Send + Sync + Debug {
         None
     }
 
+    /// The unit normal of the light's surface at `position` (a point of it, such as a beam's
+    /// origin), on the front side; `None` (the default) for lights without a surface. BDPT
+    /// needs it to turn densities at the light into area densities.
+    fn normal_at(&self, position: DVec3) -> Option<DVec3> {
+        let _ = position;
+        None
+    }
+
     /// The light's emitting surface, so a renderer can make it part of the scene: visible to
     /// camera rays (with [`emitted_radiance`](Self::emitted_radiance)) and blocking light. `None`
     /// (the default) for lights without one (points, parallel beams).

@@ -21,7 +21,7 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 use spectrace_lights::LightSource;
 use spectrace_tracer::{
-    Effects, EffectsMode, Film, FilmError, Integrator, IntegratorChoice, LightTracer,
+    Bdpt, Effects, EffectsMode, Film, FilmError, Integrator, IntegratorChoice, LightTracer,
     LightTracerScene, MemoryLimit, PathTracer, RenderOutput, RenderPlan, TraceStats, image_scale,
     render,
 };
@@ -518,9 +518,10 @@ pub fn with_integrator<R>(
 ) -> R {
     let tracer_scene = tracer_scene(scene);
     match choice {
-        IntegratorChoice::Path | IntegratorChoice::Bdpt => {
+        IntegratorChoice::Path => {
             f(&PathTracer::new(&tracer_scene, scene.path_settings(), effects))
         }
+        IntegratorChoice::Bdpt => f(&Bdpt::new(&tracer_scene, scene.bdpt_settings(), effects)),
         IntegratorChoice::Light | IntegratorChoice::Auto => {
             f(&LightTracer::new(&tracer_scene, scene.tracer_settings(), effects))
         }

@@ -13,8 +13,8 @@ use spectrace_materials::Diffuse;
 use spectrace_materials::Material;
 use spectrace_spectrum::Reflectance;
 use spectrace_tracer::{
-    DEFAULT_CHUNK_BEAMS, EffectsMode, Emitter, IntegratorChoice, LightTracerSettings, MAX_DEPTH,
-    PathTracerSettings, PinholeCamera, RenderPlan,
+    BdptSettings, DEFAULT_CHUNK_BEAMS, EffectsMode, Emitter, IntegratorChoice, LightTracerSettings,
+    MAX_DEPTH, ObjectEmission, ObjectLight, PathTracerSettings, PinholeCamera, RenderPlan,
 };
 
 use crate::files::{MAX_SCENE_BYTES, check_output_name, read_bounded};
@@ -27,7 +27,9 @@ pub struct SceneFile {
     pub camera: PinholeCamera,
     /// The objects: a shape and its material each.
     pub objects: Vec<Object>,
-    /// The light sources (any `LightSource` type, including third-party ones).
+    /// The light sources (any `LightSource` type, including third-party ones); may be empty
+    /// (or left out) when objects glow.
+    #[serde(default)]
     pub lights: Vec<Box<dyn LightSource>>,
     /// How much to render and how.
     #[serde(default)]
@@ -51,6 +53,10 @@ pub struct Object {
     pub shape: Shape,
     /// The material (`{"type": "Diffuse", ...}`).
     pub material: Box<dyn Material>,
+    /// Makes the object glow: a Lambertian emitter over its whole surface
+    /// (`{"power": W, "spd": {...}, "two_sided": false}`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub emission: Option<ObjectEmission>,
     /// An optional transform of the whole object, applied after the shape's own `transform`
     /// (same forms: `{"matrix": [...]}` row-major, or `translate`/`rotate`/`scale`).
     #[serde(default, skip_serializing)]
@@ -343,6 +349,7 @@ impl Scene {
         let mut non_convex = Vec::with_capacity(file.objects.len());
         let mut inputs = Vec::new();
         let base = path.parent().unwrap_or_else(|| Path::new("."));
+        let mut object_lights: Vec<(usize, ObjectLight)> = Vec::new();
         for (index, mut object) in file.objects.into_iter().enumerate() {
             if let Shape::Mesh(mesh) = &object.shape
                 && let Some(obj) = mesh.obj_path()
@@ -366,16 +373,44 @@ impl Scene {
                 .shape
                 .load(base)
                 .map_err(|e| scene_error(&format!("objects[{index}].shape"), e.to_string()))?;
+            if let Some(emission) = &object.emission {
+                let light = ObjectLight::new(object.shape.clone(), emission).map_err(|e| {
+                    scene_error(&format!("objects[{index}].emission"), e.to_string())
+                })?;
+                object_lights.push((index, light));
+            }
             shapes.push(object.shape);
             materials.push(Arc::from(object.material));
         }
-        let lights =
-            LightSet::new(file.lights).map_err(|e| scene_error("lights", e.to_string()))?;
-        // Area lights are part of the scene: their surfaces block light and camera paths, and
-        // camera paths that hit them see their radiance. They reflect nothing.
         let object_shapes = shapes.len();
         let mut emitters: Vec<Option<Emitter>> = vec![None; object_shapes];
-        for (index, light) in lights.lights().iter().enumerate() {
+        let mut all_lights = file.lights;
+        let glowing: Vec<(usize, f64, bool, f64)> = object_lights
+            .iter()
+            .map(|(i, l)| (*i, l.radiance(), l.two_sided(), l.area()))
+            .collect();
+        all_lights
+            .extend(object_lights.into_iter().map(|(_, l)| Box::new(l) as Box<dyn LightSource>));
+        if all_lights.is_empty() {
+            return Err(scene_error(
+                "lights",
+                "the scene has no lights and no object with an `emission`".to_owned(),
+            ));
+        }
+        let lights = LightSet::new(all_lights).map_err(|e| scene_error("lights", e.to_string()))?;
+        // Glowing objects' lights are the set's last ones.
+        let first_glowing = lights.lights().len() - glowing.len();
+        for (k, &(index, radiance, two_sided, area)) in glowing.iter().enumerate() {
+            emitters[index] = Some(Emitter::Object {
+                light: LightId((first_glowing + k) as u32),
+                radiance,
+                two_sided,
+                area,
+            });
+        }
+        // Area lights are part of the scene: their surfaces block light and camera paths, and
+        // camera paths that hit them see their radiance. They reflect nothing.
+        for (index, light) in lights.lights().iter().enumerate().take(first_glowing) {
             let Some(surface) = light.surface() else { continue };
             let shape = match surface {
                 LightSurface::Rectangle { corner, edge_u, edge_v } => {
@@ -425,6 +460,11 @@ impl Scene {
             rr_depth: self.settings.rr_depth,
             ..PathTracerSettings::default()
         }
+    }
+
+    /// BDPT's settings.
+    pub fn bdpt_settings(&self) -> BdptSettings {
+        BdptSettings { max_depth: self.settings.max_depth, rr_depth: self.settings.rr_depth }
     }
 
     /// The render plan of the scene's settings (light tracer work items: beams).

@@ -448,6 +448,11 @@ fn surface_area(light: &dyn LightSource) -> f64 {
     }
 }
 
+/// Unit normal of a light's surface at `point`, zero when it has none.
+fn light_normal(light: &dyn LightSource, point: DVec3) -> DVec3 {
+    light.normal_at(point).unwrap_or_else(|| surface_normal(light))
+}
+
 /// Unit normal of a light's emitting surface, zero when it has none.
 fn surface_normal(light: &dyn LightSource) -> DVec3 {
     match light.surface() {
@@ -526,7 +531,7 @@ fn generate_light_subpath(
     buffers.light.push(Vertex {
         kind: VertexKind::Light(light.id),
         point: beam.origin,
-        ng: surface_normal(source),
+        ng: light_normal(source, beam.origin),
         beta,
         delta: light.flags.delta_direction,
         pdf_fwd: if camera_strategies { light.pmf * pdf_pos } else { 1.0 },
@@ -752,7 +757,7 @@ fn connect(
         sampled = Some(Vertex {
             kind: VertexKind::Light(id),
             point: sample.position,
-            ng: surface_normal(source),
+            ng: light_normal(source, sample.position),
             beta: 0.0,
             delta: end.flags.delta_direction,
             pdf_fwd: end.pmf * pdf_pos,

@@ -20,6 +20,7 @@ mod effects;
 mod film;
 mod integrator;
 mod light_tracer;
+mod object_light;
 mod path_tracer;
 mod render;
 mod wavelengths;
@@ -35,6 +36,7 @@ pub use light_tracer::{
     Emitter, LightTracerScene, LightTracerSettings, MAX_DEPTH, TraceStats, chunk_rng, image_scale,
     trace_chunk, trace_chunk_until,
 };
+pub use object_light::{ObjectEmission, ObjectLight};
 pub use path_tracer::{PathTracer, PathTracerSettings};
 pub use render::{
     DEFAULT_CHUNK_BEAMS, FALLBACK_MEMORY_LIMIT, MemoryLimit, RenderOutput, RenderPlan, render,

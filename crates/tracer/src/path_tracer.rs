@@ -48,7 +48,8 @@ use crate::{CameraWavelengths, Effects, HERO, Integrator, Splat, chunk_rng};
 /// Settings of the path tracer.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct PathTracerSettings {
-    /// Most bounces a path may make (0: only what the camera sees directly and its direct light).
+    /// Most bounces a path may make, counted as the light tracer counts them: at most
+    /// `max_depth + 1` scattering vertices (0: direct light on the first surface the camera sees).
     pub max_depth: u32,
     /// Bounces after which Russian roulette may end a path.
     pub rr_depth: u32,
@@ -116,8 +117,9 @@ impl<'a> PathTracer<'a> {
     ) -> Xyz {
         let camera = self.scene.camera;
         let u_film = [uniform(rng), uniform(rng)];
-        let direction = camera.direction(f64::from(px) + u_film[0], f64::from(py) + u_film[1]);
-        let ray = Ray { origin: camera.position(), direction };
+        let u_lens = if camera.is_pinhole() { [0.5; 2] } else { [uniform(rng), uniform(rng)] };
+        let camera_ray = camera.generate_ray(px, py, u_film, u_lens);
+        let ray = Ray { origin: camera_ray.origin, direction: camera_ray.direction };
         let (mut lambdas, mut lambda_weights) = self.settings.wavelengths.sample_hero(uniform(rng));
         let radiance = self.radiance(ray, &mut lambdas, &mut lambda_weights, rng, stats);
         let mut xyz = Xyz::default();
@@ -177,10 +179,6 @@ impl<'a> PathTracer<'a> {
             }
             let Some(material) = scene.materials.get(hit.primitive as usize) else { break };
             let material: &dyn Material = material.as_ref();
-            if depth >= self.settings.max_depth {
-                stats.depth_limited += 1;
-                break;
-            }
             if material.is_dispersive() && !collapsed {
                 // Directions now depend on the wavelength: the hero alone continues.
                 collapsed = true;
@@ -198,6 +196,12 @@ impl<'a> PathTracer<'a> {
                     // an emitter seen by the BSDF-sampled ray remains (for MIS).
                     last_bounce = true;
                 }
+            }
+            if depth >= self.settings.max_depth && !last_bounce {
+                // The deepest vertex: one more ray, only for the emission it may hit (the BSDF
+                // half of this vertex's MIS pair), as the light tracer's deepest connection.
+                stats.depth_limited += 1;
+                last_bounce = true;
             }
             let u = [uniform(rng), uniform(rng), uniform(rng)];
             let mut sampled: Option<(DVec3, ScatterKind, f64)> = None;

@@ -1,0 +1,245 @@
+//! [`ObjectLight`]: any object of a scene made to glow (`objects[i].emission`), a Lambertian
+//! emitter over its shape's whole surface, sampled uniformly by area.
+//!
+//! | field | unit | default | meaning |
+//! |---|---|---|---|
+//! | `power` | W | required | total emitted power (both sides together when two-sided) |
+//! | `spd` | SPD | required | spectrum |
+//! | `two_sided` | | `false` | emit from both sides of the surface (else only outwards: along the geometric normal) |
+//!
+//! ```json
+//! {"shape": {"type": "Sphere", "center": [0, 1, 0], "radius": 0.1},
+//!  "material": {"type": "Diffuse", "reflectance": 0.8},
+//!  "emission": {"power": 20, "spd": {"type": "Blackbody", "kelvin": 2700}}}
+//! ```
+//!
+//! Every point of the surface emits the radiance `L = power / (pi * area)` (halved when
+//! two-sided) into the hemisphere around its outward normal; the object's material still
+//! reflects light that falls on it. The light is built by the renderer from the object, so it is
+//! not a light type of scene files' `lights` list.
+
+use std::f64::consts::PI;
+use std::sync::Arc;
+
+use glam::DVec3;
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+use spectrace_geometry::{Ray, Shape};
+use spectrace_lights::{
+    Beam, EmissionSample, LightError, LightFlags, LightSample, LightSource, SpdLight,
+    WavelengthSampling, uniform,
+};
+use spectrace_sampling::{Frame, sample_cosine_hemisphere_concentric};
+use spectrace_spectrum::SpectralPowerDistribution;
+
+/// The scene-file form of an object's emission.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectEmission {
+    /// Total emitted power (W).
+    pub power: f64,
+    /// The spectrum.
+    pub spd: Arc<dyn SpectralPowerDistribution>,
+    /// Whether both sides emit.
+    #[serde(default)]
+    pub two_sided: bool,
+}
+
+/// A glowing object: a Lambertian emitter over a shape's surface.
+#[derive(Debug, Clone)]
+pub struct ObjectLight {
+    emission: SpdLight,
+    shape: Shape,
+    area: f64,
+    two_sided: bool,
+}
+
+impl ObjectLight {
+    /// The light of `shape` emitting `emission`.
+    ///
+    /// # Errors
+    /// [`LightError`] naming `power` (negative or not finite) or `area` (a shape without area).
+    pub fn new(shape: Shape, emission: &ObjectEmission) -> Result<Self, LightError> {
+        let spd_light = SpdLight::new(
+            "emission",
+            emission.spd.clone(),
+            emission.power,
+            WavelengthSampling::Importance,
+        )?;
+        let area = shape.area();
+        if !(area > 0.0 && area.is_finite()) {
+            return Err(LightError::parameter(
+                "emission",
+                "area",
+                area,
+                "the shape must have a positive, finite area to emit",
+            ));
+        }
+        Ok(Self { emission: spd_light, shape, area, two_sided: emission.two_sided })
+    }
+
+    /// Radiance of every point (W m^-2 sr^-1, whole spectrum): `power / (pi area)`, halved when
+    /// two-sided.
+    pub fn radiance(&self) -> f64 {
+        let sides = if self.two_sided { 2.0 } else { 1.0 };
+        self.emission.power() / (PI * self.area * sides)
+    }
+
+    /// Surface area (m^2).
+    pub fn area(&self) -> f64 {
+        self.area
+    }
+
+    /// Whether both sides emit.
+    pub fn two_sided(&self) -> bool {
+        self.two_sided
+    }
+
+    /// The outward normal at `position` (a point of the surface), found by crossing the surface
+    /// there along `direction` (a ray from just before the point); `None` for a direction
+    /// tangent to the surface or a point not on it.
+    fn normal_crossing(&self, position: DVec3, direction: DVec3) -> Option<DVec3> {
+        let eps = 1e-7 * (1.0 + position.abs().max_element());
+        for d in [direction, -direction] {
+            let ray = Ray { origin: position - d * eps, direction: d };
+            if let Some(hit) = self.shape.intersect(&ray, 2.0 * eps)
+                && (hit.point - position).length() <= 4.0 * eps
+            {
+                return Some(hit.geometric_normal);
+            }
+        }
+        None
+    }
+
+    /// Directional density (sr^-1) of emission along `direction` from a point with `normal`.
+    fn density(&self, normal: DVec3, direction: DVec3) -> f64 {
+        let c = direction.dot(normal);
+        if self.two_sided { c.abs() / (2.0 * PI) } else { c.max(0.0) / PI }
+    }
+
+    /// Samples an emission ray from four uniforms and the area sample's third one.
+    fn sample(&self, u: [f64; 5]) -> EmissionSample {
+        let p = self.shape.sample_area([u[0], u[1], u[4]]);
+        let mut normal = p.normal;
+        let mut local = sample_cosine_hemisphere_concentric([u[2], u[3]]);
+        if self.two_sided {
+            // The side from the low bit of the area sample's spare uniform: fold it.
+            let side = (u[4] * 2.0).fract() >= 0.5;
+            if side {
+                local.z = -local.z;
+                normal = -normal;
+            }
+        }
+        let direction = Frame::from_normal(p.normal).to_world(local).normalize();
+        EmissionSample {
+            position: p.point,
+            normal,
+            direction,
+            pdf_position: 1.0 / self.area,
+            pdf_direction: self.density(p.normal, direction),
+        }
+    }
+}
+
+/// A third uniform for the area sample when the caller gives two (`sample_towards`,
+/// `sample_emission`): the SplitMix64 hash of both uniforms' bits, as independent of them as a
+/// fresh draw for the purpose (its 53 bits depend on all of theirs).
+fn third_uniform(a: f64, b: f64) -> f64 {
+    let mut z = a.to_bits() ^ b.to_bits().rotate_left(29) ^ 0x9E37_79B9_7F4A_7C15;
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    (z >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+}
+
+impl Serialize for ObjectLight {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let mut s = serializer.serialize_struct("ObjectLight", 3)?;
+        s.serialize_field("power", &self.emission.power())?;
+        s.serialize_field("area", &self.area)?;
+        s.serialize_field("two_sided", &self.two_sided)?;
+        s.end()
+    }
+}
+
+impl<'de> Deserialize<'de> for ObjectLight {
+    fn deserialize<D: serde::Deserializer<'de>>(_deserializer: D) -> Result<Self, D::Error> {
+        Err(serde::de::Error::custom(
+            "ObjectLight is not a light type of the `lights` list: give an object an `emission` \
+             ({\"power\": W, \"spd\": {...}}) to make it glow",
+        ))
+    }
+}
+
+#[typetag::serde]
+impl LightSource for ObjectLight {
+    fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
+        let u = [uniform(rng), uniform(rng), uniform(rng), uniform(rng), uniform(rng)];
+        let s = self.sample(u);
+        let (lambda, scale) = self.emission.wavelength(uniform(rng));
+        self.emission.count();
+        Beam::new(s.position, s.direction, lambda, scale)
+    }
+
+    spectrace_lights::delegate_to_spd_light!(emission);
+
+    fn flags(&self) -> Option<LightFlags> {
+        Some(LightFlags::default())
+    }
+
+    fn emission_density(&self, origin: DVec3, direction: DVec3) -> f64 {
+        self.normal_crossing(origin, direction).map_or(0.0, |n| self.density(n, direction))
+    }
+
+    fn sample_towards(&self, receiver: DVec3, u: [f64; 2]) -> Option<LightSample> {
+        let p = self.shape.sample_area([u[0], u[1], third_uniform(u[0], u[1])]);
+        let to = receiver - p.point;
+        let distance = to.length();
+        if !(distance > 0.0 && distance.is_finite()) {
+            return None;
+        }
+        let direction = to / distance;
+        let c = direction.dot(p.normal);
+        let cos = if self.two_sided { c.abs() } else { c.max(0.0) };
+        let pdf = if c != 0.0 { distance * distance / (self.area * c.abs()) } else { 0.0 };
+        Some(LightSample {
+            position: p.point,
+            direction,
+            distance,
+            intensity: self.radiance() * cos * self.area,
+            pdf,
+            delta: false,
+        })
+    }
+
+    fn pdf_towards(&self, receiver: DVec3, position: DVec3) -> f64 {
+        let to = receiver - position;
+        let d2 = to.length_squared();
+        let Some(n) = self.normal_crossing(position, -to) else { return 0.0 };
+        let c = (to.dot(n) / d2.sqrt()).abs();
+        if c > 0.0 { d2 / (self.area * c) } else { 0.0 }
+    }
+
+    fn emitted_radiance(&self, position: DVec3, direction: DVec3) -> f64 {
+        let Some(n) = self.normal_crossing(position, direction) else { return 0.0 };
+        let c = direction.dot(n);
+        if c > 0.0 || (self.two_sided && c < 0.0) { self.radiance() } else { 0.0 }
+    }
+
+    fn sample_emission(&self, u: [f64; 4]) -> Option<EmissionSample> {
+        Some(self.sample([u[0], u[1], u[2], u[3], third_uniform(u[0], u[1])]))
+    }
+
+    fn normal_at(&self, position: DVec3) -> Option<DVec3> {
+        // Cross the surface at the point along a direction that is not tangent to it.
+        [DVec3::X, DVec3::Y, DVec3::Z, DVec3::new(0.6, 0.48, 0.64)]
+            .into_iter()
+            .find_map(|d| self.normal_crossing(position, d))
+    }
+
+    fn pdf_emission(&self, position: DVec3, direction: DVec3) -> Option<(f64, f64)> {
+        let n = self.normal_crossing(position, direction)?;
+        Some((1.0 / self.area, self.density(n, direction)))
+    }
+}
