@@ -1005,6 +1005,8 @@ mod tests {
             fov_axis: FovAxis::Horizontal,
             width: 16,
             height: 16,
+            aperture_radius: 0.0,
+            focus_distance: None,
         })
         .unwrap()
     }
