@@ -90,33 +90,47 @@ impl IntegratorChoice {
     /// The estimator for a scene with `features`: this choice, or for [`IntegratorChoice::Auto`]
     /// the effects analysis' pick, with the reason in words. Never returns `Auto`.
     ///
-    /// The rule (measured: see the accuracy report): the path tracer, unless the scene has light
-    /// that camera paths cannot reach, which the light tracer renders instead:
-    /// - a light that is only a beam generator (a plugin without `sample_towards`),
-    /// - a light with a delta direction (laser, sky),
-    /// - a light with spectral lines,
-    /// - a delta-position light (point, spot) together with a specular surface: its caustics.
+    /// The rule (measured: see the accuracy report):
+    /// - **light** when a light only generates beams (a plugin without `sample_towards` or
+    ///   emission densities): no other estimator can use it;
+    /// - **path** when every light can be reached from the camera: no laser or sky (delta
+    ///   direction), no spectral lines, and no point or spot light shining on mirrors or glass
+    ///   (its caustics);
+    /// - otherwise **bdpt** when the scene has mirrors or glass (the light tracer would show
+    ///   them black: light paths cannot reach a pinhole through a specular surface, and BDPT's
+    ///   camera paths can),
+    /// - and **light** for the rest (lasers, skies or lines on diffuse scenes): the light
+    ///   tracer is BDPT's light-side strategies alone, at a fraction of the cost.
     pub fn decide(self, features: &SceneFeatures) -> (IntegratorChoice, String) {
         if self != Self::Auto {
             return (self, format!("{} (asked for)", self.name()));
         }
         let f = features;
-        let light = |why: &str| (Self::Light, format!("light: {why}"));
         if f.beam_only_lights > 0 {
-            return light(
-                "a light only generates beams (no sample_towards), which only the light tracer can use",
+            return (
+                Self::Light,
+                "light: a light only generates beams (no sample_towards), which only the light \
+                 tracer can use"
+                    .to_owned(),
             );
         }
-        if f.delta_direction_lights > 0 {
-            return light("a laser or sky (parallel beams) is never reached by camera paths");
-        }
-        if f.line_spectra {
-            return light("a light has spectral lines, which camera paths cannot sample");
-        }
-        if f.delta_position_lights > 0 && f.specular {
-            return light(
-                "a point or spot light shines on mirrors or glass: its caustics are reachable only from the light",
-            );
+        let unreachable = if f.delta_direction_lights > 0 {
+            Some("a laser or sky (parallel beams) is never reached by camera paths")
+        } else if f.line_spectra {
+            Some("a light has spectral lines, which camera paths cannot sample")
+        } else if f.delta_position_lights > 0 && f.specular {
+            Some(
+                "a point or spot light shines on mirrors or glass, whose caustics only light paths find",
+            )
+        } else {
+            None
+        };
+        if let Some(why) = unreachable {
+            return if f.specular {
+                (Self::Bdpt, format!("bdpt: {why}, and mirrors or glass need camera paths"))
+            } else {
+                (Self::Light, format!("light: {why}, and nothing specular needs camera paths"))
+            };
         }
         (Self::Path, "path: every light can be reached from the camera".to_owned())
     }
@@ -206,6 +220,35 @@ impl Effects {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_integrator_follows_the_lights_and_surfaces() {
+        let pick = |f: SceneFeatures| IntegratorChoice::Auto.decide(&f).0;
+        let area = SceneFeatures { area_lights: 1, non_specular_shapes: 3, ..Default::default() };
+        assert_eq!(pick(area), IntegratorChoice::Path);
+        assert_eq!(pick(SceneFeatures { specular: true, ..area }), IntegratorChoice::Path);
+        let spot = SceneFeatures { delta_position_lights: 1, ..area };
+        assert_eq!(pick(spot), IntegratorChoice::Path);
+        assert_eq!(pick(SceneFeatures { specular: true, ..spot }), IntegratorChoice::Bdpt);
+        let sky = SceneFeatures { delta_direction_lights: 1, ..area };
+        assert_eq!(pick(sky), IntegratorChoice::Light);
+        assert_eq!(pick(SceneFeatures { specular: true, ..sky }), IntegratorChoice::Bdpt);
+        let lines = SceneFeatures { line_spectra: true, ..area };
+        assert_eq!(pick(lines), IntegratorChoice::Light);
+        let plugin = SceneFeatures { beam_only_lights: 1, specular: true, ..area };
+        let (choice, why) = IntegratorChoice::Auto.decide(&plugin);
+        assert_eq!(choice, IntegratorChoice::Light);
+        assert!(why.contains("only generates beams"), "{why}");
+        // An explicit choice is kept and says so.
+        assert_eq!(
+            IntegratorChoice::Bdpt.decide(&area),
+            (IntegratorChoice::Bdpt, "bdpt (asked for)".to_owned())
+        );
+        for c in ["auto", "light", "path", "bdpt"] {
+            assert_eq!(IntegratorChoice::from_name(c).map(IntegratorChoice::name), Some(c));
+        }
+        assert_eq!(IntegratorChoice::from_name("mlt"), None);
+    }
 
     #[test]
     fn decisions_follow_the_features() {
