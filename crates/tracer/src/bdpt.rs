@@ -42,8 +42,9 @@
 //!
 //! # Normalisation
 //! A chunk is one *pass*: one sample of every pixel, in pixel order ([`Bdpt::pass_samples`]
-//! items), as for the [`crate::PathTracer`]. The film is normalised per pixel sample
-//! ([`Integrator::image_scale`] `= pixels / samples`). Camera strategies (`t >= 2`) estimate the
+//! items), as for the [`crate::PathTracer`]. The film is normalised per pixel sample and holds
+//! values relative to the lights' total power ([`Integrator::image_scale`] `= power * pixels /
+//! samples`). Camera strategies (`t >= 2`) estimate the
 //! pixel of their camera sample directly. A `t = 1` connection estimates the pixel it lands in,
 //! and one light path is traced per camera sample: a pass traces `pixels` light paths, which
 //! together make *one* light-tracing estimate of the whole image (each path's splat divided by
@@ -393,7 +394,9 @@ impl<'a> Bdpt<'a> {
         let wl = Wavelength { lambda: beam.lambda, density };
         let camera_strategies = beam.scale == 1.0 && density > 0.0 && density.is_finite();
         let Some(light) = self.light_end(beam.parent, &wl) else { return };
-        let inv_y = 1.0 / *CIE_Y_INTEGRAL;
+        // The film holds radiance relative to the lights' total power, as the path tracer's
+        // (see `image_scale`).
+        let inv_y = 1.0 / (*CIE_Y_INTEGRAL * self.scene.lights.power());
         let pixels = self.pass_samples().max(1) as f64;
 
         generate_light_subpath(self, &beam, &light, &wl, camera_strategies, rng, buffers, stats);
@@ -942,8 +945,15 @@ impl Integrator for Bdpt<'_> {
         stats
     }
 
+    /// The lights' power times the pixels over the samples: the film holds each sample's
+    /// contributions divided by the lights' total power (lights of any power keep the exact film
+    /// in range), and the image is the mean per pixel.
     fn image_scale(&self, samples_done: u64) -> f64 {
-        if samples_done == 0 { 0.0 } else { self.pass_samples() as f64 / samples_done as f64 }
+        if samples_done == 0 {
+            0.0
+        } else {
+            self.scene.lights.power() * self.pass_samples() as f64 / samples_done as f64
+        }
     }
 }
 
@@ -1322,7 +1332,8 @@ mod tests {
         assert_eq!(bdpt.name(), "bdpt");
         assert_eq!(bdpt.pass_samples(), 256);
         assert_eq!(bdpt.image_scale(0), 0.0);
-        assert_eq!(bdpt.image_scale(512), 0.5);
+        // The spot scene's lights' power times 256 pixels over 512 samples.
+        assert_eq!(bdpt.image_scale(512), scene.lights.power() * 0.5);
         let s: BdptSettings = serde_json::from_str(r#"{"max_depth": 3, "rr_depth": 1}"#).unwrap();
         assert_eq!(s, BdptSettings { max_depth: 3, rr_depth: 1 });
         assert!(serde_json::from_str::<BdptSettings>(r#"{"max_depth": 3, "rr": 1}"#).is_err());

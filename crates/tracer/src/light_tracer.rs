@@ -378,7 +378,8 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
             }
         }
         // Lights seen directly: connect the emission point to the camera.
-        if let Some((x, y, value)) = connect_emission(scene, &beam) {
+        if let Some((x, y, value)) = connect_emission(scene, &beam, lens_uniforms(scene, &mut rng))
+        {
             let mut xyz = spectrace_spectrum::Xyz::default();
             for j in 0..k {
                 xyz += cmf(lambdas[j]) * (weights[j] * value * inv_y);
@@ -395,9 +396,14 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
             let Some(material) = scene.materials.get(hit.primitive as usize) else { break };
             let specular = material.is_specular();
             if !specular {
-                if let Some((x, y, value)) =
-                    connect_to_camera(scene, material.as_ref(), &hit, ray.direction, &lambdas[..k])
-                {
+                if let Some((x, y, value)) = connect_to_camera(
+                    scene,
+                    material.as_ref(),
+                    &hit,
+                    ray.direction,
+                    &lambdas[..k],
+                    lens_uniforms(scene, &mut rng),
+                ) {
                     let mut xyz = spectrace_spectrum::Xyz::default();
                     for j in 0..k {
                         xyz += cmf(lambdas[j]) * (weights[j] * value[j] * inv_y);
@@ -470,6 +476,12 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
     stats
 }
 
+/// Uniforms for a point on the camera's lens: none are drawn for a pinhole (so pinhole images do
+/// not depend on whether the camera could have a lens).
+fn lens_uniforms(scene: &LightTracerScene<'_>, rng: &mut Pcg64) -> [f64; 2] {
+    if scene.camera.is_pinhole() { [0.5; 2] } else { [uniform(rng), uniform(rng)] }
+}
+
 /// Largest wavelength bundle a path can carry.
 const MAX_BUNDLE: usize = 8;
 
@@ -478,9 +490,10 @@ const MAX_BUNDLE: usize = 8;
 fn connect_emission(
     scene: &LightTracerScene<'_>,
     beam: &spectrace_lights::Beam,
+    u_lens: [f64; 2],
 ) -> Option<(u32, u32, f64)> {
     let light = scene.lights.light(beam.parent)?;
-    let projection = scene.camera.project(beam.origin)?;
+    let projection = scene.camera.sample_wi(beam.origin, u_lens)?;
     let density = light.emission_density(beam.origin, projection.to_camera);
     if !(density > 0.0) {
         return None;
@@ -500,9 +513,10 @@ fn connect_to_camera(
     hit: &spectrace_geometry::Hit,
     arriving: DVec3,
     lambdas: &[f64],
+    u_lens: [f64; 2],
 ) -> Option<(u32, u32, [f64; MAX_BUNDLE])> {
-    let projection = scene.camera.project(hit.point)?;
-    let (shadow, distance) = hit.spawn_ray_to(scene.camera.position());
+    let projection = scene.camera.sample_wi(hit.point, u_lens)?;
+    let (shadow, distance) = hit.spawn_ray_to(projection.position);
     if scene.world.occluded(&shadow, distance) {
         return None;
     }

@@ -157,6 +157,11 @@ fn ring_light_over_a_diffuse_plane_matches_the_closed_form() {
                     .unwrap();
             assert_eq!(sidecar["exr_scale_log2"], 0, "{sidecar}");
             assert_eq!(sidecar["rejected_contributions"], 0, "{sidecar}");
+            // The ring implements only the seed's beam generator: `auto` falls back to the
+            // light tracer, and the sidecar says why.
+            assert_eq!(sidecar["integrator"], "light", "{sidecar}");
+            let reason = sidecar["integrator_reason"].as_str().unwrap_or_default();
+            assert!(reason.contains("only generates beams"), "{sidecar}");
             let y = exr_y(&out.join("ring.exr"));
             assert_eq!(y.len(), SIZE * SIZE);
             let mut s = 0.0;
