@@ -207,3 +207,90 @@ fn a_thin_lens_renders_the_same_with_light_and_camera_paths() {
     assert!(!s.camera.is_pinhole());
     assert_agree(&s, (IntegratorChoice::Light, 200_000), (IntegratorChoice::Path, 32 * 32 * 8), 8);
 }
+
+#[test]
+fn camera_paths_see_a_slit_through_a_prism_where_snell_and_sellmeier_put_it() {
+    // The light tracer's prism test, reversed: a ray entering the 60-degree SF11 prism's left
+    // face at 75 degrees (away from minimum deviation, where the exit angle hardly moves) leaves
+    // with the closed-form deviation; a camera on the exit side sees a
+    // far slit (a narrow glowing strip on the entry side) in the direction the ray leaves, so the
+    // slit's image must land, per wavelength, in the pixel of -d_out(lambda). One wavelength band
+    // of 1 nm per render; a pixel is 0.05 degree wide. Tolerance: 1 pixel.
+    use glam::DVec3;
+    use spectrace_geometry::{Ray, Shape, World};
+    use spectrace_materials::{Dielectric, Incoming, Material};
+    let prism: Shape = serde_json::from_str(
+        r#"{"type": "Prism", "apex_angle_degrees": 60, "side": 1, "length": 1}"#,
+    )
+    .unwrap();
+    let world = World::new(vec![prism]).unwrap();
+    let glass = Dielectric::glass("SF11").unwrap();
+    let c30 = 30f64.to_radians().cos();
+    let n_left = DVec3::new(-c30, 0.5, 0.0);
+    let tangent = DVec3::new(0.5, c30, 0.0).normalize();
+    let theta1 = 75f64.to_radians();
+    let d_in = (-n_left * theta1.cos() - tangent * theta1.sin()).normalize();
+    let target = DVec3::new(-0.25, 0.0, 0.0);
+    let exit = |lambda: f64| {
+        let mut ray = Ray::new(target - d_in * 2.0, d_in);
+        let mut point = DVec3::ZERO;
+        for _ in 0..2 {
+            let hit = world.intersect(&ray, f64::INFINITY).unwrap();
+            let incoming =
+                Incoming { direction: ray.direction, normal: hit.shading_normal, lambda };
+            let out = glass.scatter(&incoming, [0.999_999, 0.5, 0.5]).unwrap();
+            point = hit.point;
+            ray = hit.spawn_ray(out.direction);
+        }
+        (point, ray.direction)
+    };
+    let (x_mid, d_mid) = exit(550.0);
+    let camera = x_mid + d_mid * 3.0;
+    let slit = target - d_in * 100.0;
+    // The strip: 5 cm wide across d_in in the prism's plane, 20 m tall along z, facing the prism.
+    let across = d_in.cross(DVec3::Z).normalize() * 0.05;
+    let corner = slit - across * 0.5 - DVec3::Z * 10.0;
+    for lambda in [450.0, 650.0] {
+        let json = format!(
+            r#"{{
+          "camera": {{"position": {:?}, "look_at": {:?}, "up": [0, 0, 1], "fov": 12, "width": 240, "height": 8}},
+          "objects": [
+            {{"shape": {{"type": "Prism", "apex_angle_degrees": 60, "side": 1, "length": 1}},
+             "material": {{"type": "Dielectric", "ior": {{"glass": "SF11"}}}}}},
+            {{"shape": {{"type": "Rectangle", "corner": {:?}, "edge_u": {:?}, "edge_v": [0, 0, 20]}},
+             "material": {{"type": "Diffuse", "reflectance": 0}},
+             "emission": {{"power": 1000, "spd": {{"type": "Uniform", "min_nm": {}, "max_nm": {}}}, "two_sided": true}}}}
+          ]
+        }}"#,
+            camera.to_array(),
+            x_mid.to_array(),
+            corner.to_array(),
+            across.to_array(),
+            lambda - 0.5,
+            lambda + 0.5
+        );
+        let s = scene(&json);
+        assert_eq!(choose_integrator(&s, None).0, IntegratorChoice::Path);
+        let r = render_with(&s, IntegratorChoice::Path, 240 * 8 * 1024, 9);
+        let mut columns = vec![0.0; 240];
+        for (i, p) in r.image.iter().enumerate() {
+            columns[i % 240] += p.x + p.y + p.z;
+        }
+        let total: f64 = columns.iter().sum();
+        assert!(total > 0.0, "{lambda} nm: the slit is not seen through the prism");
+        let seen = columns.iter().enumerate().map(|(x, c)| x as f64 * c).sum::<f64>() / total;
+        let (_, d_out) = exit(lambda);
+        // The traced exit direction is Snell's law with the Sellmeier index, in closed form.
+        let n = glass.ior().n(lambda);
+        let apex = 60f64.to_radians();
+        let theta4 = (n * (apex - (theta1.sin() / n).asin()).sin()).asin();
+        let deviation = d_in.dot(d_out).clamp(-1.0, 1.0).acos();
+        assert!((deviation - (theta1 + theta4 - apex)).abs() < 1e-9, "{lambda} nm: {deviation}");
+        let expected = s.camera.project(camera - d_out).unwrap().x as f64 + 0.5;
+        eprintln!("{lambda} nm: slit seen at column {seen:.2}, expected {expected}");
+        assert!(
+            (seen - expected).abs() <= 1.0,
+            "{lambda} nm: the slit appears at column {seen:.2}, Snell/Sellmeier put it at {expected}"
+        );
+    }
+}
