@@ -232,7 +232,7 @@ fn status() -> ExitCode {
     }
     println!(
         "\nRender the showcase scene:  cargo xtask render\n\
-         Render any scene:           cargo xtask render scenes/NAME.json [--beams N | --time SECS] [--out DIR] [--threads N] [--seed S]\n\
+         Render any scene:           cargo xtask render scenes/NAME.json [--integrator auto|light|path|bdpt] [--beams N | --spp N | --time SECS] [--out DIR] [--threads N] [--seed S]\n\
          Accuracy against time:      cargo xtask accuracy [SCENES]\n\
          Run every test:             cargo test --workspace\n\
          Run the benchmarks:         cargo xtask bench\n\n\

@@ -1,18 +1,25 @@
-//! Camera, spectral film and integrators of Spectrace; today the light tracer (seed 2.4.4).
+//! Camera, spectral film and the estimators of Spectrace: the light tracer (seed 2.4.4), the path
+//! tracer and bidirectional path tracing, behind one [`Integrator`] interface.
 //!
 //! This crate sits on all the others (sampling, spectrum, lights, geometry, materials) and under
-//! the renderer. Beams come from a [`spectrace_lights::LightSet`], travel through a
-//! [`spectrace_geometry::World`], scatter by each shape's [`spectrace_materials::Material`], and
-//! every non-specular hit (and every emission point) is connected to the [`PinholeCamera`] and
-//! splatted into the [`Film`] (see [`light_tracer`](trace_chunk) for the estimator). The render
-//! loop ([`render`]) drives any [`Integrator`]; [`LightTracer`] is the light tracer behind it.
+//! the renderer. A [`LightTracerScene`] holds what every estimator needs: the
+//! [`spectrace_geometry::World`], one [`spectrace_materials::Material`] per shape, the
+//! [`spectrace_lights::LightSet`] (also the light sampler), what each shape emits ([`Emitter`]:
+//! area lights' own surfaces and glowing objects, [`ObjectLight`]) and the [`PinholeCamera`]
+//! (a pinhole or a thin lens). [`LightTracer`] follows beams from the lights and connects them to
+//! the camera; [`PathTracer`] follows camera paths with next-event estimation and multiple
+//! importance sampling, carrying [`HERO`] wavelengths; [`Bdpt`] joins a camera path and a light
+//! path in every way and weighs the strategies by MIS. [`IntegratorChoice::decide`] picks one from
+//! what the scene holds. The render loop ([`render`]) drives any of them.
 //!
 //! The key design decisions: the film adds contributions in exact fixed point ([`ExactSum`]), so
 //! an image is bit-identical whatever the thread count, chunk order or number of machines
 //! ([`render`] splits work into chunks with their own random streams; sharded renders merge
-//! exactly); and an [`Effects`] analysis decides, before rendering, what the scene needs (a bundle
-//! of wavelengths per path when nothing is dispersive; beams that stop at the first diffuse hit
-//! when no interreflection is possible), reports it, and can be overridden.
+//! exactly), and every estimator writes the same film units, so their images can be compared
+//! pixel by pixel; and an [`Effects`] analysis decides, before rendering, what the scene needs
+//! (which estimator, a bundle of wavelengths per path when nothing is dispersive, beams that stop
+//! at the first diffuse hit when no interreflection is possible), reports it, and can be
+//! overridden.
 
 mod bdpt;
 mod camera;
