@@ -294,3 +294,70 @@ fn camera_paths_see_a_slit_through_a_prism_where_snell_and_sellmeier_put_it() {
         );
     }
 }
+
+#[test]
+fn camera_estimators_are_bit_identical_across_threads_and_merge_shards_exactly() {
+    use spectrace_renderer::{RenderOptions, merge_parts, render_scene};
+    let dir = crate::rendering::temp_dir("camera-shards");
+    let path = dir.join("glass.json");
+    std::fs::write(&path, GLASS_UNDER_AREA_LIGHT).unwrap();
+    let s = Scene::load(&path).unwrap();
+    for integrator in [IntegratorChoice::Path, IntegratorChoice::Bdpt] {
+        let name = integrator.name();
+        let base = RenderOptions {
+            spp: Some(6),
+            seed: Some(4),
+            integrator: Some(integrator),
+            ..quiet_defaults()
+        };
+        let whole = render_scene(
+            &s,
+            &RenderOptions {
+                out_dir: dir.join(name).join("whole"),
+                threads: Some(2),
+                ..base.clone()
+            },
+        )
+        .unwrap();
+        assert_eq!(whole.integrator, name);
+        // 6 passes of 32 x 32 samples.
+        assert_eq!(whole.beams, 6 * 32 * 32);
+        let one = render_in(&s, &base, 1);
+        let three = render_in(&s, &base, 3);
+        assert_eq!(one.output.film, three.output.film, "{name}: 1 and 3 threads differ");
+        let mut parts = Vec::new();
+        for k in 0..4 {
+            let opts = RenderOptions {
+                shard: Some((k, 4)),
+                out_dir: dir.join(name).join("parts"),
+                threads: Some(1),
+                ..base.clone()
+            };
+            parts.push(std::path::PathBuf::from(&render_scene(&s, &opts).unwrap().outputs[0]));
+        }
+        let merged = merge_parts(&parts, &dir.join(name).join("merged")).unwrap();
+        assert_eq!((merged.beams, merged.integrator.as_str()), (whole.beams, name));
+        for ext in ["exr", "png"] {
+            let a =
+                std::fs::read(dir.join(name).join("whole").join(format!("glass.{ext}"))).unwrap();
+            let b =
+                std::fs::read(dir.join(name).join("merged").join(format!("glass.{ext}"))).unwrap();
+            assert!(a == b, "{name}: the merged {ext} differs from the one-machine render");
+        }
+    }
+}
+
+/// Options that write nothing to the terminal.
+fn quiet_defaults() -> spectrace_renderer::RenderOptions {
+    spectrace_renderer::RenderOptions { verbose: false, ..Default::default() }
+}
+
+/// Renders in memory with `threads` threads.
+fn render_in(
+    s: &Scene,
+    options: &spectrace_renderer::RenderOptions,
+    threads: usize,
+) -> InMemoryRender {
+    let options = spectrace_renderer::RenderOptions { threads: Some(threads), ..options.clone() };
+    spectrace_renderer::render_in_memory(s, &options).unwrap()
+}
