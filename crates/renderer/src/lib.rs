@@ -958,7 +958,8 @@ pub fn effects_benchmark(
         seed: Some(1),
         ..RenderOptions::default()
     };
-    let plan = plan_for(scene, &options)?;
+    // The effects analysis' savings are measured on the light tracer, whose knobs they are.
+    let plan = plan_with(scene, &options, IntegratorChoice::Light)?;
     let measure = |mode: EffectsMode| -> Result<(f64, f64, Effects), RenderError> {
         let effects = decide_effects(scene, Some(mode));
         let started = Instant::now();
