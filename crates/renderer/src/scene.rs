@@ -13,8 +13,9 @@ use spectrace_materials::Diffuse;
 use spectrace_materials::Material;
 use spectrace_spectrum::Reflectance;
 use spectrace_tracer::{
-    BdptSettings, DEFAULT_CHUNK_BEAMS, EffectsMode, Emitter, IntegratorChoice, LightTracerSettings,
-    MAX_DEPTH, ObjectEmission, ObjectLight, PathTracerSettings, PinholeCamera, RenderPlan,
+    BdptSettings, CameraWavelengths, DEFAULT_CHUNK_BEAMS, EffectsMode, Emitter, IntegratorChoice,
+    LightTracerSettings, MAX_DEPTH, ObjectEmission, ObjectLight, PathTracerSettings, PinholeCamera,
+    RenderPlan,
 };
 
 use crate::files::{MAX_SCENE_BYTES, check_output_name, read_bounded};
@@ -86,6 +87,9 @@ pub struct Settings {
     /// Camera samples per pixel for the camera integrators (`path`, `bdpt`); the upper limit
     /// when `time_seconds` is set.
     pub spp: u64,
+    /// How the path tracer's camera paths draw their wavelengths: `"visible"` (in proportion to
+    /// the observer's sensitivity, the default) or `"uniform"` (360-830 nm).
+    pub camera_wavelengths: CameraWavelengths,
 }
 
 impl Default for Settings {
@@ -100,6 +104,7 @@ impl Default for Settings {
             chunk_beams: DEFAULT_CHUNK_BEAMS,
             integrator: IntegratorChoice::Auto,
             spp: DEFAULT_SPP,
+            camera_wavelengths: CameraWavelengths::Visible,
         }
     }
 }
@@ -458,7 +463,7 @@ impl Scene {
         PathTracerSettings {
             max_depth: self.settings.max_depth,
             rr_depth: self.settings.rr_depth,
-            ..PathTracerSettings::default()
+            wavelengths: self.settings.camera_wavelengths,
         }
     }
 
