@@ -42,8 +42,10 @@
 //!
 //! # Normalisation
 //! A chunk is one *pass*: one sample of every pixel, in pixel order ([`Bdpt::pass_samples`]
-//! items), as for the [`crate::PathTracer`]. The film is normalised per pixel sample
-//! ([`Integrator::image_scale`] `= pixels / samples`). Camera strategies (`t >= 2`) estimate the
+//! items), as for the [`crate::PathTracer`]. As the path tracer's, the film holds the estimates
+//! divided by the lights' total power `Phi` (the renderer's normalisation of camera integrators,
+//! which keeps lights of any power in the film's fixed-point range), normalised per pixel sample:
+//! [`Integrator::image_scale`] `= Phi * pixels / samples`. Camera strategies (`t >= 2`) estimate the
 //! pixel of their camera sample directly. A `t = 1` connection estimates the pixel it lands in,
 //! and one light path is traced per camera sample: a pass traces `pixels` light paths, which
 //! together make *one* light-tracing estimate of the whole image (each path's splat divided by
@@ -393,7 +395,9 @@ impl<'a> Bdpt<'a> {
         let wl = Wavelength { lambda: beam.lambda, density };
         let camera_strategies = beam.scale == 1.0 && density > 0.0 && density.is_finite();
         let Some(light) = self.light_end(beam.parent, &wl) else { return };
-        let inv_y = 1.0 / *CIE_Y_INTEGRAL;
+        // The film holds values relative to the lights' total power (see `image_scale`).
+        let power = scene.lights.power();
+        let inv_y = if power > 0.0 { 1.0 / (*CIE_Y_INTEGRAL * power) } else { 0.0 };
         let pixels = self.pass_samples().max(1) as f64;
 
         generate_light_subpath(self, &beam, &light, &wl, camera_strategies, rng, buffers, stats);
@@ -942,8 +946,15 @@ impl Integrator for Bdpt<'_> {
         stats
     }
 
+    /// The lights' power times the pixels over the samples: the film holds each sample's
+    /// estimate divided by the lights' total power, as the path tracer's (the renderer's
+    /// normalisation of camera integrators), and the image is the mean per pixel.
     fn image_scale(&self, samples_done: u64) -> f64 {
-        if samples_done == 0 { 0.0 } else { self.pass_samples() as f64 / samples_done as f64 }
+        if samples_done == 0 {
+            0.0
+        } else {
+            self.scene.lights.power() * self.pass_samples() as f64 / samples_done as f64
+        }
     }
 }
 
@@ -1080,6 +1091,34 @@ mod tests {
         }
     }
 
+    /// A closed diffuse sphere of reflectance `a` whose surface glows on both sides (radiance
+    /// `L`), with the camera inside: every pixel sees `L / (1 - a)` (the white furnace).
+    fn furnace_scene(a: f64) -> Fixture {
+        let sphere = Shape::Sphere(Sphere::new(DVec3::ZERO, 1.5).unwrap());
+        let emission: crate::ObjectEmission = serde_json::from_str(
+            r#"{"power": 30, "spd": {"type": "Uniform", "min_nm": 400, "max_nm": 700},
+            "two_sided": true}"#,
+        )
+        .unwrap();
+        let light = crate::ObjectLight::new(sphere.clone(), &emission).unwrap();
+        let emitter = Emitter::Object {
+            light: LightId(0),
+            radiance: light.radiance(),
+            two_sided: true,
+            area: light.area(),
+        };
+        let mut camera = camera([0.3, -0.2, 0.1], [0.0, 0.0, -1.0]);
+        camera = PinholeCamera::new(CameraRepr { fov: 100.0, ..camera.into() }).unwrap();
+        Fixture {
+            world: World::new(vec![sphere]).unwrap(),
+            materials: vec![material(&format!(r#"{{"type": "Diffuse", "reflectance": {a}}}"#))],
+            lights: LightSet::new(vec![Box::new(light)]).unwrap(),
+            camera,
+            emitters: vec![Some(emitter)],
+            objects: 1,
+        }
+    }
+
     fn effects(scene: &LightTracerScene<'_>) -> Effects {
         Effects::decide(scene.features(&[false; 8]), EffectsMode::Off)
     }
@@ -1197,7 +1236,7 @@ mod tests {
 
     #[test]
     fn mis_weights_of_all_strategies_of_sampled_paths_sum_to_one() {
-        for fixture in [box_scene(), caustic_scene(), spot_scene()] {
+        for fixture in [box_scene(), caustic_scene(), spot_scene(), furnace_scene(0.6)] {
             let scene = fixture.scene();
             let bdpt = Bdpt::new(&scene, BdptSettings::default(), effects(&scene));
             let mut rng = Pcg64::seed_from_u64(11);
@@ -1272,7 +1311,7 @@ mod tests {
             assert!(checked > 1000, "only {checked} connections");
             assert!(strategies[1] > 0 && strategies[2] > 0, "{strategies:?}");
             // Only the box has two diffuse surfaces that see each other, and a visible emitter.
-            if fixture.objects == 5 {
+            if fixture.objects == 5 || fixture.emitters.iter().any(Option::is_some) {
                 assert!(strategies[0] > 0 && strategies[3] > 0, "{strategies:?}");
             }
         }
@@ -1315,6 +1354,31 @@ mod tests {
     }
 
     #[test]
+    fn glowing_furnace_matches_the_closed_form_in_the_renderers_units() {
+        // A closed two-sided glowing diffuse sphere seen from inside: L / (1 - a) everywhere.
+        let a = 0.6;
+        let fixture = furnace_scene(a);
+        let scene = fixture.scene();
+        let bdpt = Bdpt::new(&scene, BdptSettings::default(), effects(&scene));
+        let pt = PathTracer::new(&scene, PathTracerSettings::default(), effects(&scene));
+        // The renderer turns every camera integrator's film into an image with the lights'
+        // power times the pixels over the samples: BDPT's film must be in the path tracer's
+        // units (it was in absolute units, 30x too bright here, the lights' power).
+        let (power, pixels) = (scene.lights.power(), bdpt.pass_samples());
+        for samples in [256, 4096, 12_345] {
+            let renderer = crate::image_scale(power, samples) * pixels as f64;
+            assert!((bdpt.image_scale(samples) - renderer).abs() <= 1e-12 * renderer);
+            assert_eq!(bdpt.image_scale(samples), pt.image_scale(samples));
+        }
+        let spd = spectrace_spectrum::Uniform::new(400.0, 700.0).unwrap();
+        let l = 30.0 / (2.0 * PI * 4.0 * PI * 1.5 * 1.5);
+        let expected = l / (1.0 - a) * spectrace_spectrum::xyz_of(&spd).y / *CIE_Y_INTEGRAL;
+        let (mean, se) = mean_y(&bdpt, 6, 8 * pixels, pixels, &ALL);
+        assert!((mean - expected).abs() < 4.0 * se, "{mean} vs {expected} (standard error {se})");
+        assert!(se < 0.02 * expected, "standard error {se} vs {expected}");
+    }
+
+    #[test]
     fn passes_are_normalised_per_pixel() {
         let fixture = spot_scene();
         let scene = fixture.scene();
@@ -1322,7 +1386,8 @@ mod tests {
         assert_eq!(bdpt.name(), "bdpt");
         assert_eq!(bdpt.pass_samples(), 256);
         assert_eq!(bdpt.image_scale(0), 0.0);
-        assert_eq!(bdpt.image_scale(512), 0.5);
+        // The film is relative to the lights' power (10 W), as the path tracer's.
+        assert_eq!(bdpt.image_scale(512), 10.0 * 0.5);
         let s: BdptSettings = serde_json::from_str(r#"{"max_depth": 3, "rr_depth": 1}"#).unwrap();
         assert_eq!(s, BdptSettings { max_depth: 3, rr_depth: 1 });
         assert!(serde_json::from_str::<BdptSettings>(r#"{"max_depth": 3, "rr": 1}"#).is_err());
