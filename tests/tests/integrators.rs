@@ -136,9 +136,11 @@ fn every_integrator_passes_the_furnace_test() {
     let area = 4.0 * std::f64::consts::PI * 1.5 * 1.5;
     let l = 30.0 / (2.0 * std::f64::consts::PI * area);
     let expected = y_of_radiance(l / (1.0 - a), &spd);
-    for (integrator, effort) in
-        [(IntegratorChoice::Light, 100_000), (IntegratorChoice::Path, 16 * 16 * 16)]
-    {
+    for (integrator, effort) in [
+        (IntegratorChoice::Light, 100_000),
+        (IntegratorChoice::Path, 16 * 16 * 16),
+        (IntegratorChoice::Bdpt, 16 * 16 * 8),
+    ] {
         let (mean, se) = mean_and_error(&s, integrator, effort, 6);
         let name = integrator.name();
         assert!(

@@ -7,13 +7,15 @@
 //! - the light subpath starts with one beam of the light set ([`LightSource::next_beam`]): its
 //!   light `l` (chosen by power), origin, direction and wavelength `lambda` (drawn from the
 //!   light's SPD), then a random walk ([`Transport::Importance`]) with Russian roulette;
-//! - the camera subpath is a ray through a uniform point of pixel `p` from the pinhole, then a
-//!   random walk ([`Transport::Radiance`]);
+//! - the camera subpath is a ray through a uniform point of pixel `p` from the pinhole, or from a
+//!   uniform point of a thin lens ([`crate::PinholeCamera::generate_ray`]; a pinhole draws no
+//!   lens uniforms), then a random walk ([`Transport::Radiance`]);
 //! - `s = 0`: the camera subpath hits an emitter ([`LightTracerScene::emitted`]);
 //! - `s = 1, t >= 2`: a light point sampled afresh towards the camera vertex
 //!   ([`LightSource::sample_towards`]; next-event estimation);
-//! - `t = 1`: a light vertex connected to the pinhole ([`crate::PinholeCamera::project`]), splatted
-//!   into the pixel it projects into (the light tracer's estimate);
+//! - `t = 1`: a light vertex connected to the pinhole, or to a point of the lens sampled towards
+//!   it ([`crate::PinholeCamera::sample_wi`]), splatted into the pixel that ray lands in (the
+//!   light tracer's estimate);
 //! - `s, t >= 2`: a shadow ray between two non-specular vertices.
 //!
 //! Every strategy is weighted by the power heuristic over all strategies that could have made
@@ -42,17 +44,19 @@
 //!
 //! # Normalisation
 //! A chunk is one *pass*: one sample of every pixel, in pixel order ([`Bdpt::pass_samples`]
-//! items), as for the [`crate::PathTracer`]. The film is normalised per pixel sample and holds
-//! values relative to the lights' total power ([`Integrator::image_scale`] `= power * pixels /
-//! samples`). Camera strategies (`t >= 2`) estimate the
+//! items), as for the [`crate::PathTracer`]. As the path tracer's, the film holds the estimates
+//! divided by the lights' total power `Phi` (the renderer's normalisation of camera integrators,
+//! which keeps lights of any power in the film's fixed-point range), normalised per pixel sample:
+//! [`Integrator::image_scale`] `= Phi * pixels / samples`. Camera strategies (`t >= 2`) estimate the
 //! pixel of their camera sample directly. A `t = 1` connection estimates the pixel it lands in,
 //! and one light path is traced per camera sample: a pass traces `pixels` light paths, which
 //! together make *one* light-tracing estimate of the whole image (each path's splat divided by
 //! the number of paths). So `t = 1` splats are divided by the number of pixels, and after `n`
 //! passes every pixel holds the mean of `n` such estimates, as for the camera strategies.
 //!
-//! The same count enters the MIS weights: the camera's direction density is taken over the whole
-//! image, `1 / (A_image cos^3 theta)` with `A_image = width * height * pixel_area`, which is the
+//! The same count enters the MIS weights: the camera's direction density
+//! ([`crate::PinholeCamera::pdf_we`], from the vertex's pinhole or lens point) is taken over the
+//! whole image, `1 / (A_image cos^3 theta)` with `A_image = width * height * pixel_area`, which is the
 //! per-pixel density `1 / (A_pixel cos^3 theta)` of one camera sample compared with `pixels`
 //! light paths.
 //!
@@ -114,8 +118,8 @@ pub struct MisVertex {
 /// The power-heuristic weight of strategy `s` (the first `s` vertices from the light, the others
 /// from the camera) for the full path `path`, ordered from the light (index 0) to the camera
 /// (last). Strategies that end a connection at a delta vertex are not counted, nor `s = 0`
-/// when `light_is_delta` (a light a camera path cannot hit), nor `t = 0` (a pinhole is never
-/// hit). Zero densities (delta vertices) count as 1, so deltas cancel. `s` must be a valid
+/// when `light_is_delta` (a light a camera path cannot hit), nor `t = 0` (the camera, pinhole or
+/// lens, is not part of the scene: paths never hit it). Zero densities (delta vertices) count as 1, so deltas cancel. `s` must be a valid
 /// strategy; the result is in `[0, 1]`.
 pub fn mis_weight(path: &[MisVertex], s: usize, light_is_delta: bool) -> f64 {
     let n = path.len();
@@ -147,7 +151,7 @@ pub fn mis_weight(path: &[MisVertex], s: usize, light_is_delta: bool) -> f64 {
 /// What a vertex is.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum VertexKind {
-    /// The pinhole.
+    /// The pinhole, or a point of a thin lens.
     Camera,
     /// A point on light `id` (where a beam starts, or sampled by next-event estimation).
     Light(LightId),
@@ -231,10 +235,6 @@ pub struct Bdpt<'a> {
     effects: Effects,
     /// The light set's SPD (the marginal density of a beam's wavelength).
     set_spd: Arc<dyn SpectralPowerDistribution>,
-    /// The camera's viewing direction.
-    forward: DVec3,
-    /// Area of the whole image on the plane at distance 1.
-    image_area: f64,
 }
 
 /// Reused storage of one chunk: no allocation per sample.
@@ -251,18 +251,7 @@ impl<'a> Bdpt<'a> {
     /// A bidirectional path tracer of `scene` with `settings` (the `effects` decision is kept
     /// for reports; paths always continue after diffuse hits).
     pub fn new(scene: &'a LightTracerScene<'a>, settings: BdptSettings, effects: Effects) -> Self {
-        let camera = scene.camera;
-        let (w, h) = (f64::from(camera.width()), f64::from(camera.height()));
-        let forward = camera.direction(w / 2.0, h / 2.0);
-        let image_area = w * h * camera.pixel_area();
-        Self {
-            scene,
-            settings,
-            effects,
-            set_spd: LightSource::spd(scene.lights),
-            forward,
-            image_area,
-        }
+        Self { scene, settings, effects, set_spd: LightSource::spd(scene.lights) }
     }
 
     /// Its settings.
@@ -300,16 +289,12 @@ impl<'a> Bdpt<'a> {
         Some(LightEnd { id, flags, pmf })
     }
 
-    /// Solid-angle density of the camera's ray towards `point` (over the whole image), 0 when
-    /// the point is outside the image.
-    fn camera_pdf(&self, point: DVec3) -> f64 {
-        let camera = self.scene.camera;
-        if camera.project(point).is_none() {
-            return 0.0;
-        }
-        let d = (point - camera.position()).normalize();
-        let cos = d.dot(self.forward);
-        if cos > 0.0 { 1.0 / (self.image_area * cos * cos * cos) } else { 0.0 }
+    /// Solid-angle density of a camera ray leaving the lens at `origin` (the pinhole for a
+    /// pinhole camera) towards `point` (over the whole image: [`crate::PinholeCamera::pdf_we`]),
+    /// 0 when it misses the image.
+    fn camera_pdf(&self, origin: DVec3, point: DVec3) -> f64 {
+        let ray = crate::CameraRay { origin, direction: point - origin };
+        self.scene.camera.pdf_we(&ray).1
     }
 
     /// Area density at `vertex` of a vertex `v` that chooses the direction towards it with
@@ -338,7 +323,7 @@ impl<'a> Bdpt<'a> {
         wl: &Wavelength,
     ) -> f64 {
         let solid = match v.kind {
-            VertexKind::Camera => self.camera_pdf(next.point),
+            VertexKind::Camera => self.camera_pdf(v.point, next.point),
             VertexKind::Light(id) => self.light_pdfs(id, v.point, next.point - v.point).1,
             VertexKind::Surface(hit) => {
                 if let Some(id) = light.filter(|_| prev.is_none()) {
@@ -394,9 +379,9 @@ impl<'a> Bdpt<'a> {
         let wl = Wavelength { lambda: beam.lambda, density };
         let camera_strategies = beam.scale == 1.0 && density > 0.0 && density.is_finite();
         let Some(light) = self.light_end(beam.parent, &wl) else { return };
-        // The film holds radiance relative to the lights' total power, as the path tracer's
-        // (see `image_scale`).
-        let inv_y = 1.0 / (*CIE_Y_INTEGRAL * self.scene.lights.power());
+        // The film holds values relative to the lights' total power (see `image_scale`).
+        let power = scene.lights.power();
+        let inv_y = if power > 0.0 { 1.0 / (*CIE_Y_INTEGRAL * power) } else { 0.0 };
         let pixels = self.pass_samples().max(1) as f64;
 
         generate_light_subpath(self, &beam, &light, &wl, camera_strategies, rng, buffers, stats);
@@ -478,8 +463,9 @@ fn shading_correction(hit: &Hit, wi: DVec3, wo: DVec3) -> f64 {
     if denominator > 0.0 { wi.dot(ns).abs() * wo.dot(ng).abs() / denominator } else { 0.0 }
 }
 
-/// The camera subpath of a sample of pixel `(px, py)` into `buffers.camera`: the pinhole, then
-/// a random walk from a ray through a uniform point of the pixel.
+/// The camera subpath of a sample of pixel `(px, py)` into `buffers.camera`: the pinhole (or a
+/// uniform point of the lens), then a random walk from a ray through a uniform point of the pixel
+/// ([`crate::PinholeCamera::generate_ray`]).
 fn generate_camera_subpath(
     bdpt: &Bdpt<'_>,
     px: u32,
@@ -490,12 +476,13 @@ fn generate_camera_subpath(
     stats: &mut TraceStats,
 ) {
     let camera = bdpt.scene.camera;
-    let (u0, u1) = (uniform(rng), uniform(rng));
-    let direction = camera.direction(f64::from(px) + u0, f64::from(py) + u1);
-    let ray = Ray { origin: camera.position(), direction };
+    let u_film = [uniform(rng), uniform(rng)];
+    // A pinhole draws no lens uniforms, so that its images keep their random streams.
+    let u_lens = if camera.is_pinhole() { [0.5; 2] } else { [uniform(rng), uniform(rng)] };
+    let camera_ray = camera.generate_ray(px, py, u_film, u_lens);
+    let ray = Ray { origin: camera_ray.origin, direction: camera_ray.direction };
     buffers.camera.push(Vertex::camera(ray.origin));
-    let cos = direction.dot(bdpt.forward);
-    let pdf_dir = if cos > 0.0 { 1.0 / (bdpt.image_area * cos * cos * cos) } else { 0.0 };
+    let pdf_dir = camera.pdf_we(&camera_ray).1;
     let first = bdpt.scene.world.intersect(&ray, f64::INFINITY);
     let max = bdpt.max_vertices().0;
     random_walk(
@@ -681,6 +668,7 @@ fn connect(
     }
     let mut raster = None;
     let mut sampled: Option<Vertex> = None;
+    let mut sampled_camera: Option<Vertex> = None;
     let mut end = *beam_light;
     let value;
     if s == 0 {
@@ -693,45 +681,50 @@ fn connect(
         end = bdpt.light_end(id, wl)?;
         value = pt.beta * le * spd.value(wl.lambda) / wl.density;
     } else if t == 1 {
-        // A light vertex seen by the camera.
+        // A light vertex seen by the camera, through a point of the lens sampled towards it
+        // (the pinhole for a pinhole camera: no uniforms drawn).
         let qs = &light[s - 1];
-        let camera_point = camera[0].point;
-        let projection = scene.camera.project(qs.point)?;
+        let lens = scene.camera;
+        let u_lens = if lens.is_pinhole() { [0.5; 2] } else { [uniform(rng), uniform(rng)] };
+        let cs = lens.sample_wi(qs.point, u_lens)?;
+        if !(cs.pdf > 0.0 && cs.importance > 0.0) {
+            return None;
+        }
         match qs.kind {
             VertexKind::Light(id) => {
-                let density = bdpt.light_pdfs(id, qs.point, projection.to_camera).1;
+                let density = bdpt.light_pdfs(id, qs.point, cs.to_camera).1;
                 if !(density > 0.0) || beam_light.flags.delta_direction {
                     return None;
                 }
-                let shadow = Ray { origin: qs.point, direction: projection.to_camera };
-                if scene.intersect_from_light(&shadow, id, projection.distance).is_some() {
+                let shadow = Ray { origin: qs.point, direction: cs.to_camera };
+                if scene.intersect_from_light(&shadow, id, cs.distance).is_some() {
                     return None;
                 }
-                value = qs.beta * density * projection.importance;
+                value = qs.beta * density * cs.importance;
             }
             VertexKind::Surface(hit) => {
-                let (shadow, distance) = hit.spawn_ray_to(camera_point);
+                let (shadow, distance) = hit.spawn_ray_to(cs.position);
                 if scene.world.occluded(&shadow, distance) {
                     return None;
                 }
                 let wi = (light[s - 2].point - qs.point).normalize();
                 let cos = if hit.shading_normal == hit.geometric_normal {
-                    projection.to_camera.dot(hit.shading_normal).abs()
+                    cs.to_camera.dot(hit.shading_normal).abs()
                 } else {
                     let cos_in = wi.dot(hit.geometric_normal).abs();
                     if !(cos_in > 0.0) {
                         return None;
                     }
-                    projection.to_camera.dot(hit.geometric_normal).abs()
-                        * wi.dot(hit.shading_normal).abs()
+                    cs.to_camera.dot(hit.geometric_normal).abs() * wi.dot(hit.shading_normal).abs()
                         / cos_in
                 };
-                let f = bsdf(bdpt, qs, light[s - 2].point, camera_point, Transport::Importance, wl);
-                value = qs.beta * f * cos * projection.importance;
+                let f = bsdf(bdpt, qs, light[s - 2].point, cs.position, Transport::Importance, wl);
+                value = qs.beta * f * cos * cs.importance;
             }
             VertexKind::Camera => return None,
         }
-        raster = Some((projection.x, projection.y));
+        raster = Some((cs.x, cs.y));
+        sampled_camera = Some(Vertex::camera(cs.position));
     } else if s == 1 {
         // Next-event estimation: a light chosen by pmf(l | lambda), a point on it.
         let pt = &camera[t - 1];
@@ -805,7 +798,8 @@ fn connect(
         return None;
     }
     let (weight, light_is_delta) = if camera_strategies {
-        let delta = build_mis_path(bdpt, light, camera, s, t, sampled.as_ref(), &end, wl, mis);
+        let sampled = Sampled { light: sampled.as_ref(), camera: sampled_camera.as_ref() };
+        let delta = build_mis_path(bdpt, light, camera, s, t, sampled, &end, wl, mis);
         (mis_weight(mis, s, delta), delta)
     } else {
         (1.0, true)
@@ -842,6 +836,14 @@ fn choose_light(bdpt: &Bdpt<'_>, wl: &Wavelength, u: f64) -> Option<LightId> {
     last
 }
 
+/// The vertices a strategy sampled afresh: the light vertex of next-event estimation (`s = 1`),
+/// the lens point of a connection to the camera (`t = 1`).
+#[derive(Clone, Copy)]
+struct Sampled<'v> {
+    light: Option<&'v Vertex>,
+    camera: Option<&'v Vertex>,
+}
+
 /// The full path of strategy `(s, t)` as [`MisVertex`]es into `mis`, from the light to the
 /// camera, with the densities at the connection updated; returns whether its light cannot be
 /// hit by a camera path.
@@ -852,27 +854,31 @@ fn build_mis_path(
     camera: &[Vertex],
     s: usize,
     t: usize,
-    sampled: Option<&Vertex>,
+    sampled: Sampled<'_>,
     end: &LightEnd,
     wl: &Wavelength,
     mis: &mut Vec<MisVertex>,
 ) -> bool {
     mis.clear();
     let qs = if s == 1 {
-        sampled.copied().or_else(|| light.first().copied())
+        sampled.light.copied().or_else(|| light.first().copied())
     } else if s > 0 {
         Some(light[s - 1])
     } else {
         None
     };
-    let pt = camera[t - 1];
+    let pt = match sampled.camera {
+        Some(c) if t == 1 => *c,
+        _ => camera[t - 1],
+    };
     let qs_minus = if s >= 2 { Some(light[s - 2]) } else { None };
     let pt_minus = if t >= 2 { Some(camera[t - 2]) } else { None };
     for (i, v) in light.iter().take(s).enumerate() {
         let v = if i + 1 == s { qs.unwrap_or(*v) } else { *v };
         mis.push(MisVertex { from_light: v.pdf_fwd, from_camera: v.pdf_rev, delta: v.delta });
     }
-    for v in camera[..t].iter().rev() {
+    for (j, v) in camera[..t].iter().enumerate().rev() {
+        let v = if j + 1 == t { pt } else { *v };
         mis.push(MisVertex { from_light: v.pdf_rev, from_camera: v.pdf_fwd, delta: v.delta });
     }
     let ip = s; // index of pt in the full path
@@ -946,8 +952,8 @@ impl Integrator for Bdpt<'_> {
     }
 
     /// The lights' power times the pixels over the samples: the film holds each sample's
-    /// contributions divided by the lights' total power (lights of any power keep the exact film
-    /// in range), and the image is the mean per pixel.
+    /// estimate divided by the lights' total power, as the path tracer's (the renderer's
+    /// normalisation of camera integrators), and the image is the mean per pixel.
     fn image_scale(&self, samples_done: u64) -> f64 {
         if samples_done == 0 {
             0.0
@@ -1090,6 +1096,34 @@ mod tests {
         }
     }
 
+    /// A closed diffuse sphere of reflectance `a` whose surface glows on both sides (radiance
+    /// `L`), with the camera inside: every pixel sees `L / (1 - a)` (the white furnace).
+    fn furnace_scene(a: f64) -> Fixture {
+        let sphere = Shape::Sphere(Sphere::new(DVec3::ZERO, 1.5).unwrap());
+        let emission: crate::ObjectEmission = serde_json::from_str(
+            r#"{"power": 30, "spd": {"type": "Uniform", "min_nm": 400, "max_nm": 700},
+            "two_sided": true}"#,
+        )
+        .unwrap();
+        let light = crate::ObjectLight::new(sphere.clone(), &emission).unwrap();
+        let emitter = Emitter::Object {
+            light: LightId(0),
+            radiance: light.radiance(),
+            two_sided: true,
+            area: light.area(),
+        };
+        let mut camera = camera([0.3, -0.2, 0.1], [0.0, 0.0, -1.0]);
+        camera = PinholeCamera::new(CameraRepr { fov: 100.0, ..camera.into() }).unwrap();
+        Fixture {
+            world: World::new(vec![sphere]).unwrap(),
+            materials: vec![material(&format!(r#"{{"type": "Diffuse", "reflectance": {a}}}"#))],
+            lights: LightSet::new(vec![Box::new(light)]).unwrap(),
+            camera,
+            emitters: vec![Some(emitter)],
+            objects: 1,
+        }
+    }
+
     fn effects(scene: &LightTracerScene<'_>) -> Effects {
         Effects::decide(scene.features(&[false; 8]), EffectsMode::Off)
     }
@@ -1207,7 +1241,7 @@ mod tests {
 
     #[test]
     fn mis_weights_of_all_strategies_of_sampled_paths_sum_to_one() {
-        for fixture in [box_scene(), caustic_scene(), spot_scene()] {
+        for fixture in [box_scene(), caustic_scene(), spot_scene(), furnace_scene(0.6)] {
             let scene = fixture.scene();
             let bdpt = Bdpt::new(&scene, BdptSettings::default(), effects(&scene));
             let mut rng = Pcg64::seed_from_u64(11);
@@ -1282,7 +1316,7 @@ mod tests {
             assert!(checked > 1000, "only {checked} connections");
             assert!(strategies[1] > 0 && strategies[2] > 0, "{strategies:?}");
             // Only the box has two diffuse surfaces that see each other, and a visible emitter.
-            if fixture.objects == 5 {
+            if fixture.objects == 5 || fixture.emitters.iter().any(Option::is_some) {
                 assert!(strategies[0] > 0 && strategies[3] > 0, "{strategies:?}");
             }
         }
@@ -1325,6 +1359,110 @@ mod tests {
     }
 
     #[test]
+    fn glowing_furnace_matches_the_closed_form_in_the_renderers_units() {
+        // A closed two-sided glowing diffuse sphere seen from inside: L / (1 - a) everywhere.
+        let a = 0.6;
+        let fixture = furnace_scene(a);
+        let scene = fixture.scene();
+        let bdpt = Bdpt::new(&scene, BdptSettings::default(), effects(&scene));
+        let pt = PathTracer::new(&scene, PathTracerSettings::default(), effects(&scene));
+        // The renderer turns every camera integrator's film into an image with the lights'
+        // power times the pixels over the samples: BDPT's film must be in the path tracer's
+        // units (it was in absolute units, 30x too bright here, the lights' power).
+        let (power, pixels) = (scene.lights.power(), bdpt.pass_samples());
+        for samples in [256, 4096, 12_345] {
+            let renderer = crate::image_scale(power, samples) * pixels as f64;
+            assert!((bdpt.image_scale(samples) - renderer).abs() <= 1e-12 * renderer);
+            assert_eq!(bdpt.image_scale(samples), pt.image_scale(samples));
+        }
+        let spd = spectrace_spectrum::Uniform::new(400.0, 700.0).unwrap();
+        let l = 30.0 / (2.0 * PI * 4.0 * PI * 1.5 * 1.5);
+        let expected = l / (1.0 - a) * spectrace_spectrum::xyz_of(&spd).y / *CIE_Y_INTEGRAL;
+        let (mean, se) = mean_y(&bdpt, 6, 8 * pixels, pixels, &ALL);
+        assert!((mean - expected).abs() < 4.0 * se, "{mean} vs {expected} (standard error {se})");
+        assert!(se < 0.02 * expected, "standard error {se} vs {expected}");
+    }
+
+    #[test]
+    fn thin_lens_matches_the_path_tracer() {
+        // The spot over the plane through a thin lens (aperture 0.05) focused on the plane: camera
+        // subpaths start on the lens, t = 1 connections sample the lens; the image mean is the
+        // path tracer's within 4 combined standard errors.
+        let mut fixture = spot_scene();
+        let (position, look_at) = (DVec3::new(0.0, 1.2, 2.0), DVec3::ZERO);
+        fixture.camera = PinholeCamera::new(CameraRepr {
+            aperture_radius: 0.05,
+            focus_distance: Some((look_at - position).length()),
+            ..fixture.camera.clone().into()
+        })
+        .unwrap();
+        assert!(!fixture.camera.is_pinhole());
+        let scene = fixture.scene();
+        let bdpt = bdpt_mean(&scene, 8, 16, &ALL);
+        let path = path_mean(&scene, 8, 32);
+        let combined = (bdpt.1 * bdpt.1 + path.1 * path.1).sqrt();
+        assert!(combined < 0.03 * path.0, "standard errors too large: {bdpt:?} {path:?}");
+        assert!((bdpt.0 - path.0).abs() < 4.0 * combined, "bdpt {bdpt:?} vs path {path:?}");
+        // The MIS weights of the lens's strategies still sum to one.
+        let mut rng = Pcg64::seed_from_u64(3);
+        let bdpt = Bdpt::new(&scene, BdptSettings::default(), effects(&scene));
+        let mut buffers = Buffers { light: Vec::new(), camera: Vec::new(), mis: Vec::new() };
+        let mut stats = TraceStats::default();
+        let mut lens_connections = 0;
+        for i in 0..2000u32 {
+            let beam = LightSource::next_beam(scene.lights, &mut rng);
+            let wl = Wavelength { lambda: beam.lambda, density: bdpt.set_spd.value(beam.lambda) };
+            let end = bdpt.light_end(beam.parent, &wl).unwrap();
+            generate_light_subpath(
+                &bdpt,
+                &beam,
+                &end,
+                &wl,
+                true,
+                &mut rng,
+                &mut buffers,
+                &mut stats,
+            );
+            buffers.camera.clear();
+            let (px, py) = (i % 16, (i / 16) % 16);
+            generate_camera_subpath(&bdpt, px, py, &wl, &mut rng, &mut buffers, &mut stats);
+            // The camera subpath starts on the lens.
+            let start = buffers.camera[0].point;
+            assert!((start - position).length() <= 0.05 + 1e-12);
+            let (lv, cv) = (buffers.light.clone(), buffers.camera.clone());
+            for t in 1..=cv.len() {
+                for s in 0..=lv.len() {
+                    if s + t < 2 {
+                        continue;
+                    }
+                    let mis = &mut buffers.mis;
+                    let Some(c) = connect(&bdpt, &lv, &cv, s, t, &end, &wl, true, &mut rng, mis)
+                    else {
+                        continue;
+                    };
+                    let n = mis.len();
+                    let valid = |k: usize| {
+                        if k == 0 {
+                            !mis[0].delta && !c.light_is_delta
+                        } else {
+                            !mis[k - 1].delta && !mis[k].delta
+                        }
+                    };
+                    let sum: f64 = (0..n)
+                        .filter(|&k| valid(k))
+                        .map(|k| mis_weight(mis, k, c.light_is_delta))
+                        .sum();
+                    assert!((sum - 1.0).abs() < 1e-9, "({s}, {t}): weights sum to {sum}");
+                    if t == 1 {
+                        lens_connections += 1;
+                    }
+                }
+            }
+        }
+        assert!(lens_connections > 100, "only {lens_connections} connections to the lens");
+    }
+
+    #[test]
     fn passes_are_normalised_per_pixel() {
         let fixture = spot_scene();
         let scene = fixture.scene();
@@ -1332,8 +1470,8 @@ mod tests {
         assert_eq!(bdpt.name(), "bdpt");
         assert_eq!(bdpt.pass_samples(), 256);
         assert_eq!(bdpt.image_scale(0), 0.0);
-        // The spot scene's lights' power times 256 pixels over 512 samples.
-        assert_eq!(bdpt.image_scale(512), scene.lights.power() * 0.5);
+        // The film is relative to the lights' power (10 W), as the path tracer's.
+        assert_eq!(bdpt.image_scale(512), 10.0 * 0.5);
         let s: BdptSettings = serde_json::from_str(r#"{"max_depth": 3, "rr_depth": 1}"#).unwrap();
         assert_eq!(s, BdptSettings { max_depth: 3, rr_depth: 1 });
         assert!(serde_json::from_str::<BdptSettings>(r#"{"max_depth": 3, "rr": 1}"#).is_err());
