@@ -1,12 +1,17 @@
-//! Spectrace's renderer: a scene file goes in, a validated scene is assembled, the light tracer
-//! renders it, and a linear EXR, an sRGB PNG and a JSON sidecar come out.
+//! Spectrace's renderer: a scene file goes in, a validated scene is assembled, the estimator the
+//! effects analysis chooses (light tracer, path tracer or BDPT) renders it, and a linear EXR, an
+//! sRGB PNG and a JSON sidecar come out.
 //!
-//! This crate is thin glue over the others (DESIGN.md's data flow): [`Scene`] reads and validates
-//! the JSON (errors name the file, line, column and field path), [`render_scene`] runs the effects
-//! analysis, checks that light can reach the camera, renders on threads with a progress bar and
-//! writes the outputs, and [`merge_parts`] turns the partial films of a sharded render into the
-//! same image a single machine would make, bit for bit. The `spectrace` binary exposes both; the
-//! xtask's `render` subcommand calls it. Nothing but `xtask` and the tests depend on this crate.
+//! This crate is thin glue over the others (the data flow of `docs/ARCHITECTURE.md`): [`Scene`]
+//! reads and validates the JSON (errors name the file, line, column and field path) and adds area
+//! lights' surfaces and glowing objects to the scene, [`render_scene`] runs the effects analysis,
+//! chooses the integrator ([`choose_integrator`]), checks that light can reach the camera, renders
+//! on threads with a progress bar and writes the outputs normalised per estimator
+//! ([`Normalisation`]), and [`merge_parts`] turns the partial films of a sharded render into the
+//! same image a single machine would make, bit for bit. The key design decision: one render path
+//! for every estimator ([`with_integrator`]), so sharding, time budgets, probes and outputs work
+//! the same for all. The `spectrace` binary exposes it; the xtask's `render` subcommand calls it.
+//! Nothing but `xtask` and the tests depend on this crate.
 
 pub mod accuracy;
 pub mod cli;
