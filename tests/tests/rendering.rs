@@ -697,7 +697,14 @@ fn a_closed_mirror_box_keeps_the_beam_count_and_the_time_budget() {
     let effects = decide_effects(&inside, None);
     // The probe stops at the first beam that lights the film (it used to trace 20,000 beams of
     // 8000 bounces: 55 s).
-    let beams_100 = RenderOptions { beams: Some(100), out_dir: out.clone(), ..Default::default() };
+    // The light tracer's beams and deadlines are what this test is about (auto would pick BDPT:
+    // a point light among mirrors).
+    let beams_100 = RenderOptions {
+        beams: Some(100),
+        out_dir: out.clone(),
+        integrator: Some(IntegratorChoice::Light),
+        ..Default::default()
+    };
     let probed =
         probe(&inside, &effects, &plan_with(&inside, &beams_100, IntegratorChoice::Light).unwrap())
             .unwrap();
@@ -716,6 +723,7 @@ fn a_closed_mirror_box_keeps_the_beam_count_and_the_time_budget() {
         time: Some(budget),
         threads: Some(2),
         out_dir: out.clone(),
+        integrator: Some(IntegratorChoice::Light),
         ..Default::default()
     };
     let report = render_scene(&inside, &timed).unwrap();
