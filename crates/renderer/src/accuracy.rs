@@ -1,31 +1,34 @@
-//! What accuracy costs in time: error-against-time sweeps of every accuracy knob.
+//! What accuracy costs in time: error-against-time sweeps of every accuracy knob, the estimator
+//! included.
 //!
 //! [`run`] renders, for each scene, a *reference* image once at high effort (the scene as written,
-//! effects analysis on; cached on disk with the settings that made it), then sweeps the number of
-//! beams (doubling from [`AccuracyOptions::start_beams`]) for each [`Configuration`]:
+//! effects analysis on, by an estimator that is unbiased on the scene: see
+//! [`reference_integrator`]; cached on disk with the settings that made it), then sweeps the
+//! number of paths (doubling from [`AccuracyOptions::start_beams`]) for each [`Configuration`]:
 //!
 //! | configuration | what changes |
 //! |---|---|
-//! | `baseline` | nothing: the scene as written, effects analysis `auto` |
+//! | `baseline` | nothing: the light tracer on the scene as written, effects analysis `auto` |
 //! | `equal_wavelengths` | every light draws its wavelengths uniformly with weights (`"wavelength_sampling": "equal_wavelengths"`) instead of by importance |
 //! | `piecewise_constant_spd` | every `Tabulated` SPD of the lights (and every tabulated `CieIlluminant`) becomes the seed's "choppy" `Binned` SPD: bins centred on the table's nodes, the same values |
 //! | `effects_off` | the effects analysis off (one wavelength per path, beams continue after diffuse hits) |
+//! | `path`, `bdpt` | the estimator: N paths are `ceil(N / pixels)` camera samples per pixel |
+//! | `auto` | the estimator `auto` picks ([`IntegratorChoice::decide`]) |
 //!
 //! Each point records the wall time of the render alone and the relative RMSE of the XYZ image
 //! against the reference, `sqrt(sum |xyz - ref|^2 / sum |ref|^2)` over all pixels. Monte Carlo
 //! error falls as `time^(-1/2)`; the report fits the slope of log error against log time per
-//! configuration and puts it beside -1/2 (a flatter slope means bias, as with a changed spectrum,
-//! or fixed costs that do not scale with beams).
+//! configuration and puts it beside -1/2 (a flatter slope means bias, as with a changed spectrum
+//! or an estimator that misses some light, or fixed costs that do not scale with paths).
 //!
-//! Outputs: `accuracy.md` (a table per scene, the slopes, and which configuration reaches a given
-//! error fastest) and `accuracy.svg` (log-log plot of error against time, one line per scene and
+//! Outputs: `accuracy.md` (a table per scene, the slopes, which configuration reaches a given
+//! error fastest, and the seconds to 10% of each estimator with auto's time over the fastest's)
+//! and `accuracy.svg` (log-log plot of error against time, one panel per scene, one line per
 //! configuration, with a dashed line of slope -1/2), both in [`AccuracyOptions::out_dir`].
 //!
 //! To keep the default run short, [`AccuracyOptions::max_width`] scales the camera resolution down
 //! (editing the scene JSON's `camera.width`/`camera.height` before it is parsed, keeping the aspect
 //! ratio); the field of view is unchanged, so the image shows the same view with fewer pixels.
-//!
-//! Later integrators join the same report as further [`Configuration`]s.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -35,10 +38,9 @@ use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 use spectrace_lights::LightSource;
 use spectrace_spectrum::{CieIlluminant, SpectralPowerDistribution, Xyz};
-use spectrace_tracer::{EffectsMode, LightTracer, render};
+use spectrace_tracer::{EffectsMode, IntegratorChoice, render};
 
-use crate::{RenderOptions, Scene, decide_effects, image, normalisation, plan_with, tracer_scene};
-use spectrace_tracer::IntegratorChoice;
+use crate::{RenderOptions, Scene, choose_integrator, decide_effects, plan_with, with_integrator};
 
 /// Settings of an accuracy run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -49,10 +51,10 @@ pub struct AccuracyOptions {
     pub out_dir: PathBuf,
     /// Where reference images are cached (default `target/accuracy-cache`).
     pub cache_dir: PathBuf,
-    /// Beams of the reference image (default 2^25; keep it at least 16 times the largest sweep
-    /// point, so the reference's own noise adds at most ~3% to the measured errors).
+    /// Paths of the reference image (default 2^23; keep it at least 8 times the largest sweep
+    /// point, so the reference's own noise adds at most ~6% to the measured errors).
     pub reference_beams: u64,
-    /// Beams of the first sweep point (default 2^14).
+    /// Paths of the first sweep point (default 2^12: one sample per pixel at the default width).
     pub start_beams: u64,
     /// Sweep points per configuration: `start_beams * 2^k` for `k < steps` (default 8).
     pub steps: u32,
@@ -61,36 +63,46 @@ pub struct AccuracyOptions {
     /// Seed of the reference; the sweep points use seeds derived from it (never equal to it).
     pub seed: u64,
     /// Scale the camera down to at most this many pixels wide, keeping the aspect ratio (default
-    /// `Some(240)`; `None` renders at the scene's own resolution).
+    /// `Some(96)`; `None` renders at the scene's own resolution).
     pub max_width: Option<u32>,
+    /// The configurations to sweep, in report order (default: [`Configuration::ALL`]).
+    #[serde(default = "all_configurations")]
+    pub configurations: Vec<Configuration>,
+}
+
+fn all_configurations() -> Vec<Configuration> {
+    Configuration::ALL.to_vec()
 }
 
 impl Default for AccuracyOptions {
-    /// Settings measured to finish in about a minute per small scene on 2 shared cores
-    /// (`scenes/fading_spot.json`: see `docs/accuracy.md`), so 2-3 scenes stay under 10 minutes.
+    /// Settings measured to finish every shipped scene with every configuration in under 20
+    /// minutes on 2 shared cores (see the run time in `docs/accuracy.md`).
     fn default() -> Self {
         Self {
             scenes: default_scenes(),
             out_dir: PathBuf::from("docs"),
             cache_dir: PathBuf::from("target/accuracy-cache"),
-            reference_beams: 1 << 25,
-            start_beams: 1 << 14,
-            steps: 8,
+            reference_beams: 1 << 23,
+            start_beams: 1 << 12,
+            steps: 9,
             threads: 0,
             seed: 0x5EED_ACC0,
-            max_width: Some(240),
+            max_width: Some(96),
+            configurations: all_configurations(),
         }
     }
 }
 
-/// The scenes of the default report: those of `scenes/fading_spot.json`, `scenes/cornell.json`
-/// and `scenes/prism.json` that exist (paths relative to the working directory).
+/// The scenes of the default report: every shipped scene, `scenes/*.json` relative to the working
+/// directory, sorted by name (none if the folder cannot be read).
 pub fn default_scenes() -> Vec<PathBuf> {
-    ["scenes/fading_spot.json", "scenes/cornell.json", "scenes/prism.json"]
-        .iter()
-        .map(PathBuf::from)
-        .filter(|p| p.is_file())
-        .collect()
+    let Ok(entries) = std::fs::read_dir("scenes") else { return Vec::new() };
+    let mut scenes: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_file() && p.extension().is_some_and(|x| x == "json"))
+        .collect();
+    scenes.sort();
+    scenes
 }
 
 /// One accuracy knob setting the sweep renders.
@@ -105,16 +117,57 @@ pub enum Configuration {
     PiecewiseConstantSpd,
     /// The effects analysis off.
     EffectsOff,
+    /// The scene as written, rendered by the path tracer.
+    Path,
+    /// The scene as written, rendered by bidirectional path tracing.
+    Bdpt,
+    /// The scene as written, rendered by the estimator `auto` picks.
+    Auto,
 }
 
 impl Configuration {
     /// Every configuration, in report order.
-    pub const ALL: [Configuration; 4] = [
+    pub const ALL: [Configuration; 7] = [
         Configuration::Baseline,
         Configuration::EqualWavelengths,
         Configuration::PiecewiseConstantSpd,
         Configuration::EffectsOff,
+        Configuration::Path,
+        Configuration::Bdpt,
+        Configuration::Auto,
     ];
+
+    /// The estimator knob: the light tracer (`baseline`), `path`, `bdpt` and `auto`.
+    pub const INTEGRATORS: [Configuration; 4] =
+        [Configuration::Baseline, Configuration::Path, Configuration::Bdpt, Configuration::Auto];
+
+    /// Parses a name as in reports (`baseline`, `equal_wavelengths`, ..., `path`, `bdpt`, `auto`;
+    /// `light` is accepted for `baseline`).
+    pub fn from_name(name: &str) -> Option<Self> {
+        if name == "light" {
+            return Some(Configuration::Baseline);
+        }
+        Configuration::ALL.into_iter().find(|c| c.name() == name)
+    }
+
+    /// The estimator the configuration renders with (the light-tracer knobs use the light
+    /// tracer).
+    pub fn integrator(self) -> IntegratorChoice {
+        match self {
+            Configuration::Path => IntegratorChoice::Path,
+            Configuration::Bdpt => IntegratorChoice::Bdpt,
+            Configuration::Auto => IntegratorChoice::Auto,
+            _ => IntegratorChoice::Light,
+        }
+    }
+
+    /// The estimator's name in the integrator tables (`light` for `baseline`).
+    pub fn integrator_label(self) -> &'static str {
+        match self {
+            Configuration::Baseline => "light",
+            other => other.name(),
+        }
+    }
 
     /// The name used in reports.
     pub fn name(self) -> &'static str {
@@ -123,6 +176,9 @@ impl Configuration {
             Configuration::EqualWavelengths => "equal_wavelengths",
             Configuration::PiecewiseConstantSpd => "piecewise_constant_spd",
             Configuration::EffectsOff => "effects_off",
+            Configuration::Path => "path",
+            Configuration::Bdpt => "bdpt",
+            Configuration::Auto => "auto",
         }
     }
 
@@ -130,7 +186,8 @@ impl Configuration {
     pub fn description(self) -> &'static str {
         match self {
             Configuration::Baseline => {
-                "the scene as written: wavelengths by importance, SPDs as given, effects analysis auto"
+                "the light tracer on the scene as written: wavelengths by importance, SPDs as \
+                 given, effects analysis auto (the `light` of the integrator tables)"
             }
             Configuration::EqualWavelengths => {
                 "every light draws wavelengths uniformly over its SPD's range, weighted by the SPD \
@@ -143,6 +200,17 @@ impl Configuration {
             }
             Configuration::EffectsOff => {
                 "effects analysis off: one wavelength per path, beams continue after diffuse hits"
+            }
+            Configuration::Path => {
+                "the path tracer (camera paths, next-event estimation, MIS) on the scene as \
+                 written; N paths are ceil(N / pixels) samples per pixel"
+            }
+            Configuration::Bdpt => {
+                "bidirectional path tracing with MIS on the scene as written; N paths are \
+                 ceil(N / pixels) samples per pixel"
+            }
+            Configuration::Auto => {
+                "the estimator `auto` picks (`IntegratorChoice::decide`), with its own seeds"
             }
         }
     }
@@ -166,6 +234,10 @@ pub struct AccuracyPoint {
     pub seconds: f64,
     /// Relative RMSE of XYZ against the reference.
     pub relative_rmse: f64,
+    /// Sum of Y over the image over the reference's: 1 for an unbiased estimator (up to noise);
+    /// far from 1 when light is missing or added.
+    #[serde(default)]
+    pub mean_ratio: f64,
 }
 
 /// The sweep of one configuration on one scene.
@@ -188,7 +260,9 @@ pub struct ConfigurationResult {
 /// The reference image of a scene.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ReferenceInfo {
-    /// Beams.
+    /// The estimator that rendered it (see [`reference_integrator`]).
+    pub integrator: IntegratorChoice,
+    /// Paths (beams for the light tracer, camera samples for the others).
     pub beams: u64,
     /// Seed.
     pub seed: u64,
@@ -213,6 +287,10 @@ pub struct SceneResult {
     pub height: u32,
     /// The baseline's effects decision.
     pub effects_summary: String,
+    /// The estimator `auto` picks for the scene.
+    pub auto_picks: IntegratorChoice,
+    /// Why, in words.
+    pub auto_reason: String,
     /// The reference.
     pub reference: ReferenceInfo,
     /// One sweep per configuration.
@@ -245,6 +323,14 @@ pub const ROUND_TARGET: f64 = 0.10;
 /// machine vary by about this much.
 pub const TIE_FACTOR: f64 = 1.15;
 
+/// `auto` counts as a good pick when its time to [`ROUND_TARGET`] is within this factor of the
+/// fastest estimator's.
+pub const AUTO_FACTOR: f64 = 1.3;
+
+/// A slope of log error against log time over the last three points flatter than this means the
+/// error levels off (bias); such a configuration's time to a target is never extrapolated.
+pub const LEVELS_OFF_SLOPE: f64 = -0.25;
+
 /// Runs the sweeps, writes `accuracy.md` and `accuracy.svg` into `options.out_dir`, and returns
 /// the measurements. Progress goes to stderr.
 ///
@@ -255,6 +341,9 @@ pub fn run(options: &AccuracyOptions) -> Result<AccuracyReport, String> {
     let started = Instant::now();
     if options.scenes.is_empty() {
         return Err("accuracy: no scenes given (and none of the default scenes exists)".to_owned());
+    }
+    if options.configurations.is_empty() {
+        return Err("accuracy: configurations: none given (name at least one)".to_owned());
     }
     if options.start_beams == 0 || options.steps == 0 || options.reference_beams == 0 {
         return Err(
@@ -332,12 +421,28 @@ fn run_scene(
     let baseline = parse(&json, path).map_err(|e| format!("accuracy: {e}"))?;
     let (width, height) = (baseline.camera.width(), baseline.camera.height());
     let effects_summary = decide_effects(&baseline, Some(EffectsMode::Auto)).summary();
-    eprintln!("accuracy: {name}: {width}x{height} pixels; {effects_summary}");
+    let (auto_picks, auto_reason) = choose_integrator(&baseline, Some(IntegratorChoice::Auto));
+    let reference_integrator = reference_integrator(&baseline);
+    eprintln!(
+        "accuracy: {name}: {width}x{height} pixels; {effects_summary}; auto picks {auto_reason}; \
+         reference by {}",
+        reference_integrator.name()
+    );
 
     // Warm-up (page faults, thread start-up) so the first timed point is not penalised.
-    render_xyz(&baseline, EffectsMode::Auto, options.start_beams, options.seed ^ 0xFFFF, threads)?;
+    for integrator in [IntegratorChoice::Light, reference_integrator] {
+        let seed = options.seed ^ 0xFFFF;
+        render_xyz(&baseline, integrator, EffectsMode::Auto, options.start_beams, seed, threads)?;
+    }
 
-    let key = cache_key(&text, options.reference_beams, options.seed, width, height);
+    let key = cache_key(
+        &text,
+        reference_integrator,
+        options.reference_beams,
+        options.seed,
+        width,
+        height,
+    );
     let cache_file = options.cache_dir.join(format!("{name}-{key:016x}.xyz"));
     let (reference, reference_seconds, cached) = match read_reference(&cache_file, width, height) {
         Some((image, seconds)) => {
@@ -350,11 +455,13 @@ fn run_scene(
         }
         None => {
             eprintln!(
-                "accuracy: {name}: rendering the reference, {} beams...",
-                options.reference_beams
+                "accuracy: {name}: rendering the reference, {} paths by {}...",
+                options.reference_beams,
+                reference_integrator.name()
             );
-            let (image, seconds) = render_xyz(
+            let (image, seconds, _) = render_xyz(
                 &baseline,
+                reference_integrator,
                 EffectsMode::Auto,
                 options.reference_beams,
                 options.seed,
@@ -372,12 +479,14 @@ fn run_scene(
         ));
     }
 
-    let mut prepared = vec![Prepared {
-        configuration: Configuration::Baseline,
-        changed: String::new(),
-        scene: Ok(baseline),
-    }];
-    for configuration in Configuration::ALL.into_iter().skip(1) {
+    let mut prepared = Vec::new();
+    for &configuration in &options.configurations {
+        if rewrite(configuration, &json).is_ok_and(|(changed, _)| changed.is_empty()) {
+            // The scene as written: no need to parse it again.
+            let scene = parse(&json, path);
+            prepared.push(Prepared { configuration, changed: String::new(), scene });
+            continue;
+        }
         let (changed, scene) = match rewrite(configuration, &json) {
             Ok((changed, rewritten)) => (
                 changed,
@@ -396,19 +505,25 @@ fn run_scene(
     // speed then spread over every configuration instead of biasing one.
     let mut points: Vec<Vec<AccuracyPoint>> = vec![Vec::new(); prepared.len()];
     for k in 0..options.steps {
-        let beams = options.start_beams << k;
+        let nominal = options.start_beams << k;
         for (c, p) in prepared.iter().enumerate() {
             let Ok(scene) = &p.scene else { continue };
-            let seed = sweep_seed(options.seed, c as u64, u64::from(k));
-            let (xyz, seconds) =
-                render_xyz(scene, p.configuration.effects_mode(), beams, seed, threads)?;
+            // Seeds by the configuration's place in `ALL`, so a subset sweeps with the same seeds.
+            let index = Configuration::ALL.iter().position(|&k| k == p.configuration).unwrap_or(c);
+            let seed = sweep_seed(options.seed, index as u64, u64::from(k));
+            let integrator = p.configuration.integrator();
+            let mode = p.configuration.effects_mode();
+            let (xyz, seconds, beams) =
+                render_xyz(scene, integrator, mode, nominal, seed, threads)?;
             let relative_rmse = relative_rmse(&xyz, &reference)?;
+            let mean_ratio = mean_ratio(&xyz, &reference);
             eprintln!(
-                "accuracy: {name}: {:<22} {beams:>10} beams {seconds:>8.3} s  error {:.3}%",
+                "accuracy: {name}: {:<22} {beams:>10} paths {seconds:>8.3} s  error {:.3}%  \
+                 mean Y {mean_ratio:.3}x the reference",
                 p.configuration.name(),
                 relative_rmse * 100.0
             );
-            points[c].push(AccuracyPoint { beams, seed, seconds, relative_rmse });
+            points[c].push(AccuracyPoint { beams, seed, seconds, relative_rmse, mean_ratio });
         }
     }
     let configurations = prepared
@@ -434,7 +549,10 @@ fn run_scene(
         width,
         height,
         effects_summary,
+        auto_picks,
+        auto_reason,
         reference: ReferenceInfo {
+            integrator: reference_integrator,
             beams: options.reference_beams,
             seed: options.seed,
             seconds: reference_seconds,
@@ -450,35 +568,129 @@ fn parse(json: &Value, path: &Path) -> Result<Scene, String> {
     Scene::from_json(&text, path).map_err(|e| e.to_string())
 }
 
-/// Renders `beams` beams and returns the XYZ image and the wall time of the render alone.
+/// The estimator of a scene's reference image: one that is unbiased on it. The path tracer where
+/// `auto` picks it (every light can be reached from the camera), BDPT everywhere else (the light
+/// tracer shows mirrors and glass black; the path tracer misses skies, lasers, spectral lines and
+/// the caustics of point lights).
+pub fn reference_integrator(scene: &Scene) -> IntegratorChoice {
+    match choose_integrator(scene, Some(IntegratorChoice::Auto)).0 {
+        IntegratorChoice::Path => IntegratorChoice::Path,
+        _ => IntegratorChoice::Bdpt,
+    }
+}
+
+/// Renders `paths` paths with `integrator` (for a camera integrator, `ceil(paths / pixels)`
+/// samples per pixel) and returns the XYZ image, the wall time of the render alone and the paths
+/// traced.
 fn render_xyz(
     scene: &Scene,
+    integrator: IntegratorChoice,
     mode: EffectsMode,
-    beams: u64,
+    paths: u64,
     seed: u64,
     threads: usize,
-) -> Result<(Vec<Xyz>, f64), String> {
+) -> Result<(Vec<Xyz>, f64, u64), String> {
     let options = RenderOptions {
-        beams: Some(beams),
+        beams: Some(paths),
         seed: Some(seed),
         threads: Some(threads),
         effects: Some(mode),
         ..RenderOptions::default()
     };
-    let mut plan =
-        plan_with(scene, &options, IntegratorChoice::Light).map_err(|e| e.to_string())?;
-    // At least ~16 chunks per render, so small sweep points use every thread too; the chunk size
-    // depends on the beams alone, so a cached reference stays valid whatever the thread count.
-    plan.chunk_beams = (beams / 16).clamp(1, plan.chunk_beams.max(1024)).min(plan.chunk_beams);
+    let (choice, _) = choose_integrator(scene, Some(integrator));
+    let mut plan = plan_with(scene, &options, choice).map_err(|e| e.to_string())?;
+    if choice == IntegratorChoice::Light {
+        // At least ~16 chunks per render, so small sweep points use every thread too; the chunk
+        // size depends on the beams alone, so a cached reference stays valid whatever the thread
+        // count. (A camera integrator's chunk is a pass of one sample per pixel.)
+        plan.chunk_beams = (paths / 16).clamp(1, plan.chunk_beams.max(1024)).min(plan.chunk_beams);
+    }
     let effects = decide_effects(scene, Some(mode));
-    let tracer_scene = tracer_scene(scene);
-    let tracer = LightTracer::new(&tracer_scene, scene.tracer_settings(), effects);
     scene.lights.reset_count();
     let started = Instant::now();
-    let output = render(&tracer, &plan, &|_| {}).map_err(|e| e.to_string())?;
+    // The image by the estimator's own `image_scale` (its documented film units), not the
+    // renderer's `normalisation`, which assumes every camera integrator's film is relative to
+    // the lights' power (BDPT's is not).
+    let (output, scale) = with_integrator(scene, choice, effects, |tracer| {
+        render(tracer, &plan, &|_| {}).map(|out| {
+            let scale = tracer.image_scale(out.beams);
+            (out, scale)
+        })
+    })
+    .map_err(|e| e.to_string())?;
     let seconds = started.elapsed().as_secs_f64();
     scene.lights.reset_count();
-    Ok((image(&output, normalisation(IntegratorChoice::Light, scene.lights.power(), 1)), seconds))
+    Ok((output.film.to_xyz(scale), seconds, output.beams))
+}
+
+/// One estimator's measurement in [`integrator_benchmark`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IntegratorTiming {
+    /// The estimator asked for (`auto` included).
+    pub integrator: IntegratorChoice,
+    /// Paths traced (beams for the light tracer; `ceil(paths / pixels)` samples per pixel for
+    /// the camera integrators).
+    pub paths: u64,
+    /// Wall time of the render alone (s).
+    pub seconds: f64,
+}
+
+impl IntegratorTiming {
+    /// Paths per second.
+    pub fn paths_per_second(&self) -> f64 {
+        self.paths as f64 / self.seconds.max(1e-9)
+    }
+}
+
+/// One scene of `spectrace bench`: paths per second of every estimator with the same paths.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IntegratorBenchmarkRow {
+    /// The scene file.
+    pub scene: String,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// The estimator `auto` picks.
+    pub auto_picks: IntegratorChoice,
+    /// Why, in words.
+    pub auto_reason: String,
+    /// Light, path, bdpt and auto, in that order.
+    pub timings: Vec<IntegratorTiming>,
+}
+
+/// Renders `scene` with light, path, bdpt and auto, each with `paths` paths (N beams for the
+/// light tracer, `ceil(N / pixels)` samples per pixel for the camera integrators) and the same
+/// seed, and measures each (the integrator columns of `spectrace bench`).
+///
+/// # Errors
+/// A message naming the estimator for zero paths, too many threads or a failed render.
+pub fn integrator_benchmark(
+    scene: &Scene,
+    paths: u64,
+    threads: usize,
+) -> Result<IntegratorBenchmarkRow, String> {
+    let (auto_picks, auto_reason) = choose_integrator(scene, Some(IntegratorChoice::Auto));
+    let mut timings = Vec::new();
+    for integrator in [
+        IntegratorChoice::Light,
+        IntegratorChoice::Path,
+        IntegratorChoice::Bdpt,
+        IntegratorChoice::Auto,
+    ] {
+        let (_, seconds, traced) =
+            render_xyz(scene, integrator, EffectsMode::Auto, paths, 1, threads)
+                .map_err(|e| format!("{}: {}: {e}", scene.path.display(), integrator.name()))?;
+        timings.push(IntegratorTiming { integrator, paths: traced, seconds });
+    }
+    Ok(IntegratorBenchmarkRow {
+        scene: scene.path.display().to_string(),
+        width: scene.camera.width(),
+        height: scene.camera.height(),
+        auto_picks,
+        auto_reason,
+        timings,
+    })
 }
 
 /// Relative RMSE of an XYZ image against a reference:
@@ -503,6 +715,12 @@ pub fn relative_rmse(image: &[Xyz], reference: &[Xyz]) -> Result<f64, String> {
         return Err("the reference image is black".to_owned());
     }
     Ok((diff / norm).sqrt())
+}
+
+/// Sum of Y over `image` over the sum over `reference` (NaN for a black reference).
+fn mean_ratio(image: &[Xyz], reference: &[Xyz]) -> f64 {
+    let sum = |img: &[Xyz]| img.iter().map(|p| p.y).sum::<f64>();
+    sum(image) / sum(reference)
 }
 
 /// Least-squares slope of `y` against `x` (`None` for fewer than two distinct `x` or
@@ -688,7 +906,11 @@ fn set_piecewise_constant(json: &mut Value) -> (usize, usize) {
 fn rewrite(configuration: Configuration, json: &Value) -> Result<(String, Value), String> {
     let mut out = json.clone();
     match configuration {
-        Configuration::Baseline | Configuration::EffectsOff => Ok((String::new(), out)),
+        Configuration::Baseline
+        | Configuration::EffectsOff
+        | Configuration::Path
+        | Configuration::Bdpt
+        | Configuration::Auto => Ok((String::new(), out)),
         Configuration::EqualWavelengths => match set_equal_wavelengths(&mut out) {
             (0, 0) => Err("every light already samples equal wavelengths".to_owned()),
             (0, _) => {
@@ -715,14 +937,22 @@ fn rewrite(configuration: Configuration, json: &Value) -> Result<(String, Value)
 // The reference cache.
 
 const CACHE_MAGIC: &[u8; 8] = b"SPXYZREF";
-const CACHE_VERSION: u32 = 1;
+const CACHE_VERSION: u32 = 3;
 const CACHE_HEADER: usize = 8 + 4 + 4 + 4 + 8 + 8;
 
 /// FNV-1a over the scene file and the reference's settings (and the crate version, so a changed
 /// tracer renders a new reference).
-fn cache_key(scene_text: &str, beams: u64, seed: u64, width: u32, height: u32) -> u64 {
+fn cache_key(
+    scene_text: &str,
+    integrator: IntegratorChoice,
+    beams: u64,
+    seed: u64,
+    width: u32,
+    height: u32,
+) -> u64 {
     let settings = format!(
-        "|beams={beams}|seed={seed}|{width}x{height}|v{}|cache{CACHE_VERSION}",
+        "|{}|beams={beams}|seed={seed}|{width}x{height}|v{}|cache{CACHE_VERSION}",
+        integrator.name(),
         env!("CARGO_PKG_VERSION")
     );
     scene_text
@@ -831,10 +1061,105 @@ fn time_to_reach(result: &ConfigurationResult, target: f64) -> Reach {
         }
     }
     match (pts.last(), result.slope_vs_time) {
-        (Some(last), Some(slope)) if slope < -0.3 => {
+        (Some(last), Some(slope)) if slope < -0.3 && !levels_off(result) => {
             Reach::Extrapolated(last.seconds * (target / last.relative_rmse).powf(1.0 / slope))
         }
         _ => Reach::NotReached,
+    }
+}
+
+/// Least-squares slope of log error against log time over the last three sweep points (`None`
+/// for fewer than three).
+fn tail_slope(result: &ConfigurationResult) -> Option<f64> {
+    let pts = &result.points;
+    let tail = pts.get(pts.len().checked_sub(3)?..)?;
+    fit_slope(&tail.iter().map(|p| (p.seconds.ln(), p.relative_rmse.ln())).collect::<Vec<_>>())
+}
+
+/// Whether the error levels off at the end of the sweep (the last three points' slope is flatter
+/// than [`LEVELS_OFF_SLOPE`]): the estimator converges to another image (bias), so extrapolating
+/// its time to a smaller error would be wrong.
+fn levels_off(result: &ConfigurationResult) -> bool {
+    tail_slope(result).is_some_and(|s| s > LEVELS_OFF_SLOPE)
+}
+
+/// Time to `target` measured within the sweep only: interpolated, or at most the first point;
+/// `None` when the sweep does not reach it (never extrapolated).
+fn measured_reach(result: &ConfigurationResult, target: f64) -> Option<Reach> {
+    match time_to_reach(result, target) {
+        r @ (Reach::Interpolated(_) | Reach::AtMost(_)) => Some(r),
+        Reach::Extrapolated(_) | Reach::NotReached => None,
+    }
+}
+
+/// One estimator's time to [`ROUND_TARGET`] in words, for the integrator tables.
+fn reach_text(result: Option<&ConfigurationResult>) -> String {
+    let Some(result) = result.filter(|r| !r.points.is_empty()) else { return "-".to_owned() };
+    match measured_reach(result, ROUND_TARGET) {
+        Some(Reach::AtMost(t)) => format!("<= {}", sig(t)),
+        Some(r) => r.seconds().map_or_else(|| "-".to_owned(), sig),
+        None => {
+            let last = result.points.last().map_or(f64::NAN, |p| p.relative_rmse);
+            if levels_off(result) {
+                format!(
+                    "does not reach {} (levels off at {})",
+                    percent(ROUND_TARGET),
+                    percent(last)
+                )
+            } else {
+                format!(
+                    "does not reach {} in the sweep ({} at the end)",
+                    percent(ROUND_TARGET),
+                    percent(last)
+                )
+            }
+        }
+    }
+}
+
+/// Auto's time to [`ROUND_TARGET`] over the fastest of light, path and bdpt, and the text of the
+/// ratio column (`None` when the ratio cannot be measured).
+fn auto_ratio(scene: &SceneResult) -> (Option<f64>, String) {
+    let reach = |c: Configuration| {
+        scene
+            .configurations
+            .iter()
+            .find(|r| r.configuration == c)
+            .and_then(|r| measured_reach(r, ROUND_TARGET))
+            .and_then(Reach::seconds)
+    };
+    let fastest = [Configuration::Baseline, Configuration::Path, Configuration::Bdpt]
+        .into_iter()
+        .filter_map(|c| reach(c).map(|t| (c, t)))
+        .min_by(|a, b| a.1.total_cmp(&b.1));
+    match (reach(Configuration::Auto), fastest) {
+        (Some(auto), Some((c, best))) => {
+            let ratio = auto / best;
+            (Some(ratio), format!("{ratio:.2} (fastest: {})", c.integrator_label()))
+        }
+        (None, Some((c, _))) => {
+            (Some(f64::INFINITY), format!("auto does not reach it; {} does", c.integrator_label()))
+        }
+        (_, None) => {
+            let converging: Vec<&str> =
+                [Configuration::Baseline, Configuration::Path, Configuration::Bdpt]
+                    .into_iter()
+                    .filter(|&c| {
+                        scene
+                            .configurations
+                            .iter()
+                            .find(|r| r.configuration == c)
+                            .is_some_and(|r| r.points.len() >= 3 && !levels_off(r))
+                    })
+                    .map(Configuration::integrator_label)
+                    .collect();
+            let text = if converging.is_empty() {
+                "none reaches it in the sweep".to_owned()
+            } else {
+                format!("none reaches it in the sweep; still falling: {}", converging.join(", "))
+            };
+            (None, text)
+        }
     }
 }
 
@@ -872,7 +1197,9 @@ pub fn markdown(report: &AccuracyReport) -> String {
         md,
         "Generated by `cargo xtask accuracy` (`spectrace_renderer::accuracy::run`) on {} thread(s) \
          in {:.0} s; do not edit by hand. Reference: the scene as written (effects analysis \
-         `auto`) at {} beams, seed {}, cached in `{}`. Sweep: {} to {} beams (doubling), every \
+         `auto`), rendered by an estimator that is unbiased on it (the path tracer where `auto` \
+         picks it, BDPT everywhere else), at {} paths, seed {}, cached in `{}`. Sweep: {} to {} \
+         paths (doubling; a camera integrator traces ceil(paths / pixels) samples per pixel), every \
          point with its own seed. Images are scaled to at most {} pixels wide. Error: relative RMSE \
          of XYZ over all pixels, `sqrt(sum |xyz - ref|^2 / sum |ref|^2)`; time: wall time of the \
          render alone (not loading). Plain Monte Carlo error falls as time^(-1/2): a flatter \
@@ -888,13 +1215,16 @@ pub fn markdown(report: &AccuracyReport) -> String {
         o.max_width.map_or_else(|| "(unlimited)".to_owned(), |w| w.to_string()),
     );
     let _ = writeln!(md, "Configurations:\n");
-    for c in Configuration::ALL {
+    for &c in &o.configurations {
         let _ = writeln!(md, "- `{}`: {}.", c.name(), c.description());
+    }
+    if o.configurations.iter().any(|c| c.integrator() != IntegratorChoice::Light) {
+        integrators_markdown(&mut md, report);
     }
     let _ = writeln!(
         md,
         "\n![relative RMSE against wall time, log-log](accuracy.svg)\n\n\
-         *Relative RMSE of XYZ against wall time (log-log), one line per scene and configuration; \
+         *Relative RMSE of XYZ against wall time (log-log), one panel per scene, one line per configuration; \
          dashed: slope -1/2.*\n"
     );
     for scene in &report.scenes {
@@ -903,42 +1233,123 @@ pub fn markdown(report: &AccuracyReport) -> String {
     md
 }
 
+/// The estimator summary: time to [`ROUND_TARGET`] per scene and estimator, and auto's ratio.
+fn integrators_markdown(md: &mut String, report: &AccuracyReport) {
+    let _ = writeln!(
+        md,
+        "\n## Which estimator reaches {target} first\n\n\
+         Seconds to reach {target} relative RMSE for each estimator (interpolated between sweep \
+         points; `<=` when the first point is already below it). An estimator that is biased on \
+         a scene (the light tracer where the camera sees mirrors or glass, the path tracer where \
+         lights are skies, lasers or lines) levels off: it is reported as not reaching the target, \
+         never extrapolated. The last column is auto's time over the fastest of light, path and \
+         bdpt, measured in the same run (auto renders with its own seeds, so a ratio near 1 is \
+         timing and noise); `auto` is a good pick when it is within {AUTO_FACTOR}x.\n",
+        target = percent(ROUND_TARGET)
+    );
+    let _ = writeln!(
+        md,
+        "| scene | pixels | reference | auto picks | light | path | bdpt | auto | auto / fastest | within {AUTO_FACTOR}x |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---:|---:|---:|---:|---:|---|");
+    for scene in &report.scenes {
+        let find = |c: Configuration| scene.configurations.iter().find(|r| r.configuration == c);
+        let (ratio, ratio_text) = auto_ratio(scene);
+        let within = match ratio {
+            Some(r) if r <= AUTO_FACTOR => "yes",
+            Some(_) => "**no**",
+            None => "-",
+        };
+        let _ = writeln!(
+            md,
+            "| {} | {}x{} | {} | {} | {} | {} | {} | {} | {ratio_text} | {within} |",
+            scene.name,
+            scene.width,
+            scene.height,
+            scene.reference.integrator.name(),
+            scene.auto_picks.name(),
+            reach_text(find(Configuration::Baseline)),
+            reach_text(find(Configuration::Path)),
+            reach_text(find(Configuration::Bdpt)),
+            reach_text(find(Configuration::Auto)),
+        );
+    }
+    let _ = writeln!(md, "\nWhy auto picks what it picks:\n");
+    for scene in &report.scenes {
+        let _ = writeln!(md, "- `{}`: {}.", scene.name, scene.auto_reason);
+    }
+    let _ = writeln!(md);
+}
+
 fn scene_markdown(md: &mut String, scene: &SceneResult) {
     let r = &scene.reference;
     let _ = writeln!(md, "## {} (`{}`)\n", scene.name, scene.scene);
     let _ = writeln!(
         md,
-        "{}x{} pixels; {}. Reference: {} beams, {} s{}.\n",
+        "{}x{} pixels; {}. Auto picks {}. Reference: {} paths by {}, {} s{}.\n",
         scene.width,
         scene.height,
         scene.effects_summary,
+        scene.auto_reason,
         beams_text(r.beams),
+        r.integrator.name(),
         sig(r.seconds),
         if r.cached { " (read from the cache)" } else { "" },
     );
     let baseline = scene.configurations.iter().find(|c| c.configuration == Configuration::Baseline);
-    if let Some(last) = baseline.and_then(|b| b.points.last()) {
-        // The reference carries the baseline's noise at its own beam count; it adds in quadrature
-        // to every measured error.
+    let same = match r.integrator {
+        IntegratorChoice::Path => Configuration::Path,
+        IntegratorChoice::Bdpt => Configuration::Bdpt,
+        _ => Configuration::Baseline,
+    };
+    let same_estimator = scene.configurations.iter().find(|c| c.configuration == same);
+    if let Some(last) = same_estimator.and_then(|b| b.points.last()) {
+        // The reference carries its estimator's noise at its own path count; it adds in
+        // quadrature to every measured error.
         let noise = last.relative_rmse * (last.beams as f64 / r.beams as f64).sqrt();
         let _ = writeln!(
             md,
-            "The reference's own noise is about {} (the baseline's last error scaled to the \
-             reference's beams); errors near it are inflated by it.\n",
-            percent(noise)
+            "The reference's own noise is about {} (`{}`'s last error scaled to the reference's \
+             paths); errors near it are inflated by it.\n",
+            percent(noise),
+            same.name()
         );
     }
-    let _ = writeln!(md, "| configuration | beams | seconds | relative RMSE |");
-    let _ = writeln!(md, "|---|---:|---:|---:|");
+    if scene.configurations.iter().any(|c| c.configuration.integrator() != IntegratorChoice::Light)
+    {
+        let _ = writeln!(
+            md,
+            "| estimator | seconds to {} | slope vs time (last 3 points) |",
+            percent(ROUND_TARGET)
+        );
+        let _ = writeln!(md, "|---|---:|---:|");
+        for c in Configuration::INTEGRATORS {
+            let Some(result) = scene.configurations.iter().find(|r| r.configuration == c) else {
+                continue;
+            };
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} |",
+                c.integrator_label(),
+                reach_text(Some(result)),
+                slope_text(tail_slope(result))
+            );
+        }
+        let _ = writeln!(md, "\nauto / fastest: {}.\n", auto_ratio(scene).1);
+    }
+    let _ =
+        writeln!(md, "| configuration | paths | seconds | relative RMSE | mean Y / reference |");
+    let _ = writeln!(md, "|---|---:|---:|---:|---:|");
     for c in &scene.configurations {
         for p in &c.points {
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {} |",
+                "| {} | {} | {} | {} | {:.3} |",
                 c.configuration.name(),
                 beams_text(p.beams),
                 sig(p.seconds),
-                percent(p.relative_rmse)
+                percent(p.relative_rmse),
+                p.mean_ratio
             );
         }
     }
@@ -1046,7 +1457,7 @@ const PLOT_COLOURS: [(u8, u8, u8); 8] = [
     (240, 228, 66),
 ];
 
-/// The marker of the `i`-th scene, as pixel offsets: circle, triangle, square, diamond, ...
+/// The marker of the `i`-th configuration, as pixel offsets: circle, triangle, square, diamond, ...
 fn marker_shape(i: usize) -> Vec<(i32, i32)> {
     let (sides, radius, turn) = match i % 4 {
         0 => (12, 3.5, 0.0),
@@ -1065,42 +1476,64 @@ fn marker_shape(i: usize) -> Vec<(i32, i32)> {
 /// One line of the plot.
 struct PlotSeries {
     label: String,
-    scene: usize,
     configuration: usize,
     points: Vec<(f64, f64)>,
 }
 
-/// Draws the log-log plot of error against time (SVG).
+/// Draws the log-log plot of error against time (SVG): one panel per scene, one line per
+/// configuration (colour by configuration, the same in every panel), a dashed line of slope -1/2.
 ///
 /// # Errors
 /// A message if the file cannot be written.
 pub fn write_plot(report: &AccuracyReport, path: &Path) -> Result<(), String> {
     use plotters::prelude::*;
     let err = |e: &dyn std::fmt::Display| format!("{}: plot: {e}", path.display());
-    let series: Vec<PlotSeries> = report
-        .scenes
-        .iter()
-        .enumerate()
-        .flat_map(|(si, s)| {
-            s.configurations.iter().filter(|c| !c.points.is_empty()).map(move |c| {
-                let ci = Configuration::ALL
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| err(&e))?;
+    }
+    let panels = report.scenes.len().max(1);
+    let cols = panels.min(2);
+    let rows = panels.div_ceil(cols);
+    let size = (560 * cols as u32, 60 + 400 * rows as u32);
+    let root = SVGBackend::new(path, size).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let root = root
+        .titled("Spectrace: relative RMSE of XYZ against wall time", ("sans-serif", 22))
+        .map_err(|e| err(&e))?;
+    let areas = root.split_evenly((rows, cols));
+    for (scene, area) in report.scenes.iter().zip(&areas) {
+        let series: Vec<PlotSeries> = scene
+            .configurations
+            .iter()
+            .filter(|c| !c.points.is_empty())
+            .map(|c| PlotSeries {
+                label: c.configuration.name().to_owned(),
+                configuration: Configuration::ALL
                     .iter()
                     .position(|&k| k == c.configuration)
-                    .unwrap_or_default();
-                PlotSeries {
-                    label: format!("{}: {}", s.name, c.configuration.name()),
-                    scene: si,
-                    configuration: ci,
-                    points: c
-                        .points
-                        .iter()
-                        .filter(|p| p.seconds > 0.0 && p.relative_rmse > 0.0)
-                        .map(|p| (p.seconds, p.relative_rmse))
-                        .collect(),
-                }
+                    .unwrap_or_default(),
+                points: c
+                    .points
+                    .iter()
+                    .filter(|p| p.seconds > 0.0 && p.relative_rmse > 0.0)
+                    .map(|p| (p.seconds, p.relative_rmse))
+                    .collect(),
             })
-        })
-        .collect();
+            .collect();
+        draw_panel(area, &scene.name, &series).map_err(|e| err(&e))?;
+    }
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}
+
+/// One scene's panel of [`write_plot`].
+fn draw_panel<DB: plotters::prelude::DrawingBackend>(
+    area: &plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
+    title: &str,
+    series: &[PlotSeries],
+) -> Result<(), String> {
+    use plotters::prelude::*;
+    let err = |e: &dyn std::fmt::Display| format!("panel {title}: {e}");
     let all: Vec<(f64, f64)> = series.iter().flat_map(|s| s.points.iter().copied()).collect();
     let bounds = |f: fn(&(f64, f64)) -> f64| {
         let lo = all.iter().map(f).fold(f64::INFINITY, f64::min);
@@ -1109,16 +1542,11 @@ pub fn write_plot(report: &AccuracyReport, path: &Path) -> Result<(), String> {
     };
     let (x0, x1) = bounds(|p| p.0);
     let (y0, y1) = bounds(|p| p.1);
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).map_err(|e| err(&e))?;
-    }
-    let root = SVGBackend::new(path, (960, 640)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption("Spectrace: relative RMSE of XYZ against wall time", ("sans-serif", 22))
-        .margin(16)
-        .x_label_area_size(48)
-        .y_label_area_size(72)
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, ("sans-serif", 18))
+        .margin(10)
+        .x_label_area_size(36)
+        .y_label_area_size(56)
         .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
         .map_err(|e| err(&e))?;
     chart
@@ -1139,11 +1567,10 @@ pub fn write_plot(report: &AccuracyReport, path: &Path) -> Result<(), String> {
         })
         .draw()
         .map_err(|e| err(&e))?;
-    for PlotSeries { label, scene: si, configuration: ci, points } in &series {
-        // Colour by configuration, marker by scene.
+    for PlotSeries { label, configuration: ci, points } in series {
         let (r, g, b) = PLOT_COLOURS[ci % PLOT_COLOURS.len()];
         let color = RGBColor(r, g, b);
-        let marker = marker_shape(*si);
+        let marker = marker_shape(*ci);
         let legend_marker = marker.clone();
         chart
             .draw_series(LineSeries::new(points.iter().copied(), color.stroke_width(2)))
@@ -1177,11 +1604,11 @@ pub fn write_plot(report: &AccuracyReport, path: &Path) -> Result<(), String> {
     chart
         .configure_series_labels()
         .position(SeriesLabelPosition::UpperRight)
+        .label_font(("sans-serif", 11))
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .draw()
         .map_err(|e| err(&e))?;
-    root.present().map_err(|e| err(&e))?;
     Ok(())
 }
 
@@ -1280,6 +1707,7 @@ mod tests {
             threads: 2,
             seed: 7,
             max_width: None,
+            configurations: Configuration::ALL.to_vec(),
         };
         let report = run(&options).unwrap();
         let scene = &report.scenes[0];
@@ -1308,6 +1736,172 @@ mod tests {
     }
 
     #[test]
+    fn the_integrator_knob_sweeps_every_estimator_against_an_unbiased_reference() {
+        let dir = temp("integrators");
+        let scene = dir.join("tiny.json");
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(&scene, TINY).unwrap();
+        let options = AccuracyOptions {
+            scenes: vec![scene.clone()],
+            out_dir: dir.join("docs"),
+            cache_dir: dir.join("cache"),
+            reference_beams: 1 << 16,
+            start_beams: 1 << 10,
+            steps: 3,
+            threads: 2,
+            seed: 11,
+            max_width: None,
+            configurations: Configuration::INTEGRATORS.to_vec(),
+        };
+        let report = run(&options).unwrap();
+        let result = &report.scenes[0];
+        // A point light on a diffuse floor: every light is reachable, so auto picks the path
+        // tracer and the reference is the path tracer's.
+        assert_eq!(result.auto_picks, IntegratorChoice::Path);
+        assert_eq!(result.reference.integrator, IntegratorChoice::Path);
+        let names: Vec<_> = result.configurations.iter().map(|c| c.configuration).collect();
+        assert_eq!(names, Configuration::INTEGRATORS);
+        let pixels = 32 * 24;
+        for c in &result.configurations {
+            assert_eq!(c.points.len(), 3, "{:?}", c.configuration);
+            for (k, p) in c.points.iter().enumerate() {
+                let nominal = 1u64 << (10 + k);
+                let expected = match c.configuration {
+                    Configuration::Baseline => nominal,
+                    // ceil(nominal / pixels) samples per pixel.
+                    _ => nominal.div_ceil(pixels) * pixels,
+                };
+                assert_eq!(p.beams, expected, "{:?} point {k}", c.configuration);
+            }
+        }
+        for c in Configuration::INTEGRATORS {
+            let r = result.configurations.iter().find(|r| r.configuration == c).unwrap();
+            let errors: Vec<f64> = r.points.iter().map(|p| p.relative_rmse).collect();
+            assert!(errors.windows(2).all(|w| w[1] < w[0]), "{c:?}: errors {errors:?}");
+            // Unbiased against the reference: the same brightness, up to noise (every estimator
+            // in the same units; the light is 40 W, so a film left relative to the power shows).
+            let last = r.points.last().unwrap();
+            assert!((last.mean_ratio - 1.0).abs() < 0.1, "{c:?}: {last:?}");
+        }
+        let md = std::fs::read_to_string(dir.join("docs/accuracy.md")).unwrap();
+        assert!(md.contains("## Which estimator reaches 10.0% first"), "{md}");
+        assert!(md.contains("| tiny | 32x24 | path | path |"), "{md}");
+        assert!(md.contains("auto / fastest:"));
+
+        // The bench's measurement: the same paths for every estimator.
+        let loaded = Scene::load(&scene).unwrap();
+        let row = integrator_benchmark(&loaded, 2000, 2).unwrap();
+        assert_eq!(row.auto_picks, IntegratorChoice::Path);
+        let asked: Vec<_> = row.timings.iter().map(|t| t.integrator).collect();
+        assert_eq!(
+            asked,
+            [
+                IntegratorChoice::Light,
+                IntegratorChoice::Path,
+                IntegratorChoice::Bdpt,
+                IntegratorChoice::Auto
+            ]
+        );
+        let paths: Vec<u64> = row.timings.iter().map(|t| t.paths).collect();
+        assert_eq!(paths, [2000, 2304, 2304, 2304]);
+        assert!(row.timings.iter().all(|t| t.paths_per_second() > 0.0));
+
+        // No configurations: an error naming the field.
+        let none = AccuracyOptions { configurations: Vec::new(), ..options };
+        assert!(run(&none).unwrap_err().contains("configurations"));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_biased_estimator_levels_off_and_is_not_extrapolated() {
+        let point = |seconds: f64, relative_rmse: f64| AccuracyPoint {
+            beams: 1,
+            seed: 0,
+            seconds,
+            relative_rmse,
+            mean_ratio: 0.5,
+        };
+        // Falls at first, then flattens at 40%: the overall slope is steep enough to
+        // extrapolate, the last three points say bias.
+        let biased = ConfigurationResult {
+            configuration: Configuration::Baseline,
+            changed: String::new(),
+            not_applicable: None,
+            points: vec![
+                point(1.0, 3.2),
+                point(2.0, 1.6),
+                point(4.0, 0.8),
+                point(8.0, 0.42),
+                point(16.0, 0.41),
+                point(32.0, 0.40),
+            ],
+            slope_vs_time: None,
+            slope_vs_beams: None,
+        };
+        let slope = fit_slope(
+            &biased
+                .points
+                .iter()
+                .map(|p| (p.seconds.ln(), p.relative_rmse.ln()))
+                .collect::<Vec<_>>(),
+        );
+        let biased = ConfigurationResult { slope_vs_time: slope, ..biased };
+        assert!(biased.slope_vs_time.is_some_and(|s| s < -0.3), "{biased:?}");
+        assert!(levels_off(&biased));
+        assert_eq!(time_to_reach(&biased, 0.1), Reach::NotReached);
+        assert_eq!(reach_text(Some(&biased)), "does not reach 10.0% (levels off at 40.0%)");
+        // Still falling at -1/2: not reached within the sweep, and said so (not extrapolated).
+        let falling = ConfigurationResult {
+            points: vec![point(1.0, 0.8), point(4.0, 0.4), point(16.0, 0.2)],
+            slope_vs_time: Some(-0.5),
+            ..biased.clone()
+        };
+        assert!(!levels_off(&falling));
+        assert!(matches!(time_to_reach(&falling, 0.1), Reach::Extrapolated(_)));
+        assert_eq!(
+            reach_text(Some(&falling)),
+            "does not reach 10.0% in the sweep (20.0% at the end)"
+        );
+
+        // Auto against the fastest: auto 2 s, light 1 s, path 4 s, bdpt never.
+        let result = |configuration, seconds: f64| ConfigurationResult {
+            configuration,
+            points: vec![point(seconds / 2.0, 0.2), point(seconds * 2.0, 0.05)],
+            slope_vs_time: Some(-0.5),
+            ..biased.clone()
+        };
+        let mut scene = SceneResult {
+            scene: "s.json".to_owned(),
+            name: "s".to_owned(),
+            width: 1,
+            height: 1,
+            effects_summary: String::new(),
+            auto_picks: IntegratorChoice::Path,
+            auto_reason: String::new(),
+            reference: ReferenceInfo {
+                integrator: IntegratorChoice::Bdpt,
+                beams: 1,
+                seed: 0,
+                seconds: 0.0,
+                cached: false,
+                file: String::new(),
+            },
+            configurations: vec![
+                result(Configuration::Baseline, 1.0),
+                result(Configuration::Path, 4.0),
+                ConfigurationResult { configuration: Configuration::Bdpt, ..biased.clone() },
+                result(Configuration::Auto, 2.0),
+            ],
+        };
+        let (ratio, text) = auto_ratio(&scene);
+        assert!(ratio.is_some_and(|r| (r - 2.0).abs() < 1e-9), "{ratio:?}");
+        assert_eq!(text, "2.00 (fastest: light)");
+        scene.configurations[3] =
+            ConfigurationResult { configuration: Configuration::Auto, ..biased.clone() };
+        assert_eq!(auto_ratio(&scene).0, Some(f64::INFINITY));
+    }
+
+    #[test]
     fn slopes_and_reach() {
         let pts: Vec<(f64, f64)> = (0..5).map(|k| (k as f64, 3.0 - 0.5 * k as f64)).collect();
         assert!((fit_slope(&pts).unwrap() + 0.5).abs() < 1e-12);
@@ -1316,8 +1910,20 @@ mod tests {
             changed: String::new(),
             not_applicable: None,
             points: vec![
-                AccuracyPoint { beams: 1, seed: 0, seconds: 1.0, relative_rmse: 0.2 },
-                AccuracyPoint { beams: 4, seed: 0, seconds: 4.0, relative_rmse: 0.1 },
+                AccuracyPoint {
+                    beams: 1,
+                    seed: 0,
+                    seconds: 1.0,
+                    relative_rmse: 0.2,
+                    mean_ratio: 1.0,
+                },
+                AccuracyPoint {
+                    beams: 4,
+                    seed: 0,
+                    seconds: 4.0,
+                    relative_rmse: 0.1,
+                    mean_ratio: 1.0,
+                },
             ],
             slope_vs_time: Some(-0.5),
             slope_vs_beams: Some(-0.5),

@@ -76,12 +76,14 @@ enum Command {
         #[arg(long)]
         restrict_paths: bool,
     },
-    /// Measure beams/s of scenes, and what the effects analysis saves (auto against off).
+    /// Measure paths/s of scenes with every estimator (light, path, bdpt, auto) and what the
+    /// effects analysis saves the light tracer (auto against off).
     Bench {
         /// Scene files.
         #[arg(required = true)]
         scenes: Vec<PathBuf>,
-        /// Beams per render.
+        /// Paths per render: beams for the light tracer, ceil(N / pixels) samples per pixel for
+        /// path and bdpt.
         #[arg(long, default_value_t = 1_000_000, allow_negative_numbers = true, value_parser = parse_count)]
         beams: u64,
         /// Worker threads (0: one per core).
@@ -90,7 +92,7 @@ enum Command {
     },
     /// Error against time for every accuracy knob: writes docs/accuracy.md and docs/accuracy.svg.
     Accuracy {
-        /// Scene files (default: scenes/fading_spot.json, scenes/cornell.json, scenes/prism.json).
+        /// Scene files (default: every scenes/*.json).
         scenes: Vec<PathBuf>,
         /// Beams of the cached reference image.
         #[arg(long)]
@@ -104,6 +106,10 @@ enum Command {
         /// Largest image width (scenes are scaled down to it; 0 keeps their size).
         #[arg(long)]
         max_width: Option<u32>,
+        /// The configurations to sweep, comma-separated (default: all): baseline (or light),
+        /// equal_wavelengths, piecewise_constant_spd, effects_off, path, bdpt, auto.
+        #[arg(long, value_delimiter = ',', value_parser = parse_configuration)]
+        configurations: Vec<crate::accuracy::Configuration>,
         /// Where accuracy.md and accuracy.svg go.
         #[arg(long, default_value = "docs")]
         out: PathBuf,
@@ -123,6 +129,16 @@ enum Command {
 fn parse_integrator(s: &str) -> Result<IntegratorChoice, String> {
     IntegratorChoice::from_name(s.trim())
         .ok_or_else(|| format!("`{s}`: must be auto, light, path or bdpt"))
+}
+
+/// An accuracy configuration's name.
+fn parse_configuration(s: &str) -> Result<crate::accuracy::Configuration, String> {
+    crate::accuracy::Configuration::from_name(s.trim()).ok_or_else(|| {
+        format!(
+            "`{s}`: must be baseline (or light), equal_wavelengths, piecewise_constant_spd, \
+             effects_off, path, bdpt or auto"
+        )
+    })
 }
 
 /// A whole number of at least 1 (beams).
@@ -180,26 +196,53 @@ fn parse_effects(s: &str) -> Result<EffectsMode, String> {
     }
 }
 
-/// `spectrace bench`: a Markdown table of beams/s per scene with and without the effects
-/// analysis.
+/// Paths per second as millions, three significant digits.
+fn millions(rate: f64) -> String {
+    let m = rate / 1e6;
+    if m >= 10.0 {
+        format!("{m:.1} M")
+    } else if m >= 1.0 {
+        format!("{m:.2} M")
+    } else {
+        format!("{m:.3} M")
+    }
+}
+
+/// `spectrace bench`: a Markdown table per scene of paths/s for every estimator with the same
+/// paths (light, path, bdpt and auto, and which one auto picks), and what the effects analysis
+/// saves the light tracer (auto against off).
 fn bench(scenes: &[PathBuf], beams: u64, threads: usize) -> ExitCode {
     println!(
-        "| scene | effects decision | beams/s (auto) | beams/s (off) | spectral samples on film per s, auto / off |"
+        "| scene | pixels | auto picks | paths/s, light | paths/s, path | paths/s, bdpt | paths/s, auto | light: beams/s with effects off | light: spectral samples on film per s, effects auto / off |"
     );
-    println!("|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|");
     for path in scenes {
         let row = crate::Scene::load(path)
-            .map_err(crate::RenderError::from)
-            .and_then(|scene| crate::effects_benchmark(&scene, beams, threads));
+            .map_err(|e| crate::RenderError::from(e).to_string())
+            .and_then(|scene| {
+                let integrators = crate::accuracy::integrator_benchmark(&scene, beams, threads)?;
+                let effects =
+                    crate::effects_benchmark(&scene, beams, threads).map_err(|e| e.to_string())?;
+                Ok((integrators, effects))
+            });
         match row {
-            Ok(r) => println!(
-                "| {} | {} | {:.3e} | {:.3e} | {:.2}x |",
-                r.scene,
-                r.effects,
-                r.beams as f64 / r.auto_seconds,
-                r.beams as f64 / r.off_seconds,
-                r.auto_spectral_samples_per_second / r.off_spectral_samples_per_second.max(1e-300)
-            ),
+            Ok((i, r)) => {
+                let name = path
+                    .file_stem()
+                    .map_or_else(|| r.scene.clone(), |s| s.to_string_lossy().into_owned());
+                let rates: Vec<String> =
+                    i.timings.iter().map(|t| millions(t.paths_per_second())).collect();
+                let effects_gain = r.auto_spectral_samples_per_second
+                    / r.off_spectral_samples_per_second.max(1e-300);
+                println!(
+                    "| `{name}` | {}x{} | {} | {} | {} | {effects_gain:.2}x |",
+                    i.width,
+                    i.height,
+                    i.auto_picks.name(),
+                    rates.join(" | "),
+                    millions(r.beams as f64 / r.off_seconds),
+                );
+            }
             Err(e) => {
                 eprintln!("error: {e}");
                 return ExitCode::from(2);
@@ -261,7 +304,15 @@ where
         }
         Command::Merge { parts, out } => merge_parts(&parts, &out),
         Command::Bench { scenes, beams, threads } => return bench(&scenes, beams, threads),
-        Command::Accuracy { scenes, reference_beams, start_beams, steps, max_width, out } => {
+        Command::Accuracy {
+            scenes,
+            reference_beams,
+            start_beams,
+            steps,
+            max_width,
+            configurations,
+            out,
+        } => {
             let mut options = crate::accuracy::AccuracyOptions::default();
             if !scenes.is_empty() {
                 options.scenes = scenes;
@@ -277,6 +328,9 @@ where
             }
             if let Some(w) = max_width {
                 options.max_width = (w > 0).then_some(w);
+            }
+            if !configurations.is_empty() {
+                options.configurations = configurations;
             }
             options.out_dir = out;
             return match crate::accuracy::run(&options) {
