@@ -608,9 +608,8 @@ fn render_xyz(
     let effects = decide_effects(scene, Some(mode));
     scene.lights.reset_count();
     let started = Instant::now();
-    // The image by the estimator's own `image_scale` (its documented film units), not the
-    // renderer's `normalisation`, which assumes every camera integrator's film is relative to
-    // the lights' power (BDPT's is not).
+    // The image by the estimator's own `image_scale` (its documented film units; the same as
+    // the renderer's `normalisation`).
     let (output, scale) = with_integrator(scene, choice, effects, |tracer| {
         render(tracer, &plan, &|_| {}).map(|out| {
             let scale = tracer.image_scale(out.beams);
