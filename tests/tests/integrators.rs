@@ -405,3 +405,24 @@ fn observer_weighted_wavelengths_have_less_colour_noise_than_uniform_ones() {
     eprintln!("colour noise: visible {a:.4e}, uniform {b:.4e}, ratio {:.3}", a / b);
     assert!(a < 0.75 * b, "visible {a} vs uniform {b}");
 }
+
+#[test]
+fn light_and_path_agree_with_a_spot_two_points_and_an_area_light_together() {
+    // Next-event estimation samples every point or spot light and chooses among the area lights
+    // by power; MIS on emission must use that choice's probability. A mix of both kinds checks it.
+    let json = SPOT_OVER_PLANE.replace(
+        r#""power": 50, "spd": {"type": "Blackbody", "kelvin": 3000}}]"#,
+        r#""power": 50, "spd": {"type": "Blackbody", "kelvin": 3000}},
+           {"type": "PointLight", "position": [-1, 0.8, 0.5], "power": 10, "spd": {"type": "CieIlluminant", "name": "D65"}},
+           {"type": "PointLight", "position": [1, 0.4, -1], "power": 5, "spd": {"type": "CieIlluminant", "name": "A"}},
+           {"type": "RectangleLight", "corner": [-0.3, 1.2, -0.3], "edge_u": [0.6, 0, 0], "edge_v": [0, 0, 0.6], "power": 30,
+            "spd": {"type": "CieIlluminant", "name": "D50"}},
+           {"type": "DiskLight", "center": [0.8, 0.3, 0.8], "normal": [-1, -0.2, -1], "radius": 0.1, "power": 8,
+            "spd": {"type": "Uniform", "min_nm": 380, "max_nm": 720}}]"#,
+    );
+    let s = scene(&json);
+    assert_eq!(s.lights.lights().len(), 5);
+    assert_eq!(choose_integrator(&s, None).0, IntegratorChoice::Path);
+    assert_agree(&s, (IntegratorChoice::Light, 300_000), (IntegratorChoice::Path, 32 * 32 * 8), 8);
+    assert_agree(&s, (IntegratorChoice::Light, 300_000), (IntegratorChoice::Bdpt, 32 * 32 * 8), 8);
+}

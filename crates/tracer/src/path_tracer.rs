@@ -8,10 +8,11 @@
 //!   added, weighted by the power heuristic against the density with which next-event
 //!   estimation would have chosen `x` (full weight for the camera's own ray and after a specular
 //!   bounce, which next-event estimation cannot produce).
-//! - **Next-event estimation** (at non-specular surfaces): a light chosen by the light sampler
-//!   ([`spectrace_lights::LightSet::sample_light`], by power), a point on it by its
-//!   `sample_towards`, a shadow ray; weighted by the power heuristic against BSDF sampling, or
-//!   fully for delta lights (points, spots), which only this strategy reaches.
+//! - **Next-event estimation** (at non-specular surfaces): every delta-position light (points,
+//!   spots) once, fully weighted (only this strategy reaches them, and sampling each instead of
+//!   choosing one removes the variance of the choice for a shadow ray per light); and one of the
+//!   other lights chosen by power among them, a point on it by its `sample_towards`, weighted by
+//!   the power heuristic against BSDF sampling.
 //! - **BSDF sampling** chooses the next direction ([`spectrace_materials::Transport::Radiance`]:
 //!   refraction scales radiance by `(n_i / n_t)^2`); specular chains are followed, so glass and
 //!   mirrors show what they reflect and refract.
@@ -38,8 +39,9 @@ use std::time::Instant;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use spectrace_geometry::{Hit, Ray};
-use spectrace_lights::{LightSource, uniform};
+use spectrace_lights::{LightId, LightSource, uniform};
 use spectrace_materials::{Incoming, Material, ScatterKind, Transport};
+use spectrace_sampling::Discrete;
 use spectrace_spectrum::{CIE_Y_INTEGRAL, Xyz, cmf};
 
 use crate::light_tracer::{LightTracerScene, TraceStats};
@@ -87,6 +89,13 @@ pub struct PathTracer<'a> {
     scene: &'a LightTracerScene<'a>,
     settings: PathTracerSettings,
     effects: Effects,
+    /// The lights with a delta position (points, spots): next-event estimation samples every
+    /// one of them at every vertex (BSDF sampling can never hit them, so there is nothing to
+    /// weigh them against, and choosing one at random would only add variance).
+    delta_lights: Vec<LightId>,
+    /// The light sampler for the other lights (area lights, glowing objects): chosen by power,
+    /// `None` when there are none.
+    area_lights: Option<(Discrete, Vec<LightId>)>,
 }
 
 impl<'a> PathTracer<'a> {
@@ -99,7 +108,31 @@ impl<'a> PathTracer<'a> {
         settings: PathTracerSettings,
         effects: Effects,
     ) -> Self {
-        Self { scene, settings, effects }
+        let mut delta_lights = Vec::new();
+        let (mut ids, mut powers) = (Vec::new(), Vec::new());
+        for (i, light) in scene.lights.lights().iter().enumerate() {
+            let id = LightId(i as u32);
+            match light.flags() {
+                Some(f) if f.delta_position && !f.delta_direction => delta_lights.push(id),
+                // Lights camera paths cannot reach (delta direction, beam generators only) are
+                // left out: the effects analysis does not choose the path tracer for them.
+                Some(f) if f.delta_direction => {}
+                None => {}
+                Some(_) => {
+                    ids.push(id);
+                    powers.push(light.power());
+                }
+            }
+        }
+        let area_lights = Discrete::new(&powers).ok().map(|d| (d, ids));
+        Self { scene, settings, effects, delta_lights, area_lights }
+    }
+
+    /// Probability with which next-event estimation chooses light `id` among the area lights.
+    fn area_pmf(&self, id: LightId) -> f64 {
+        self.area_lights
+            .as_ref()
+            .map_or(0.0, |(d, ids)| ids.iter().position(|&i| i == id).map_or(0.0, |k| d.pmf(k)))
     }
 
     /// Pixels in the image: the work items of one pass (one chunk).
@@ -162,7 +195,15 @@ impl<'a> PathTracer<'a> {
                 let weight = if specular {
                     1.0
                 } else {
-                    power_heuristic(prev_pdf, scene.emitter_pdf(prev_point, &hit))
+                    // The scene's density uses the whole set's pmf; next-event estimation
+                    // chooses among the area lights only.
+                    let set_pmf = scene.lights.pmf(light);
+                    let nee = if set_pmf > 0.0 {
+                        scene.emitter_pdf(prev_point, &hit) / set_pmf * self.area_pmf(light)
+                    } else {
+                        0.0
+                    };
+                    power_heuristic(prev_pdf, nee)
                 };
                 if weight > 0.0
                     && let Some(spd) = scene.light_spd(light)
@@ -251,8 +292,9 @@ impl<'a> PathTracer<'a> {
         radiance
     }
 
-    /// Next-event estimation at a non-specular `hit` seen from `wo`: one light sample, weighted
-    /// by the power heuristic against BSDF sampling, added to `radiance`.
+    /// Next-event estimation at a non-specular `hit` seen from `wo`: every delta-position light
+    /// (points, spots) once, and one area light chosen by power, weighted by the power heuristic
+    /// against BSDF sampling; added to `radiance`.
     #[allow(clippy::too_many_arguments)]
     fn next_event(
         &self,
@@ -265,11 +307,61 @@ impl<'a> PathTracer<'a> {
         rng: &mut dyn rand::Rng,
         stats: &mut TraceStats,
     ) {
+        for &id in &self.delta_lights {
+            self.connect_light(
+                hit,
+                wo,
+                material,
+                lambdas,
+                beta,
+                radiance,
+                id,
+                1.0,
+                [0.5, 0.5],
+                stats,
+            );
+        }
+        if let Some((choice, ids)) = &self.area_lights {
+            let (k, u0) = choice.sample_remapped(uniform(rng));
+            let u1 = uniform(rng);
+            if let Some(&id) = ids.get(k) {
+                let pmf = choice.pmf(k);
+                self.connect_light(
+                    hit,
+                    wo,
+                    material,
+                    lambdas,
+                    beta,
+                    radiance,
+                    id,
+                    pmf,
+                    [u0, u1],
+                    stats,
+                );
+            }
+        }
+    }
+
+    /// One light sample of light `id` (chosen with probability `pmf`) seen from `hit`, weighted
+    /// by the power heuristic against BSDF sampling (fully for a delta light), added to
+    /// `radiance`.
+    #[allow(clippy::too_many_arguments)]
+    fn connect_light(
+        &self,
+        hit: &Hit,
+        wo: DVec3,
+        material: &dyn Material,
+        lambdas: &[f64; HERO],
+        beta: &[f64; HERO],
+        radiance: &mut [f64; HERO],
+        id: LightId,
+        pmf: f64,
+        u: [f64; 2],
+        stats: &mut TraceStats,
+    ) {
         let scene = self.scene;
-        let (id, pmf, u0) = scene.lights.sample_light(uniform(rng));
-        let u1 = uniform(rng);
         let Some(light) = scene.lights.light(id) else { return };
-        let Some(sample) = light.sample_towards(hit.point, [u0, u1]) else { return };
+        let Some(sample) = light.sample_towards(hit.point, u) else { return };
         if !(sample.intensity > 0.0 && pmf > 0.0 && sample.distance > 0.0) {
             return;
         }
@@ -301,6 +393,45 @@ impl<'a> PathTracer<'a> {
                 if f > 0.0 {
                     radiance[j] += beta[j] * f * g * spd.value(lambdas[j]);
                 }
+            }
+        }
+    }
+}
+
+impl PathTracer<'_> {
+    /// Point and spot lights seen directly: a camera ray never hits a point, but the pixel a
+    /// point light projects into receives its intensity towards the camera times the camera's
+    /// importance (a finite pixel value, as the light tracer and BDPT show it). Once per pass,
+    /// exactly (the light's colour is its SPD's XYZ integral, not a sampled wavelength), or with
+    /// one lens sample per pass for a thin lens.
+    fn splat_delta_lights(
+        &self,
+        rng: &mut dyn rand::Rng,
+        film: &mut dyn Splat,
+        stats: &mut TraceStats,
+    ) {
+        let scene = self.scene;
+        let camera = scene.camera;
+        let inv = 1.0 / (*CIE_Y_INTEGRAL * scene.lights.power());
+        for &id in &self.delta_lights {
+            let Some(light) = scene.lights.light(id) else { continue };
+            let Some(origin) = light.sample_emission([0.5; 4]).map(|e| e.position) else {
+                continue;
+            };
+            let u_lens = if camera.is_pinhole() { [0.5; 2] } else { [uniform(rng), uniform(rng)] };
+            let Some(seen) = camera.sample_wi(origin, u_lens) else { continue };
+            let density = light.emission_density(origin, seen.to_camera);
+            if !(density > 0.0) {
+                continue;
+            }
+            let shadow = Ray { origin, direction: seen.to_camera };
+            if scene.world.occluded(&shadow, seen.distance * (1.0 - 1e-9)) {
+                continue;
+            }
+            let Some(spd) = scene.light_spd(id) else { continue };
+            let value = light.power() * density * seen.importance * inv;
+            if film.splat(seen.x, seen.y, spectrace_spectrum::xyz_of(spd.as_ref()) * value) {
+                stats.splats += 1;
             }
         }
     }
@@ -338,6 +469,9 @@ impl Integrator for PathTracer<'_> {
         let width = u64::from(self.scene.camera.width().max(1));
         let pixels = self.pass_samples().max(1);
         let start = pass_start(chunk, pixels);
+        if samples >= pixels {
+            self.splat_delta_lights(&mut rng, film, &mut stats);
+        }
         for i in 0..samples {
             let p = (i + start) % pixels;
             let (px, py) = ((p % width) as u32, (p / width) as u32);
