@@ -3,8 +3,8 @@
 //! [`crate::render`] knows chunks, threads, shards, the time budget, the shared exact film and
 //! the memory check, but not which estimator runs. An integrator supplies the rest:
 //! - [`Integrator::render_chunk`]: the unit of work, `samples` work items of chunk `chunk`
-//!   (light paths for the light tracer; later camera samples for a path tracer, or path pairs
-//!   for BDPT), drawn from the chunk's own random stream ([`crate::chunk_rng`]`(seed, chunk)`) and
+//!   (light paths for the light tracer; camera samples for the path tracer and BDPT, whose
+//!   samples each trace a light path too), drawn from the chunk's own random stream ([`crate::chunk_rng`]`(seed, chunk)`) and
 //!   splatted into the film through [`Splat`];
 //! - [`Integrator::image_scale`]: the normalisation, the factor that turns the film's exact sums
 //!   into the image once `samples_done` work items have been done (for the light tracer, the
@@ -15,13 +15,13 @@
 //! when the image is made. This is what keeps images bit-identical for any thread count and
 //! shard split: a chunk's contributions do not depend on how many items the whole render does.
 //!
-//! The plan for camera paths (pbrt's `AddSample` vs `AddSplat`): a path tracer's pixel samples
-//! are normalised per pixel (by the sum of their filter weights), light splats by the work done
-//! over the whole image. They will go into the same film as two separate sets of exact sums (a
-//! pixel layer with its weight sums next to today's splat layer), each layer normalised by its
-//! own factor when the image is made: `image = pixel_sums / pixel_weights + scale * splat_sums`,
-//! with `scale` from [`Integrator::image_scale`]. The splat layer and its normalisation stay as
-//! they are, so light-tracer images keep their bits; BDPT uses both layers.
+//! Pixel samples and light splats (pbrt's `AddSample` and `AddSplat`) share this one film with
+//! their own normalisations folded into one factor: camera estimators work in *passes* (a chunk
+//! is one sample of every pixel, never cut), so a pixel sample's normalisation `1 / passes` is the
+//! same for every pixel, and BDPT divides its light splats (`t = 1`) by the pixel count, the
+//! light paths of a pass, so that `image = film x power x pixels / samples` holds for both. The
+//! light tracer's `image = film x power / beams` is the same formula with the factor 1. A film
+//! layer with per-pixel weight sums would only be needed to cut passes short.
 
 use std::time::Instant;
 
@@ -33,7 +33,7 @@ use crate::{Effects, Splat, TraceStats};
 /// An estimator the render loop drives: it renders chunks of work items into a film and says
 /// how to normalise the film's sums.
 pub trait Integrator: Send + Sync {
-    /// A short name for reports: `"light"` (later `"path"`, `"bdpt"`).
+    /// A short name for reports: `"light"`, `"path"` or `"bdpt"`.
     fn name(&self) -> &'static str;
 
     /// The film's size in pixels (width, height): the camera's resolution.
