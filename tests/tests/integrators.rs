@@ -34,7 +34,13 @@ fn the_path_tracer_matches_the_lit_plane_closed_form() {
 }
 
 #[test]
-fn the_path_tracer_conserves_energy_in_the_integrating_sphere() {
+fn bdpt_matches_the_lit_plane_closed_form() {
+    let s = scene(POINT_OVER_PLANE);
+    assert_lit_plane_matches_with(&s, IntegratorChoice::Bdpt, 32 * 32 * 8, 600, |to| to.y);
+}
+
+#[test]
+fn the_camera_estimators_conserve_energy_in_the_integrating_sphere() {
     // As the light tracer's test: a point light at the centre of a diffuse sphere of reflectance
     // rho; the camera at the centre sees L = rho P / (pi A (1 - rho)) (direct light plus every
     // interreflection: Russian roulette and next-event estimation must be unbiased at every
@@ -51,9 +57,20 @@ fn the_path_tracer_conserves_energy_in_the_integrating_sphere() {
     let spd = Uniform::new(400.0, 700.0).unwrap();
     let (rho, p, area) = (0.8, 10.0, 4.0 * std::f64::consts::PI * 4.0);
     let expected = y_of_radiance(rho * p / (std::f64::consts::PI * area * (1.0 - rho)), &spd);
-    let (mean, se) = mean_and_error(&s, IntegratorChoice::Path, 16 * 16 * 32, 6);
-    assert!((mean - expected).abs() < 5.0 * se, "{mean} vs {expected} (standard error {se})");
-    assert!(se < 0.02 * expected, "the test must be sharp: standard error {se} vs {expected}");
+    for (integrator, effort) in
+        [(IntegratorChoice::Path, 16 * 16 * 32), (IntegratorChoice::Bdpt, 16 * 16 * 16)]
+    {
+        let (mean, se) = mean_and_error(&s, integrator, effort, 6);
+        let name = integrator.name();
+        assert!(
+            (mean - expected).abs() < 5.0 * se,
+            "{name}: {mean} vs {expected} (standard error {se})"
+        );
+        assert!(
+            se < 0.02 * expected,
+            "{name}: the test must be sharp: standard error {se} vs {expected}"
+        );
+    }
 }
 
 /// A spot over a diffuse plane, seen from above at an angle (the scene of the issue's timing).
@@ -425,4 +442,56 @@ fn light_and_path_agree_with_a_spot_two_points_and_an_area_light_together() {
     assert_eq!(choose_integrator(&s, None).0, IntegratorChoice::Path);
     assert_agree(&s, (IntegratorChoice::Light, 300_000), (IntegratorChoice::Path, 32 * 32 * 8), 8);
     assert_agree(&s, (IntegratorChoice::Light, 300_000), (IntegratorChoice::Bdpt, 32 * 32 * 8), 8);
+}
+
+#[test]
+fn each_bdpt_strategy_alone_converges_to_the_same_image() {
+    // A diffuse plane under an area light, one bounce at most (max_depth 0): every path is
+    // light -> plane -> camera, which three strategies can sample: s = 0 (the camera path hits
+    // the light), s = 1 (next-event estimation) and s = 2 (the light path's plane vertex joined to
+    // the camera, t = 1). Unweighted, each alone must give the image MIS combines. Tolerance:
+    // 5 combined standard errors of the image means over 8 seeds, and each sharp (5%).
+    use spectrace_renderer::{RenderOptions, decide_effects, plan_with, tracer_scene};
+    use spectrace_tracer::{Bdpt, BdptSettings, render};
+    let json = r#"{
+      "camera": {"position": [0, 1.2, 2.2], "look_at": [0, 0, 0], "fov": 45, "width": 24, "height": 24},
+      "objects": [{"shape": {"type": "Rectangle", "corner": [-2, 0, 2], "edge_u": [4, 0, 0], "edge_v": [0, 0, -4]},
+                   "material": {"type": "Diffuse", "reflectance": 0.7}}],
+      "lights": [{"type": "RectangleLight", "corner": [-0.5, 0.6, -0.5], "edge_u": [1, 0, 0], "edge_v": [0, 0, 1],
+                  "power": 20, "spd": {"type": "CieIlluminant", "name": "D65"}}],
+      "settings": {"max_depth": 0}
+    }"#;
+    let s = scene(json);
+    let effects = decide_effects(&s, None);
+    let ts = tracer_scene(&s);
+    let run = |only: Option<(usize, usize)>, seed: u64| -> f64 {
+        let settings = BdptSettings { max_depth: 0, rr_depth: 4, only_strategy: only };
+        let bdpt = Bdpt::new(&ts, settings, effects);
+        let options = RenderOptions {
+            spp: Some(32),
+            seed: Some(seed),
+            threads: Some(2),
+            ..Default::default()
+        };
+        let plan = plan_with(&s, &options, IntegratorChoice::Bdpt).unwrap();
+        let out = render(&bdpt, &plan, &|_| {}).unwrap();
+        spectrace_lights::LightSource::reset_count(&s.lights);
+        let image = out.film.to_xyz(spectrace_tracer::Integrator::image_scale(&bdpt, out.beams));
+        image.iter().map(|p| p.y).sum::<f64>() / image.len() as f64
+    };
+    let stats = |only: Option<(usize, usize)>| {
+        let v: Vec<f64> = (0..8).map(|k| run(only, 40 + k)).collect();
+        let m = v.iter().sum::<f64>() / 8.0;
+        (m, (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / 7.0 / 8.0).sqrt())
+    };
+    let (all, all_se) = stats(None);
+    for strategy in [(0, 3), (1, 2), (2, 1)] {
+        let (m, se) = stats(Some(strategy));
+        let combined = (se * se + all_se * all_se).sqrt();
+        assert!(
+            (m - all).abs() < 5.0 * combined,
+            "strategy {strategy:?} alone: {m} vs MIS {all} (standard errors {se}, {all_se})"
+        );
+        assert!(se < 0.05 * m, "strategy {strategy:?}: standard error {se} of {m}");
+    }
 }

@@ -469,7 +469,11 @@ impl Scene {
 
     /// BDPT's settings.
     pub fn bdpt_settings(&self) -> BdptSettings {
-        BdptSettings { max_depth: self.settings.max_depth, rr_depth: self.settings.rr_depth }
+        BdptSettings {
+            max_depth: self.settings.max_depth,
+            rr_depth: self.settings.rr_depth,
+            only_strategy: None,
+        }
     }
 
     /// The render plan of the scene's settings (light tracer work items: beams).

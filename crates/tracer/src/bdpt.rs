@@ -92,11 +92,16 @@ pub struct BdptSettings {
     pub max_depth: u32,
     /// Bounces after which Russian roulette may end a subpath.
     pub rr_depth: u32,
+    /// For checking the estimator: render only the strategy `(s, t)`, *unweighted* (every
+    /// strategy alone estimates all paths it can sample, so strategies of the same path length
+    /// give the same image where each can sample every path). Not a scene setting.
+    #[serde(skip)]
+    pub only_strategy: Option<(usize, usize)>,
 }
 
 impl Default for BdptSettings {
     fn default() -> Self {
-        Self { max_depth: 64, rr_depth: 4 }
+        Self { max_depth: 64, rr_depth: 4, only_strategy: None }
     }
 }
 
@@ -403,10 +408,18 @@ impl<'a> Bdpt<'a> {
                 if s + t < 2 || s + t > max_len {
                     continue;
                 }
-                let Some(c) = connect(self, lv, cv, s, t, &light, &wl, camera_strategies, rng, mis)
+                if self.settings.only_strategy.is_some_and(|only| only != (s, t)) {
+                    continue;
+                }
+                let Some(mut c) =
+                    connect(self, lv, cv, s, t, &light, &wl, camera_strategies, rng, mis)
                 else {
                     continue;
                 };
+                if self.settings.only_strategy.is_some() {
+                    // Unweighted: undo the MIS weight.
+                    c.value = if c.weight > 0.0 { c.value / c.weight } else { 0.0 };
+                }
                 if !(c.value > 0.0 && c.value.is_finite()) {
                     continue;
                 }
@@ -1473,7 +1486,7 @@ mod tests {
         // The film is relative to the lights' power (10 W), as the path tracer's.
         assert_eq!(bdpt.image_scale(512), 10.0 * 0.5);
         let s: BdptSettings = serde_json::from_str(r#"{"max_depth": 3, "rr_depth": 1}"#).unwrap();
-        assert_eq!(s, BdptSettings { max_depth: 3, rr_depth: 1 });
+        assert_eq!(s, BdptSettings { max_depth: 3, rr_depth: 1, only_strategy: None });
         assert!(serde_json::from_str::<BdptSettings>(r#"{"max_depth": 3, "rr": 1}"#).is_err());
     }
 }
