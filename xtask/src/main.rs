@@ -54,7 +54,7 @@ const CRATES: &[CrateInfo] = &[
     CrateInfo {
         package: "spectrace-tracer",
         path: "crates/tracer",
-        what: "pinhole camera, exact XYZ film, light tracer, effects analysis, threaded chunks",
+        what: "camera (pinhole, thin lens), exact XYZ film, light tracer, path tracer, BDPT, effects analysis",
     },
     CrateInfo {
         package: "spectrace-renderer",
@@ -212,7 +212,7 @@ fn print_help() {
         "usage: cargo xtask [COMMAND]\n\n\
          commands:\n  \
          status   what Spectrace contains so far (default)\n  \
-         render [SCENE] [--beams N | --time SECS] [--out DIR] [--threads N] [--seed S] [--shard K/N]\n           \
+         render [SCENE] [--integrator auto|light|path|bdpt] [--beams N | --spp N | --time SECS]\n                  [--out DIR] [--threads N] [--seed S] [--shard K/N]\n           \
                   build in release and render SCENE (default scenes/showcase.json)\n  \
          accuracy [SCENES]  error against time for every accuracy knob (docs/accuracy.md)\n  \
          fuzz [--cases N] [--seed S]  fuzz the scene and part-file loaders (release)\n  \
@@ -236,7 +236,8 @@ fn status() -> ExitCode {
          Accuracy against time:      cargo xtask accuracy [SCENES]\n\
          Run every test:             cargo test --workspace\n\
          Run the benchmarks:         cargo xtask bench\n\n\
-         Not built yet: path tracing and bidirectional path tracing with MIS."
+         Estimators: light tracer, path tracer, BDPT (--integrator auto|light|path|bdpt; auto by default).\n\
+         Not built yet: rough metals and glass, fluorescence, measured luminaires and sensors."
     );
     ExitCode::SUCCESS
 }
