@@ -376,6 +376,22 @@ fn scene_errors_name_the_file_position_and_field() {
         POINT_OVER_PLANE.replace(r#""reflectance": 0.5"#, r#""reflectance": 1.5"#);
     let e = load_error(&bad_reflectance);
     assert!(e.contains("objects[0].material.reflectance"), "{e}");
+    // The camera estimators' settings and glowing objects name their fields too.
+    let with = |settings: &str| {
+        POINT_OVER_PLANE.replace("\"lights\"", &format!("\"settings\": {settings}, \"lights\""))
+    };
+    let e = load_error(&with(r#"{"spp": 0}"#));
+    assert!(e.contains("settings.spp") && e.contains("at least 1"), "{e}");
+    let e = load_error(&with(r#"{"integrator": "mlt"}"#));
+    assert!(e.contains("settings.integrator") && e.contains("mlt"), "{e}");
+    let e = load_error(&with(r#"{"camera_wavelengths": "red"}"#));
+    assert!(e.contains("settings.camera_wavelengths"), "{e}");
+    let glowing = POINT_OVER_PLANE.replace(
+        r#""material": {"type": "Diffuse", "reflectance": 0.5}"#,
+        r#""material": {"type": "Diffuse", "reflectance": 0.5}, "emission": {"power": -3, "spd": {"type": "Uniform"}}"#,
+    );
+    let e = load_error(&glowing);
+    assert!(e.contains("objects[0].emission") && e.contains("power"), "{e}");
 }
 
 #[test]

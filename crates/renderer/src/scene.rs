@@ -332,6 +332,9 @@ impl Scene {
                 ),
             ));
         }
+        if s.spp == 0 {
+            return Err(scene_error("settings.spp", "must be at least 1".to_owned()));
+        }
         if s.chunk_beams == 0 {
             return Err(scene_error("settings.chunk_beams", "must be at least 1".to_owned()));
         }

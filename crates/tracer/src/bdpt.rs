@@ -81,7 +81,8 @@ use spectrace_lights::{LightFlags, LightId, LightSource, LightSurface, uniform};
 use spectrace_materials::{Incoming, ScatterKind, Transport};
 use spectrace_spectrum::{CIE_Y_INTEGRAL, SpectralPowerDistribution, cmf};
 
-use crate::light_tracer::{LightTracerScene, TraceStats};
+use crate::light_tracer::{LightTracerScene, TraceStats, shading_correction};
+use crate::path_tracer::{camera_image_scale, pass_pixel, pass_start};
 use crate::{Effects, Integrator, Splat, chunk_rng};
 
 /// Settings of the bidirectional path tracer.
@@ -463,17 +464,6 @@ fn surface_normal(light: &dyn LightSource) -> DVec3 {
         Some(LightSurface::Disk { normal, .. }) => normal.normalize_or_zero(),
         _ => DVec3::ZERO,
     }
-}
-
-/// The factor that makes importance transport exact with shading normals:
-/// `|wi . n_s| |wo . n_g| / (|wi . n_g| |wo . n_s|)` (Veach 1997, section 5.3).
-fn shading_correction(hit: &Hit, wi: DVec3, wo: DVec3) -> f64 {
-    let (ns, ng) = (hit.shading_normal, hit.geometric_normal);
-    if ns == ng {
-        return 1.0;
-    }
-    let denominator = wi.dot(ng).abs() * wo.dot(ns).abs();
-    if denominator > 0.0 { wi.dot(ns).abs() * wo.dot(ng).abs() / denominator } else { 0.0 }
 }
 
 /// The camera subpath of a sample of pixel `(px, py)` into `buffers.camera`: the pinhole (or a
@@ -935,8 +925,9 @@ impl Integrator for Bdpt<'_> {
         (self.scene.camera.width(), self.scene.camera.height())
     }
 
-    /// One pass: item `i` is a sample of pixel `i` (row-major) with its light path; `samples`
-    /// should be the image's pixel count. The deadline is not looked at: a pass is never cut.
+    /// One pass, mapped to pixels as the path tracer's (`pass_pixel`: whole passes sample every
+    /// pixel once, one-item probe chunks spread over the image), each sample with its light
+    /// path. The deadline is not looked at: a pass is never cut.
     fn render_chunk(
         &self,
         seed: u64,
@@ -955,9 +946,9 @@ impl Integrator for Bdpt<'_> {
             camera: Vec::with_capacity(camera_max.min(64)),
             mis: Vec::with_capacity((camera_max + light_max).min(128)),
         };
+        let start = pass_start(chunk, pixels);
         for i in 0..samples {
-            let p = i % pixels;
-            let (px, py) = ((p % width) as u32, (p / width) as u32);
+            let (px, py) = pass_pixel(start, i, pixels, width);
             self.sample_pixel(px, py, &mut rng, &mut buffers, film, &mut stats);
             stats.beams += 1;
         }
@@ -968,11 +959,7 @@ impl Integrator for Bdpt<'_> {
     /// estimate divided by the lights' total power, as the path tracer's (the renderer's
     /// normalisation of camera integrators), and the image is the mean per pixel.
     fn image_scale(&self, samples_done: u64) -> f64 {
-        if samples_done == 0 {
-            0.0
-        } else {
-            self.scene.lights.power() * self.pass_samples() as f64 / samples_done as f64
-        }
+        camera_image_scale(self.scene.lights.power(), self.pass_samples(), samples_done)
     }
 }
 

@@ -34,7 +34,7 @@ use spectrace_materials::{Incoming, Material};
 /// The factor that makes particle (importance) transport exact with shading normals:
 /// `|wi . n_s| |wo . n_g| / (|wi . n_g| |wo . n_s|)`, 1 where the normals agree (Veach 1997,
 /// section 5.3). `wi` points back to where the particle came from, `wo` where it goes.
-fn shading_correction(hit: &spectrace_geometry::Hit, wi: DVec3, wo: DVec3) -> f64 {
+pub(crate) fn shading_correction(hit: &spectrace_geometry::Hit, wi: DVec3, wo: DVec3) -> f64 {
     let (ns, ng) = (hit.shading_normal, hit.geometric_normal);
     if ns == ng {
         return 1.0;

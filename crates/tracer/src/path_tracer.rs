@@ -443,6 +443,20 @@ pub(crate) fn pass_start(chunk: u64, pixels: u64) -> u64 {
     chunk.wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(32) % pixels.max(1)
 }
 
+/// The pixel `(x, y)` of item `i` of a pass that starts at pixel `start` (row-major, wrapping),
+/// for an image `width` pixels wide of `pixels` pixels: the one mapping of camera estimators.
+pub(crate) fn pass_pixel(start: u64, i: u64, pixels: u64, width: u64) -> (u32, u32) {
+    let p = (i + start) % pixels.max(1);
+    let width = width.max(1);
+    ((p % width) as u32, (p / width) as u32)
+}
+
+/// The image scale of a camera estimator: the lights' `power` times the `pixels` over the
+/// samples done (its film holds estimates relative to the lights' power, one per pixel sample).
+pub(crate) fn camera_image_scale(power: f64, pixels: u64, samples_done: u64) -> f64 {
+    if samples_done == 0 { 0.0 } else { power * pixels as f64 / samples_done as f64 }
+}
+
 impl Integrator for PathTracer<'_> {
     fn name(&self) -> &'static str {
         Self::NAME
@@ -473,8 +487,7 @@ impl Integrator for PathTracer<'_> {
             self.splat_delta_lights(&mut rng, film, &mut stats);
         }
         for i in 0..samples {
-            let p = (i + start) % pixels;
-            let (px, py) = ((p % width) as u32, (p / width) as u32);
+            let (px, py) = pass_pixel(start, i, pixels, width);
             let xyz = self.sample_pixel(px, py, &mut rng, &mut stats);
             stats.beams += 1;
             // A rejected (non-finite) sample is counted by the film, never added.
@@ -489,10 +502,6 @@ impl Integrator for PathTracer<'_> {
     /// radiance divided by the lights' total power (so that lights of any power keep the exact
     /// film in range), and the image is the mean per pixel.
     fn image_scale(&self, samples_done: u64) -> f64 {
-        if samples_done == 0 {
-            0.0
-        } else {
-            self.scene.lights.power() * self.pass_samples() as f64 / samples_done as f64
-        }
+        camera_image_scale(self.scene.lights.power(), self.pass_samples(), samples_done)
     }
 }
