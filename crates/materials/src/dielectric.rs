@@ -32,7 +32,10 @@ use spectrace_sampling::clamp_uniform;
 use crate::fresnel::{fresnel_dielectric, refract};
 use crate::ior::IorRepr;
 use crate::vectors::normalise;
-use crate::{Incoming, Ior, Material, MaterialError, ScatterKind, Scattered, Transport};
+use crate::{
+    BundleScattered, Incoming, Ior, Material, MaterialError, ScatterKind, Scattered, Transport,
+    scatter_each,
+};
 
 /// A smooth dielectric boundary (glass) with a possibly dispersive index of refraction.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -40,6 +43,15 @@ use crate::{Incoming, Ior, Material, MaterialError, ScatterKind, Scattered, Tran
 pub struct Dielectric {
     ior: Ior,
     transmittance: Option<Transmittance>,
+}
+
+/// The lobe a uniform chose: its direction, whether it refracts, and the indices before and
+/// after the boundary.
+struct Lobe {
+    direction: DVec3,
+    transmission: bool,
+    eta_i: f64,
+    eta_t: f64,
 }
 
 /// Scene-file form of [`Dielectric`]: the index unvalidated, so its errors name the field.
@@ -90,6 +102,38 @@ impl Dielectric {
         self.transmittance.as_ref()
     }
 
+    /// The lobe `u0` chooses for a beam along `d` at `lambda`: Fresnel reflection with
+    /// probability `F`, else refraction (total internal reflection where there is none).
+    fn lobe(&self, d: DVec3, normal: DVec3, lambda: f64, u0: f64) -> Lobe {
+        let n_inside = self.ior.n(lambda);
+        let entering = d.dot(normal) < 0.0;
+        // Normal on the beam's side, and the indices before (i) and after (t) the boundary.
+        let (n, eta_i, eta_t) =
+            if entering { (normal, 1.0, n_inside) } else { (-normal, n_inside, 1.0) };
+        let cos_i = (-d.dot(n)).clamp(0.0, 1.0);
+        let f = fresnel_dielectric(cos_i, eta_t / eta_i);
+        let reflection =
+            Lobe { direction: normalise(d + 2.0 * cos_i * n), transmission: false, eta_i, eta_t };
+        if clamp_uniform(u0) < f {
+            return reflection;
+        }
+        match refract(d, n, eta_t / eta_i) {
+            Some(direction) => Lobe { direction, transmission: true, eta_i, eta_t },
+            None => reflection, // total internal reflection (F = 1 already chose it)
+        }
+    }
+
+    /// The weight of a refraction at `lambda`: the transmittance, and for radiance the
+    /// `(n_i / n_t)^2` change across the boundary.
+    fn refraction_weight(&self, lobe: &Lobe, lambda: f64, transport: Transport) -> f64 {
+        let mut weight = self.transmittance.as_ref().map_or(1.0, |t| t.value(lambda));
+        if transport == Transport::Radiance {
+            let ratio = lobe.eta_i / lobe.eta_t;
+            weight *= ratio * ratio;
+        }
+        weight
+    }
+
     /// The Fresnel reflectance for a beam travelling along `direction` onto a boundary with
     /// outward `normal` at `lambda` (nm): the probability that [`Material::scatter`] reflects.
     pub fn reflectance(&self, direction: DVec3, normal: DVec3, lambda: f64) -> f64 {
@@ -112,46 +156,64 @@ impl Material for Dielectric {
         u: [f64; 3],
         transport: Transport,
     ) -> Option<Scattered> {
-        let d = incoming.direction;
-        let n_inside = self.ior.n(incoming.lambda);
-        let entering = d.dot(incoming.normal) < 0.0;
-        // Normal on the beam's side, and the indices before (i) and after (t) the boundary.
-        let (n, eta_i, eta_t) = if entering {
-            (incoming.normal, 1.0, n_inside)
+        let lobe = self.lobe(incoming.direction, incoming.normal, incoming.lambda, u[0]);
+        let weight = if lobe.transmission {
+            self.refraction_weight(&lobe, incoming.lambda, transport)
         } else {
-            (-incoming.normal, n_inside, 1.0)
+            1.0
         };
-        let cos_i = (-d.dot(n)).clamp(0.0, 1.0);
-        let f = fresnel_dielectric(cos_i, eta_t / eta_i);
-        let reflection = Scattered {
-            direction: normalise(d + 2.0 * cos_i * n),
-            weight: 1.0,
-            kind: ScatterKind::Specular,
-            pdf: 0.0,
-            eta: 1.0,
-            transmission: false,
-        };
-        if clamp_uniform(u[0]) < f {
-            return Some(reflection);
-        }
-        let Some(direction) = refract(d, n, eta_t / eta_i) else {
-            return Some(reflection); // total internal reflection (F = 1 already chose it)
-        };
-        let mut weight = self.transmittance.as_ref().map_or(1.0, |t| t.value(incoming.lambda));
-        if transport == Transport::Radiance {
-            let ratio = eta_i / eta_t;
-            weight *= ratio * ratio;
-        }
         if !(weight > 0.0) {
             return None;
         }
         Some(Scattered {
-            direction,
+            direction: lobe.direction,
             weight,
             kind: ScatterKind::Specular,
             pdf: 0.0,
-            eta: eta_t / eta_i,
-            transmission: true,
+            eta: if lobe.transmission { lobe.eta_t / lobe.eta_i } else { 1.0 },
+            transmission: lobe.transmission,
+        })
+    }
+
+    /// Without dispersion the Fresnel choice and both directions are the same for every
+    /// wavelength: the lobe is chosen once, and only the transmittance differs per wavelength.
+    /// A dispersive index scatters each wavelength (the general way, [`scatter_each`]).
+    fn scatter_bundle(
+        &self,
+        direction: DVec3,
+        normal: DVec3,
+        lambdas: &[f64],
+        weights: &mut [f64],
+        u: [f64; 3],
+        transport: Transport,
+    ) -> Option<BundleScattered> {
+        if self.is_dispersive() {
+            return scatter_each(self, direction, normal, lambdas, weights, u, transport);
+        }
+        let first = weights.iter().zip(lambdas).find(|(w, _)| **w > 0.0).map(|(_, &l)| l)?;
+        let lobe = self.lobe(direction, normal, first, u[0]);
+        let mut any = false;
+        for (w, &lambda) in weights.iter_mut().zip(lambdas) {
+            if *w > 0.0 {
+                let t = if lobe.transmission {
+                    self.refraction_weight(&lobe, lambda, transport)
+                } else {
+                    1.0
+                };
+                if t > 0.0 {
+                    *w *= t;
+                    any = true;
+                } else {
+                    *w = 0.0;
+                }
+            }
+        }
+        any.then_some(BundleScattered {
+            direction: lobe.direction,
+            kind: ScatterKind::Specular,
+            pdf: 0.0,
+            eta: if lobe.transmission { lobe.eta_t / lobe.eta_i } else { 1.0 },
+            transmission: lobe.transmission,
         })
     }
 

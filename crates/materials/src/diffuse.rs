@@ -22,7 +22,7 @@ use spectrace_spectrum::Reflectance;
 use spectrace_sampling::{Frame, clamp_uniform, pdf_cosine_hemisphere, sample_cosine_hemisphere};
 
 use crate::vectors::{facing, normalise};
-use crate::{Incoming, Material, ScatterKind, Scattered};
+use crate::{BundleScattered, Incoming, Material, ScatterKind, Scattered, Transport};
 
 /// A Lambertian (ideal diffuse) reflector, two-sided.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -65,6 +65,59 @@ impl Material for Diffuse {
             eta: 1.0,
             transmission: false,
         })
+    }
+
+    /// One cosine-distributed direction for the whole bundle; each live wavelength's weight
+    /// times its `R(lambda)`.
+    fn scatter_bundle(
+        &self,
+        direction: DVec3,
+        normal: DVec3,
+        lambdas: &[f64],
+        weights: &mut [f64],
+        u: [f64; 3],
+        _transport: Transport,
+    ) -> Option<BundleScattered> {
+        let mut any = false;
+        for (w, &lambda) in weights.iter_mut().zip(lambdas) {
+            if *w > 0.0 {
+                let albedo = self.reflectance.value(lambda);
+                if albedo > 0.0 {
+                    *w *= albedo;
+                    any = true;
+                } else {
+                    *w = 0.0;
+                }
+            }
+        }
+        if !any {
+            return None;
+        }
+        let n = facing(direction, normal);
+        let local = sample_cosine_hemisphere([clamp_uniform(u[1]), clamp_uniform(u[2])]);
+        Some(BundleScattered {
+            direction: normalise(Frame::from_normal(n).to_world(local)),
+            kind: ScatterKind::Diffuse,
+            pdf: pdf_cosine_hemisphere(local.z),
+            eta: 1.0,
+            transmission: false,
+        })
+    }
+
+    /// The lobe's side test once; `R(lambda) / pi` per wavelength.
+    fn eval_bundle(
+        &self,
+        wi: DVec3,
+        wo: DVec3,
+        normal: DVec3,
+        lambdas: &[f64],
+        _transport: Transport,
+        out: &mut [f64],
+    ) {
+        let lit = same_side(wi, wo, normal);
+        for (o, &lambda) in out.iter_mut().zip(lambdas) {
+            *o = if lit { self.reflectance.value(lambda) * FRAC_1_PI } else { 0.0 };
+        }
     }
 
     fn eval(&self, wi: DVec3, wo: DVec3, normal: DVec3, lambda: f64) -> f64 {

@@ -55,7 +55,9 @@ pub use error::MaterialError;
 pub use fresnel::{Polarised, fresnel_dielectric, fresnel_dielectric_polarised, reflect, refract};
 pub use glass::{GLASSES, Glass, find_glass, known_glasses};
 pub use ior::{FRAUNHOFER_C_NM, FRAUNHOFER_D_NM, FRAUNHOFER_F_NM, Ior, VALID_MAX_NM, VALID_MIN_NM};
-pub use material::{Incoming, Material, ScatterKind, Scattered, Transport};
+pub use material::{
+    BundleScattered, Incoming, Material, ScatterKind, Scattered, Transport, scatter_each,
+};
 pub use mirror::Mirror;
 
 /// Vectors (`DVec3`), re-exported so users need no direct dependency.

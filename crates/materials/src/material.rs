@@ -63,6 +63,24 @@ pub struct Scattered {
     pub transmission: bool,
 }
 
+/// What a bundle of wavelengths sharing one path did at a surface
+/// ([`Material::scatter_bundle`]): the one outgoing direction and the lobe it came from; the
+/// per-wavelength weights are updated in place.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BundleScattered {
+    /// Unit direction of the outgoing path, away from the surface.
+    pub direction: DVec3,
+    /// Which kind of lobe was sampled.
+    pub kind: ScatterKind,
+    /// Solid-angle density of `direction` (sr^-1) for the first live wavelength; 0 for a delta
+    /// lobe.
+    pub pdf: f64,
+    /// `n_t / n_i` across the boundary for the first live wavelength (1 for a reflection).
+    pub eta: f64,
+    /// `true` if the path went through the surface.
+    pub transmission: bool,
+}
+
 /// What a surface does to a beam (seed 3.5): scatter it into a new direction with an updated
 /// weight, or absorb it.
 ///
@@ -120,6 +138,46 @@ pub trait Material: Send + Sync + Debug {
         self.eval(wi, wo, normal, lambda)
     }
 
+    /// Scatters a *bundle*: several wavelengths `lambdas` travelling along one path (towards the
+    /// surface along `direction`), with weights `weights` (same length), using the same uniforms
+    /// `u` for all. Live wavelengths (weight `> 0`) that follow the returned direction have their
+    /// weight multiplied by their own [`Scattered::weight`]; a wavelength the surface absorbs, or
+    /// one that would leave in another direction (dispersion), gets weight 0; dead wavelengths
+    /// are left alone. `None` when no live wavelength scatters.
+    ///
+    /// The first live wavelength chooses the lobe and the direction. The default calls
+    /// [`scatter_with`](Self::scatter_with) once per live wavelength; materials whose direction
+    /// does not depend on the wavelength override it to sample once per bounce (same result,
+    /// bit for bit).
+    fn scatter_bundle(
+        &self,
+        direction: DVec3,
+        normal: DVec3,
+        lambdas: &[f64],
+        weights: &mut [f64],
+        u: [f64; 3],
+        transport: Transport,
+    ) -> Option<BundleScattered> {
+        scatter_each(self, direction, normal, lambdas, weights, u, transport)
+    }
+
+    /// [`eval_with`](Self::eval_with) at every wavelength of `lambdas`, written to `out` (same
+    /// length): one evaluation per connection for a bundle. The default loops; materials with a
+    /// wavelength-independent lobe shape override it to compute the geometry once.
+    fn eval_bundle(
+        &self,
+        wi: DVec3,
+        wo: DVec3,
+        normal: DVec3,
+        lambdas: &[f64],
+        transport: Transport,
+        out: &mut [f64],
+    ) {
+        for (o, &lambda) in out.iter_mut().zip(lambdas) {
+            *o = self.eval_with(wi, wo, normal, lambda, transport);
+        }
+    }
+
     /// Solid-angle density (sr^-1) with which [`scatter`](Self::scatter), given a beam arriving
     /// from `wi` (`Incoming::direction = -wi`), returns `wo`; 0 for delta lobes. The density of
     /// the reverse choice is `pdf(wo, wi, ...)`.
@@ -132,4 +190,45 @@ pub trait Material: Send + Sync + Debug {
     /// `true` if the directions this material scatters into depend on the wavelength (a
     /// dispersive index of refraction): paths through it cannot be shared between wavelengths.
     fn is_dispersive(&self) -> bool;
+}
+
+/// [`Material::scatter_bundle`] done the general way: [`Material::scatter_with`] once per live
+/// wavelength, keeping those that leave along the first one's direction (the trait's default;
+/// exposed so materials that override it for some parameters can fall back to it).
+pub fn scatter_each<M: Material + ?Sized>(
+    material: &M,
+    direction: DVec3,
+    normal: DVec3,
+    lambdas: &[f64],
+    weights: &mut [f64],
+    u: [f64; 3],
+    transport: Transport,
+) -> Option<BundleScattered> {
+    let mut out: Option<BundleScattered> = None;
+    for (w, &lambda) in weights.iter_mut().zip(lambdas) {
+        if !(*w > 0.0) {
+            continue;
+        }
+        let incoming = Incoming { direction, normal, lambda };
+        match material.scatter_with(&incoming, u, transport) {
+            Some(s) => match out {
+                None => {
+                    out = Some(BundleScattered {
+                        direction: s.direction,
+                        kind: s.kind,
+                        pdf: s.pdf,
+                        eta: s.eta,
+                        transmission: s.transmission,
+                    });
+                    *w *= s.weight;
+                }
+                Some(b) if (s.direction - b.direction).length_squared() < 1e-20 => {
+                    *w *= s.weight;
+                }
+                Some(_) => *w = 0.0,
+            },
+            None => *w = 0.0,
+        }
+    }
+    out
 }

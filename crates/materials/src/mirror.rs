@@ -17,7 +17,7 @@ use spectrace_spectrum::Reflectance;
 
 use crate::fresnel::reflect;
 use crate::vectors::facing;
-use crate::{Incoming, Material, ScatterKind, Scattered};
+use crate::{BundleScattered, Incoming, Material, ScatterKind, Scattered, Transport};
 
 /// A perfect mirror, two-sided, with a wavelength-dependent reflectance.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -47,6 +47,42 @@ impl Material for Mirror {
         Some(Scattered {
             direction: reflect(incoming.direction, n),
             weight: r,
+            kind: ScatterKind::Specular,
+            pdf: 0.0,
+            eta: 1.0,
+            transmission: false,
+        })
+    }
+
+    /// One reflection for the whole bundle; each live wavelength's weight times its
+    /// `R(lambda)`.
+    fn scatter_bundle(
+        &self,
+        direction: DVec3,
+        normal: DVec3,
+        lambdas: &[f64],
+        weights: &mut [f64],
+        _u: [f64; 3],
+        _transport: Transport,
+    ) -> Option<BundleScattered> {
+        let mut any = false;
+        for (w, &lambda) in weights.iter_mut().zip(lambdas) {
+            if *w > 0.0 {
+                let r = self.reflectance.value(lambda);
+                if r > 0.0 {
+                    *w *= r;
+                    any = true;
+                } else {
+                    *w = 0.0;
+                }
+            }
+        }
+        if !any {
+            return None;
+        }
+        let n = facing(direction, normal);
+        Some(BundleScattered {
+            direction: reflect(direction, n),
             kind: ScatterKind::Specular,
             pdf: 0.0,
             eta: 1.0,

@@ -29,7 +29,7 @@ use rand_pcg::Pcg64;
 use serde::{Deserialize, Serialize};
 use spectrace_geometry::{Ray, World};
 use spectrace_lights::{LightId, LightSet, LightSource, uniform};
-use spectrace_materials::{Incoming, Material};
+use spectrace_materials::{Material, Transport};
 
 /// The factor that makes particle (importance) transport exact with shading normals:
 /// `|wi . n_s| |wo . n_g| / (|wi . n_g| |wo . n_s|)`, 1 where the normals agree (Veach 1997,
@@ -421,34 +421,20 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
                 break;
             }
             let u = [uniform(&mut rng), uniform(&mut rng), uniform(&mut rng)];
-            // Scatter every live wavelength with the same uniforms: without dispersion they all
-            // take the same direction; a wavelength the surface absorbs drops out of the bundle
-            // alone (the first live one that scatters sets the direction).
-            let mut direction: Option<DVec3> = None;
-            for j in 0..k {
-                if weights[j] <= 0.0 {
-                    continue;
-                }
-                let incoming = Incoming {
-                    direction: ray.direction,
-                    normal: hit.shading_normal,
-                    lambda: lambdas[j],
-                };
-                match material.scatter(&incoming, u) {
-                    Some(s) => match direction {
-                        None => {
-                            direction = Some(s.direction);
-                            weights[j] *= s.weight;
-                        }
-                        Some(d) if (s.direction - d).length_squared() < 1e-20 => {
-                            weights[j] *= s.weight
-                        }
-                        Some(_) => weights[j] = 0.0,
-                    },
-                    None => weights[j] = 0.0,
-                }
-            }
-            let Some(new_direction) = direction else { break };
+            // One scatter for the whole bundle: without dispersion every wavelength takes the
+            // same direction, each with its own weight; a wavelength the surface absorbs drops
+            // out alone, and a dispersive surface keeps only the first live one.
+            let Some(scattered) = material.scatter_bundle(
+                ray.direction,
+                hit.shading_normal,
+                &lambdas[..k],
+                &mut weights[..k],
+                u,
+                Transport::Importance,
+            ) else {
+                break;
+            };
+            let new_direction = scattered.direction;
             // Shading normals: the adjoint correction for particles (Veach 1997, section 5.3).
             let correction = shading_correction(&hit, -ray.direction, new_direction);
             for w in &mut weights[..k] {
@@ -534,12 +520,22 @@ fn connect_to_camera(
             / cos_in
     };
     let mut values = [0.0; MAX_BUNDLE];
+    let k = lambdas.len();
+    material.eval_bundle(
+        -arriving,
+        projection.to_camera,
+        hit.shading_normal,
+        lambdas,
+        Transport::Importance,
+        &mut values[..k],
+    );
     let mut any = false;
-    for (v, &lambda) in values.iter_mut().zip(lambdas) {
-        let f = material.eval(-arriving, projection.to_camera, hit.shading_normal, lambda);
-        if f > 0.0 {
-            *v = f * cos * projection.importance;
+    for v in &mut values[..k] {
+        if *v > 0.0 {
+            *v = *v * cos * projection.importance;
             any = true;
+        } else {
+            *v = 0.0;
         }
     }
     any.then_some((projection.x, projection.y, values))

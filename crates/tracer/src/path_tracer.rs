@@ -40,7 +40,7 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use spectrace_geometry::{Hit, Ray};
 use spectrace_lights::{LightId, LightSource, uniform};
-use spectrace_materials::{Incoming, Material, ScatterKind, Transport};
+use spectrace_materials::{Material, ScatterKind, Transport};
 use spectrace_sampling::Discrete;
 use spectrace_spectrum::{CIE_Y_INTEGRAL, Xyz, cmf};
 
@@ -245,31 +245,17 @@ impl<'a> PathTracer<'a> {
                 last_bounce = true;
             }
             let u = [uniform(rng), uniform(rng), uniform(rng)];
-            let mut sampled: Option<(DVec3, ScatterKind, f64)> = None;
-            for j in 0..HERO {
-                if beta[j] == 0.0 {
-                    continue;
-                }
-                let incoming = Incoming {
-                    direction: ray.direction,
-                    normal: hit.shading_normal,
-                    lambda: lambdas[j],
-                };
-                match material.scatter_with(&incoming, u, Transport::Radiance) {
-                    Some(s) => match sampled {
-                        None => {
-                            sampled = Some((s.direction, s.kind, s.pdf));
-                            beta[j] *= s.weight;
-                        }
-                        Some((d, _, _)) if (s.direction - d).length_squared() < 1e-20 => {
-                            beta[j] *= s.weight;
-                        }
-                        Some(_) => beta[j] = 0.0,
-                    },
-                    None => beta[j] = 0.0,
-                }
-            }
-            let Some((direction, kind, pdf)) = sampled else { break };
+            let Some(scattered) = material.scatter_bundle(
+                ray.direction,
+                hit.shading_normal,
+                &lambdas[..],
+                &mut beta,
+                u,
+                Transport::Radiance,
+            ) else {
+                break;
+            };
+            let (direction, kind, pdf) = (scattered.direction, scattered.kind, scattered.pdf);
             specular = kind == ScatterKind::Specular;
             prev_pdf = pdf;
             prev_point = hit.point;
@@ -387,12 +373,11 @@ impl<'a> PathTracer<'a> {
         stats.splats += 1;
         let Some(spd) = scene.light_spd(id) else { return };
         let g = sample.intensity * cos / (sample.distance * sample.distance * pmf) * weight;
+        let mut f = [0.0; HERO];
+        material.eval_bundle(wi, wo, n, lambdas, Transport::Radiance, &mut f);
         for j in 0..HERO {
-            if beta[j] != 0.0 {
-                let f = material.eval(wi, wo, n, lambdas[j]);
-                if f > 0.0 {
-                    radiance[j] += beta[j] * f * g * spd.value(lambdas[j]);
-                }
+            if beta[j] != 0.0 && f[j] > 0.0 {
+                radiance[j] += beta[j] * f[j] * g * spd.value(lambdas[j]);
             }
         }
     }

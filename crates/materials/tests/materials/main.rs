@@ -5,6 +5,7 @@
 //! tests of finiteness and unit directions.
 #![allow(clippy::unwrap_used)]
 
+mod bundles;
 mod dielectric;
 mod diffuse;
 mod dispersion;
