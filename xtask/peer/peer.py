@@ -7,6 +7,7 @@ doubling effort (2 threads each), and writes docs/peer.md, docs/peer.svg and the
 """
 
 import argparse
+import hashlib
 import json
 import math
 import os
@@ -358,6 +359,22 @@ def masks_for(name, scene):
 class Spectrace:
     def __init__(self, binary, work):
         self.binary, self.work = binary, work
+        self.out = os.path.join(work, "spectrace")
+
+    def cached(self, tag, meta):
+        """The image, time and work of an earlier render `tag` made with `meta`, or None."""
+        try:
+            with open(os.path.join(self.out, tag + ".meta.json")) as f:
+                if json.load(f) != meta:
+                    return None
+            xyz, sidecar = read_spectrace(self.out, tag)
+            return xyz, float(sidecar["wall_seconds"]), int(sidecar["beams"])
+        except (OSError, ValueError, KeyError, RuntimeError):
+            return None
+
+    def remember(self, tag, meta):
+        with open(os.path.join(self.out, tag + ".meta.json"), "w") as f:
+            json.dump(meta, f)
 
     def render(self, scene_path, integrator, effort, seed, tag, seconds=None):
         """Renders with `effort` beams (light) or samples per pixel, or for `seconds` if given;
@@ -390,19 +407,25 @@ class Spectrace:
 class Mitsuba:
     def __init__(self):
         self.scenes = {}
+        self.warm = set()
 
     def render(self, scene, name, integrator, spp, seed):
         key = (name, integrator)
         if key not in self.scenes:
             self.scenes[key] = mi.load_dict(translate(scene, {"type": integrator, "max_depth": 65}))
-            # Warm-up: trace and compile the kernels once (Dr.Jit caches them; 1 spp and more
-            # compile different kernels) so the timed renders measure rendering, not the LLVM
-            # compiler.
+            # Warm-up: trace and compile the kernels once (Dr.Jit caches them) so the timed
+            # renders measure rendering, not the LLVM compiler. Sample counts only ever grow:
+            # a render asking for fewer samples than the one before it was seen to render the
+            # earlier count (a 2-spp render after a 4-spp one had the 4-spp image and time).
             t = time.perf_counter()
-            for spp in (1, 2, 4):
-                self._go(self.scenes[key], spp, 0)
+            self._go(self.scenes[key], 1, 0)
+            self.warm.add((key, 1))
             self.compile_seconds = time.perf_counter() - t
         sc = self.scenes[key]
+        if (key, spp) not in self.warm:
+            # Mitsuba's ptracer compiles a kernel per sample count: warm it up untimed too.
+            self._go(sc, spp, seed + 100_000)
+            self.warm.add((key, spp))
         t = time.perf_counter()
         xyz = self._go(sc, max(spp, 1), seed)
         return xyz, time.perf_counter() - t
@@ -435,8 +458,22 @@ def race_scene(args, name, spectrace, mitsuba):
     log(f"[{name}] reference: Spectrace {ref_integrator}, 2 x {ref_seconds} s")
     halves = []
     beams = 0
+    reused = False
+    with open(path, "rb") as f:
+        fingerprint = hashlib.sha256(f.read()).hexdigest()
     for seed in (1001, 1002):
-        xyz, secs, done = spectrace.render(path, ref_integrator, None, seed, f"{name}-ref-{seed}", ref_seconds)
+        tag = f"{name}-ref-{seed}"
+        # A reference half is kept (target/peer/spectrace) and reused while the scene file, the
+        # integrator and the time are the same.
+        meta = {"scene_sha256": fingerprint, "integrator": ref_integrator, "seconds": ref_seconds, "seed": seed}
+        cached = spectrace.cached(tag, meta)
+        if cached is None:
+            cached = spectrace.render(path, ref_integrator, None, seed, tag, ref_seconds)
+            spectrace.remember(tag, meta)
+        else:
+            log(f"[{name}] reference half {seed}: reused from target/peer/spectrace/{tag}.exr")
+            reused = True
+        xyz, secs, done = cached
         halves.append((xyz, secs))
         beams += done
     reference = (halves[0][0] + halves[1][0]) / 2
@@ -488,7 +525,7 @@ def race_scene(args, name, spectrace, mitsuba):
         "reference": {
             "integrator": f"Spectrace {ref_integrator}",
             "work": beams,
-            "unit": "beams" if ref_integrator == "light" else "camera samples", "seconds": ref_seconds, "noise": ref_noise},
+            "unit": "beams" if ref_integrator == "light" else "camera samples", "seconds": ref_seconds, "noise": ref_noise, "reused": reused},
         "results": results,
     }
 

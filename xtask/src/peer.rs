@@ -89,8 +89,14 @@ fn find_llvm() -> Result<PathBuf, String> {
             _ => Ok(path),
         };
     }
+    find_llvm_in(LLVM_DIRS)
+}
+
+/// The newest `libLLVM*.so*` of major version >= [`MIN_LLVM`] in `dirs`, or a message listing the
+/// versions found and what to install.
+fn find_llvm_in(dirs: &[&str]) -> Result<PathBuf, String> {
     let mut found: Vec<(u32, PathBuf)> = Vec::new();
-    for dir in LLVM_DIRS {
+    for dir in dirs {
         let Ok(entries) = std::fs::read_dir(dir) else { continue };
         for entry in entries.flatten() {
             let name = entry.file_name();
@@ -108,7 +114,7 @@ fn find_llvm() -> Result<PathBuf, String> {
                 "no libLLVM of version {MIN_LLVM} or newer found in {} (found: {}); Mitsuba's \
                  llvm_ad_spectral variant needs one: on Debian or Ubuntu `apt-get install \
                  libllvm19`, or set DRJIT_LIBLLVM_PATH to the library",
-                LLVM_DIRS.join(", "),
+                dirs.join(", "),
                 if seen.is_empty() { "none".to_owned() } else { seen.join(", ") }
             ))
         }
@@ -188,7 +194,9 @@ fn venv() -> Result<PathBuf, String> {
 
 #[cfg(test)]
 mod tests {
-    use super::llvm_major;
+    #![allow(clippy::unwrap_used)]
+
+    use super::{find_llvm_in, llvm_major};
 
     #[test]
     fn llvm_versions_are_read_from_file_names() {
@@ -200,5 +208,24 @@ mod tests {
         assert_eq!(llvm_major("libLLVMSupport.a"), None);
         assert_eq!(llvm_major("libLLVM-17.a"), None);
         assert_eq!(llvm_major("libclang-19.so"), None);
+    }
+
+    #[test]
+    fn only_a_libllvm_of_version_16_or_newer_is_chosen() {
+        let dir = std::env::temp_dir().join(format!("xtask-peer-llvm-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for name in ["libLLVM-14.so.1", "libLLVM-15.so", "libLLVMSupport.a"] {
+            std::fs::write(dir.join(name), b"").unwrap();
+        }
+        let dirs = [dir.to_str().unwrap()];
+        let err = find_llvm_in(&dirs).unwrap_err();
+        assert!(
+            err.contains("found: 14, 15") && err.contains("apt-get install libllvm19"),
+            "{err}"
+        );
+        std::fs::write(dir.join("libLLVM.so.19.1"), b"").unwrap();
+        std::fs::write(dir.join("libLLVM-17.so"), b"").unwrap();
+        assert_eq!(find_llvm_in(&dirs).unwrap(), dir.join("libLLVM.so.19.1"));
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
