@@ -11,8 +11,14 @@
 //! - `cargo xtask accuracy [SCENES]`: the error-against-time report, `docs/accuracy.md`.
 //! - `cargo xtask fuzz [--cases N] [--seed S]`: a longer run of the scene and part-file fuzzer
 //!   (`tests/tests/fuzz.rs`) in release mode.
+//! - `cargo xtask peer [options]`: the race against Mitsuba 3 (`docs/peer.md`): builds a Python
+//!   virtual environment under the target directory with a pinned Mitsuba, then runs
+//!   `xtask/peer/peer.py`. Needs python3 with venv and pip, network access for the first install,
+//!   and a libLLVM of version 16 or newer. Never run by CI.
 
 use std::process::{Command, ExitCode};
+
+mod peer;
 
 /// One workspace crate as the status page lists it.
 struct CrateInfo {
@@ -84,6 +90,7 @@ fn main() -> ExitCode {
         "render" => render(&args[1..]),
         "accuracy" => accuracy(&args[1..]),
         "fuzz" => fuzz(&args[1..]),
+        "peer" => peer::run(&args[1..]),
         other => {
             eprintln!("unknown command `{other}`\n");
             print_help();
@@ -171,26 +178,10 @@ fn run_spectrace(args: &[String]) -> ExitCode {
 
 /// Builds `spectrace` in release mode, then runs it with `args` in `dir` (or here).
 fn run_spectrace_in(args: &[String], dir: Option<&std::path::Path>) -> ExitCode {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
-    eprintln!("$ cargo build --release -p spectrace-renderer --bin spectrace");
-    match Command::new(&cargo)
-        .args(["build", "--release", "-p", "spectrace-renderer", "--bin", "spectrace"])
-        .status()
-    {
-        Ok(s) if s.success() => {}
-        Ok(s) => {
-            eprintln!("building the renderer failed ({s})");
-            return ExitCode::FAILURE;
-        }
-        Err(e) => {
-            eprintln!("could not run cargo: {e}");
-            return ExitCode::FAILURE;
-        }
-    }
-    let target = std::env::var("CARGO_TARGET_DIR").unwrap_or_else(|_| "target".to_owned());
-    let binary = std::path::Path::new(&target)
-        .join("release")
-        .join(format!("spectrace{}", std::env::consts::EXE_SUFFIX));
+    let binary = match build_spectrace() {
+        Ok(binary) => binary,
+        Err(code) => return code,
+    };
     eprintln!("$ {} {}", binary.display(), args.join(" "));
     let mut command = Command::new(&binary);
     command.args(args);
@@ -207,6 +198,33 @@ fn run_spectrace_in(args: &[String], dir: Option<&std::path::Path>) -> ExitCode 
     }
 }
 
+/// The target directory: `CARGO_TARGET_DIR`, else `target` (relative to the current directory,
+/// as cargo resolves it for `cargo xtask`, which runs from the workspace).
+fn target_dir() -> std::path::PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| "target".into(), Into::into)
+}
+
+/// Builds `spectrace` in release mode; its path, or the exit code of the failure (reported).
+fn build_spectrace() -> Result<std::path::PathBuf, ExitCode> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
+    eprintln!("$ cargo build --release -p spectrace-renderer --bin spectrace");
+    match Command::new(&cargo)
+        .args(["build", "--release", "-p", "spectrace-renderer", "--bin", "spectrace"])
+        .status()
+    {
+        Ok(s) if s.success() => {}
+        Ok(s) => {
+            eprintln!("building the renderer failed ({s})");
+            return Err(ExitCode::FAILURE);
+        }
+        Err(e) => {
+            eprintln!("could not run cargo: {e}");
+            return Err(ExitCode::FAILURE);
+        }
+    }
+    Ok(target_dir().join("release").join(format!("spectrace{}", std::env::consts::EXE_SUFFIX)))
+}
+
 fn print_help() {
     println!(
         "usage: cargo xtask [COMMAND]\n\n\
@@ -216,6 +234,8 @@ fn print_help() {
                   build in release and render SCENE (default scenes/showcase.json)\n  \
          accuracy [SCENES]  error against time for every accuracy knob (docs/accuracy.md)\n  \
          fuzz [--cases N] [--seed S]  fuzz the scene and part-file loaders (release)\n  \
+         peer [--scenes A,B] [--max-seconds S] [--reference-scale F] [--no-docs]\n           \
+                  the race against Mitsuba 3 (docs/peer.md); needs python3, pip, libLLVM >= 16\n  \
          bench    run every crate's benchmarks (release)\n  \
          ci       run the checks CI runs: tests, rustfmt, clippy -D warnings\n  \
          help     this text"
@@ -234,6 +254,7 @@ fn status() -> ExitCode {
         "\nRender the showcase scene:  cargo xtask render\n\
          Render any scene:           cargo xtask render scenes/NAME.json [--integrator auto|light|path|bdpt] [--beams N | --spp N | --time SECS] [--out DIR] [--threads N] [--seed S]\n\
          Accuracy against time:      cargo xtask accuracy [SCENES]\n\
+         Race against Mitsuba 3:     cargo xtask peer (python3, pip, libLLVM >= 16; docs/peer.md)\n\
          Run every test:             cargo test --workspace\n\
          Run the benchmarks:         cargo xtask bench\n\n\
          Estimators: light tracer, path tracer, BDPT (--integrator auto|light|path|bdpt; auto by default).\n\
