@@ -5,6 +5,7 @@ mod fuzz;
 mod hostile;
 mod integrators;
 mod rendering;
+mod variance;
 
 use rand::SeedableRng;
 use rand_pcg::Pcg64;

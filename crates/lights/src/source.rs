@@ -7,7 +7,8 @@ use std::sync::Arc;
 use glam::DVec3;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
-use spectrace_spectrum::{SpectralPowerDistribution, integrate_panels};
+use spectrace_sampling::PiecewiseConstant;
+use spectrace_spectrum::{SpectralPowerDistribution, cmf, integrate_panels};
 
 use crate::{Beam, BeamCounter, LightError};
 
@@ -69,6 +70,16 @@ pub trait LightSource: Send + Sync + Debug {
     /// on it; a light whose colour varies over its surface or with direction must return `false`.
     fn uniform_spectrum(&self) -> bool {
         true
+    }
+
+    /// Draws one more wavelength (nm) for a path that carries one of this light's beams (a
+    /// companion of a light tracer's wavelength bundle) from a uniform `u` in `[0, 1)`, with its
+    /// weight `spd(lambda) / q(lambda)` for the density `q` it was drawn from (the beam's own
+    /// `scale` plays that part for the beam's wavelength). The default draws from
+    /// [`spd`](Self::spd), weight 1; built-in lights with `wavelength_sampling: "observer"`
+    /// draw from SPD x observer, as their beams do.
+    fn sample_wavelength(&self, u: f64) -> (f64, f64) {
+        (self.spd().sample_lambda(u), 1.0)
     }
 
     /// For a group of lights (a [`crate::LightSet`]): hands over its lights, leaving it empty.
@@ -232,6 +243,68 @@ pub enum WavelengthSampling {
     /// `lambda` uniform over the SPD's range, `scale = value(lambda) * (max - min)` (seed 2.2.2):
     /// every wavelength equally often, weighted by the spectrum.
     EqualWavelengths,
+    /// `lambda` drawn with density `q ∝ SPD x (xbar + ybar + zbar)` (the CIE 1931 observer's
+    /// sensitivity), `scale = SPD(lambda) / q(lambda)`: wavelengths where the eye sees nothing
+    /// are never drawn, which is unbiased for XYZ images since they add nothing to them (the
+    /// light's power, and the normalisation of its beams, are unchanged: the expected `scale` is
+    /// the fraction of the SPD inside 360-830 nm). `q` is tabulated when the light is built (a
+    /// piecewise-constant density on the 1 nm grid of the colour matching functions and the SPD's
+    /// breakpoints, each bin's value the bin's integral of the product), and the weight uses the
+    /// table's own density, so it is exact. SPDs with delta lines, and SPDs with nothing inside
+    /// 360-830 nm, keep `Importance` (their lines are drawn as lines).
+    Observer,
+}
+
+impl WavelengthSampling {
+    /// The name used in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Importance => "importance",
+            Self::EqualWavelengths => "equal_wavelengths",
+            Self::Observer => "observer",
+        }
+    }
+}
+
+/// The density `q ∝ SPD x (xbar + ybar + zbar)` of [`WavelengthSampling::Observer`], tabulated;
+/// `None` for an SPD with delta lines or nothing inside the observer's range.
+fn observer_table(spd: &dyn SpectralPowerDistribution) -> Option<PiecewiseConstant> {
+    const OBSERVER_MIN: f64 = 360.0;
+    const OBSERVER_MAX: f64 = 830.0;
+    let (lo, hi) = spd.range();
+    if !(hi > lo) || spd.is_delta() {
+        return None;
+    }
+    let mass = integrate_panels(&|l| spd.value(l), lo, hi, &spd.breakpoints());
+    if (mass - 1.0).abs() > 1e-6 {
+        return None;
+    }
+    let (a, b) = (lo.max(OBSERVER_MIN), hi.min(OBSERVER_MAX));
+    if !(b > a) {
+        return None;
+    }
+    let mut edges: Vec<f64> = (OBSERVER_MIN as u32..=OBSERVER_MAX as u32)
+        .map(f64::from)
+        .chain(spd.breakpoints())
+        .chain([a, b])
+        .filter(|x| (a..=b).contains(x))
+        .collect();
+    edges.sort_by(f64::total_cmp);
+    edges.dedup();
+    let sensitivity = |l: f64| {
+        let c = cmf(l);
+        spd.value(l) * (c.x + c.y + c.z)
+    };
+    // Simpson's rule: exact where the SPD and the observer are both linear on the bin (then a
+    // bin whose product is positive anywhere has a positive value).
+    let values: Vec<f64> = edges
+        .windows(2)
+        .map(|e| {
+            let m = 0.5 * (e[0] + e[1]);
+            (sensitivity(e[0]) + 4.0 * sensitivity(m) + sensitivity(e[1])) / 6.0
+        })
+        .collect();
+    PiecewiseConstant::new(&edges, &values).ok()
 }
 
 /// The seed's `spdLightSource`: an SPD, a power, how wavelengths are drawn, and the beam count.
@@ -241,6 +314,8 @@ pub struct SpdLight {
     spd: Arc<dyn SpectralPowerDistribution>,
     power: f64,
     sampling: WavelengthSampling,
+    /// The tabulated density of [`WavelengthSampling::Observer`] (`None`: importance sampling).
+    observer: Option<Arc<PiecewiseConstant>>,
     counter: BeamCounter,
 }
 
@@ -279,7 +354,12 @@ impl SpdLight {
                 }
             }
         }
-        Ok(Self { spd, power, sampling, counter: BeamCounter::new() })
+        let observer = if sampling == WavelengthSampling::Observer {
+            observer_table(spd.as_ref()).map(Arc::new)
+        } else {
+            None
+        };
+        Ok(Self { spd, power, sampling, observer, counter: BeamCounter::new() })
     }
 
     /// Draws a wavelength (nm) and the beam's `scale` from a uniform `u` in `[0, 1)`, according
@@ -289,6 +369,7 @@ impl SpdLight {
     pub fn wavelength(&self, u: f64) -> (f64, f64) {
         match self.sampling {
             WavelengthSampling::Importance => (self.spd.sample_lambda(u), 1.0),
+            WavelengthSampling::Observer => self.companion_wavelength(u),
             WavelengthSampling::EqualWavelengths => {
                 let (lo, hi) = self.spd.range();
                 if hi > lo {
@@ -298,6 +379,22 @@ impl SpdLight {
                     (self.spd.sample_lambda(u), 1.0)
                 }
             }
+        }
+    }
+
+    /// A companion wavelength of a bundle (see [`LightSource::sample_wavelength`]): from the
+    /// observer-weighted density for [`WavelengthSampling::Observer`] (where it applies), else
+    /// from the SPD with weight 1.
+    #[inline]
+    pub fn companion_wavelength(&self, u: f64) -> (f64, f64) {
+        match &self.observer {
+            Some(q) => {
+                let lambda = q.sample(spectrace_sampling::clamp_uniform(u));
+                let density = q.pdf(lambda);
+                let scale = if density > 0.0 { self.spd.value(lambda) / density } else { 0.0 };
+                (lambda, scale)
+            }
+            None => (self.spd.sample_lambda(u), 1.0),
         }
     }
 
@@ -363,6 +460,9 @@ macro_rules! delegate_to_spd_light {
         }
         fn reset_count(&self) {
             self.$field.reset_count();
+        }
+        fn sample_wavelength(&self, u: f64) -> (f64, f64) {
+            self.$field.companion_wavelength(u)
         }
     };
 }

@@ -14,6 +14,9 @@
 //! | `effects_off` | the effects analysis off (one wavelength per path, beams continue after diffuse hits) |
 //! | `path`, `bdpt` | the estimator: N paths are `ceil(N / pixels)` camera samples per pixel |
 //! | `auto` | the estimator `auto` picks ([`IntegratorChoice::decide`]) |
+//! | `observer_wavelengths` | every light draws its wavelengths from SPD x observer sensitivity with weights (`"wavelength_sampling": "observer"`), light tracer |
+//! | `sobol` | Owen-scrambled Sobol points instead of independent uniforms (`settings.sampler: "sobol"`), light tracer |
+//! | `path_sobol` | the path tracer with `settings.sampler: "sobol"` (compare with `path`) |
 //!
 //! Each point records the wall time of the render alone and the relative RMSE of the XYZ image
 //! against the reference, `sqrt(sum |xyz - ref|^2 / sum |ref|^2)` over all pixels. Monte Carlo
@@ -123,11 +126,17 @@ pub enum Configuration {
     Bdpt,
     /// The scene as written, rendered by the estimator `auto` picks.
     Auto,
+    /// Every light draws wavelengths from SPD x observer sensitivity (light tracer).
+    ObserverWavelengths,
+    /// The Sobol sampler (light tracer).
+    Sobol,
+    /// The Sobol sampler with the path tracer.
+    PathSobol,
 }
 
 impl Configuration {
     /// Every configuration, in report order.
-    pub const ALL: [Configuration; 7] = [
+    pub const ALL: [Configuration; 10] = [
         Configuration::Baseline,
         Configuration::EqualWavelengths,
         Configuration::PiecewiseConstantSpd,
@@ -135,6 +144,9 @@ impl Configuration {
         Configuration::Path,
         Configuration::Bdpt,
         Configuration::Auto,
+        Configuration::ObserverWavelengths,
+        Configuration::Sobol,
+        Configuration::PathSobol,
     ];
 
     /// The estimator knob: the light tracer (`baseline`), `path`, `bdpt` and `auto`.
@@ -154,7 +166,7 @@ impl Configuration {
     /// tracer).
     pub fn integrator(self) -> IntegratorChoice {
         match self {
-            Configuration::Path => IntegratorChoice::Path,
+            Configuration::Path | Configuration::PathSobol => IntegratorChoice::Path,
             Configuration::Bdpt => IntegratorChoice::Bdpt,
             Configuration::Auto => IntegratorChoice::Auto,
             _ => IntegratorChoice::Light,
@@ -179,6 +191,9 @@ impl Configuration {
             Configuration::Path => "path",
             Configuration::Bdpt => "bdpt",
             Configuration::Auto => "auto",
+            Configuration::ObserverWavelengths => "observer_wavelengths",
+            Configuration::Sobol => "sobol",
+            Configuration::PathSobol => "path_sobol",
         }
     }
 
@@ -211,6 +226,19 @@ impl Configuration {
             }
             Configuration::Auto => {
                 "the estimator `auto` picks (`IntegratorChoice::decide`), with its own seeds"
+            }
+            Configuration::ObserverWavelengths => {
+                "every light draws wavelengths in proportion to SPD x (xbar + ybar + zbar), \
+                 weighted by SPD / density (lights whose SPD has delta lines keep importance \
+                 sampling); the light tracer"
+            }
+            Configuration::Sobol => {
+                "the light tracer with Owen-scrambled Sobol points (settings.sampler \"sobol\") \
+                 instead of independent uniforms"
+            }
+            Configuration::PathSobol => {
+                "the path tracer with Owen-scrambled Sobol points (settings.sampler \"sobol\"); \
+                 N paths are ceil(N / pixels) samples per pixel"
             }
         }
     }
@@ -824,6 +852,21 @@ fn set_equal_wavelengths(json: &mut Value) -> (usize, usize) {
     (changed, skipped)
 }
 
+/// Sets `wavelength_sampling: "observer"` on every light whose SPD has no delta lines: (lights
+/// changed, lights skipped for their lines).
+fn set_observer_wavelengths(json: &mut Value) -> (usize, usize) {
+    let (mut changed, mut skipped) = (0, 0);
+    for_each_light(json, &mut |light| {
+        if light.get("spd").is_some_and(spd_has_delta) {
+            skipped += 1;
+        } else if light.get("wavelength_sampling").and_then(Value::as_str) != Some("observer") {
+            light.insert("wavelength_sampling".to_owned(), Value::from("observer"));
+            changed += 1;
+        }
+    });
+    (changed, skipped)
+}
+
 /// A piecewise-constant `Binned` SPD with bins centred on `nm` and the given values.
 fn binned_from_nodes(nm: &[f64], values: &[f64]) -> Option<Value> {
     let n = nm.len();
@@ -910,6 +953,28 @@ fn rewrite(configuration: Configuration, json: &Value) -> Result<(String, Value)
         | Configuration::Path
         | Configuration::Bdpt
         | Configuration::Auto => Ok((String::new(), out)),
+        Configuration::ObserverWavelengths => match set_observer_wavelengths(&mut out) {
+            (0, 0) => Err("every light already samples observer-weighted wavelengths".to_owned()),
+            (0, _) => Err("every light's SPD contains delta lines (kept as lines)".to_owned()),
+            (changed, 0) => Ok((format!("{changed} light(s)"), out)),
+            (changed, skipped) => Ok((
+                format!("{changed} light(s); {skipped} with delta lines left on importance"),
+                out,
+            )),
+        },
+        Configuration::Sobol | Configuration::PathSobol => {
+            let Some(root) = out.as_object_mut() else {
+                return Err("the scene is not a JSON object".to_owned());
+            };
+            let settings = root.entry("settings").or_insert_with(|| Value::Object(Map::new()));
+            match settings.as_object_mut() {
+                Some(settings) => {
+                    settings.insert("sampler".to_owned(), Value::from("sobol"));
+                    Ok(("settings.sampler = sobol".to_owned(), out))
+                }
+                None => Err("settings is not a JSON object".to_owned()),
+            }
+        }
         Configuration::EqualWavelengths => match set_equal_wavelengths(&mut out) {
             (0, 0) => Err("every light already samples equal wavelengths".to_owned()),
             (0, _) => {
@@ -1640,6 +1705,21 @@ mod tests {
         let (_, eq) = rewrite(Configuration::EqualWavelengths, &json).unwrap();
         assert_eq!(eq["lights"][0]["wavelength_sampling"], "equal_wavelengths");
         parse(&eq, path).unwrap();
+
+        let (_, ob) = rewrite(Configuration::ObserverWavelengths, &json).unwrap();
+        assert_eq!(ob["lights"][0]["wavelength_sampling"], "observer");
+        parse(&ob, path).unwrap();
+        for c in [Configuration::Sobol, Configuration::PathSobol] {
+            let (_, so) = rewrite(c, &json).unwrap();
+            assert_eq!(so["settings"]["sampler"], "sobol");
+            assert_eq!(so["settings"]["seed"], 3);
+            assert_eq!(
+                parse(&so, path).unwrap().settings.sampler,
+                spectrace_tracer::SamplerKind::Sobol
+            );
+        }
+        assert_eq!(Configuration::PathSobol.integrator(), IntegratorChoice::Path);
+        assert_eq!(Configuration::from_name("path_sobol"), Some(Configuration::PathSobol));
 
         let (changed, pc) = rewrite(Configuration::PiecewiseConstantSpd, &json).unwrap();
         assert_eq!(changed, "1 SPD(s) in 1 light(s)");

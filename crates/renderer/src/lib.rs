@@ -27,8 +27,8 @@ use serde::{Deserialize, Serialize};
 use spectrace_lights::LightSource;
 use spectrace_tracer::{
     Bdpt, Effects, EffectsMode, Film, FilmError, Integrator, IntegratorChoice, LightTracer,
-    LightTracerScene, MemoryLimit, PathTracer, RenderOutput, RenderPlan, TraceStats, image_scale,
-    render,
+    LightTracerScene, MemoryLimit, PathTracer, RenderOutput, RenderPlan, SamplerKind, TraceStats,
+    image_scale, render,
 };
 
 pub use files::{
@@ -111,6 +111,9 @@ pub struct RenderReport {
     /// Why that estimator: asked for, or the effects analysis' reason.
     #[serde(default)]
     pub integrator_reason: String,
+    /// Where the random numbers came from (`settings.sampler`): `"independent"` or `"sobol"`.
+    #[serde(default = "independent_sampler")]
+    pub sampler: String,
     /// Beams traced.
     pub beams: u64,
     /// Wall time (s).
@@ -143,6 +146,11 @@ fn light_integrator() -> String {
     LightTracer::NAME.to_owned()
 }
 
+/// The sampler of sidecars written before the field existed.
+fn independent_sampler() -> String {
+    SamplerKind::Independent.name().to_owned()
+}
+
 /// Most worker threads a render accepts.
 pub const MAX_THREADS: usize = 256;
 
@@ -153,6 +161,7 @@ pub const PROBE_BEAMS: u64 = 20_000;
 pub fn tracer_scene(scene: &Scene) -> LightTracerScene<'_> {
     LightTracerScene::new(&scene.world, &scene.materials, &scene.lights, &scene.camera)
         .with_emitters(scene.emitters.clone(), scene.object_shapes)
+        .with_sampler(scene.settings.sampler)
 }
 
 /// The estimator for a scene (with an optional override) and the reason, in words.
@@ -610,6 +619,7 @@ fn render_with(
             written,
         );
         r.integrator_reason = reason.to_owned();
+        r.sampler = scene.settings.sampler.name().to_owned();
         r
     };
     if let Some((k, n)) = plan.shard {
@@ -626,6 +636,7 @@ fn render_with(
             plan: RenderPlan { shard: None, threads: 0, ..plan },
             light_power: scene.lights.power(),
             integrator: choice,
+            sampler: scene.settings.sampler,
             effects,
             output_settings: scene.output.clone(),
             name: name.clone(),
@@ -689,6 +700,7 @@ fn report(
         effects_summary: effects.summary(),
         integrator: integrator.to_owned(),
         integrator_reason: String::new(),
+        sampler: independent_sampler(),
         beams: output.beams,
         wall_seconds: wall,
         beams_per_second: if wall > 0.0 { output.beams as f64 / wall } else { 0.0 },
@@ -846,6 +858,8 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
             Some("output settings")
         } else if part.integrator != first.integrator {
             Some("integrator")
+        } else if part.sampler != first.sampler {
+            Some("sampler")
         } else if part.light_power.to_bits() != first.light_power.to_bits() {
             Some("light power")
         } else if (part.output.film.width(), part.output.film.height()) != (w, h) {
@@ -908,6 +922,7 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
     );
     report.beams_per_second =
         if total_seconds > 0.0 { merged.beams as f64 / total_seconds } else { 0.0 };
+    report.sampler = first.sampler.name().to_owned();
     write_sidecar(out_dir, &first.name, &report)?;
     Ok(report)
 }

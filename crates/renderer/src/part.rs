@@ -11,7 +11,7 @@
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
-use spectrace_tracer::{Effects, IntegratorChoice, RenderOutput, RenderPlan};
+use spectrace_tracer::{Effects, IntegratorChoice, RenderOutput, RenderPlan, SamplerKind};
 
 use crate::OutputSettings;
 use crate::files::{MAX_PART_BYTES, check_output_name, read_bounded};
@@ -32,6 +32,8 @@ pub struct PartialFilm {
     pub light_power: f64,
     /// The estimator that rendered the part (never `auto`): it decides the normalisation.
     pub integrator: IntegratorChoice,
+    /// The sampler the part was rendered with (`settings.sampler`; parts must agree).
+    pub sampler: SamplerKind,
     /// The effects decision the parts were rendered with.
     pub effects: Effects,
     /// Output settings of the scene.
@@ -43,7 +45,7 @@ pub struct PartialFilm {
 }
 
 /// Current [`PartialFilm::version`].
-pub const PARTIAL_VERSION: u32 = 2;
+pub const PARTIAL_VERSION: u32 = 3;
 
 /// bincode's configuration for part files: the standard encoding, with every claimed length
 /// bounded by the file-size limit so a forged length cannot make the decoder reserve memory.

@@ -15,7 +15,7 @@ use spectrace_spectrum::Reflectance;
 use spectrace_tracer::{
     BdptSettings, CameraWavelengths, DEFAULT_CHUNK_BEAMS, EffectsMode, Emitter, IntegratorChoice,
     LightTracerSettings, MAX_DEPTH, ObjectEmission, ObjectLight, PathTracerSettings, PinholeCamera,
-    RenderPlan,
+    RenderPlan, SamplerKind,
 };
 
 use crate::files::{MAX_SCENE_BYTES, check_output_name, read_bounded};
@@ -90,6 +90,10 @@ pub struct Settings {
     /// How the path tracer's camera paths draw their wavelengths: `"visible"` (in proportion to
     /// the observer's sensitivity, the default) or `"uniform"` (360-830 nm).
     pub camera_wavelengths: CameraWavelengths,
+    /// Where every integrator's random numbers come from: `"independent"` (each chunk's own
+    /// stream, the default) or `"sobol"` (Owen-scrambled Sobol points, see
+    /// [`spectrace_tracer::ChunkSampler`]).
+    pub sampler: SamplerKind,
 }
 
 impl Default for Settings {
@@ -105,6 +109,7 @@ impl Default for Settings {
             integrator: IntegratorChoice::Auto,
             spp: DEFAULT_SPP,
             camera_wavelengths: CameraWavelengths::Visible,
+            sampler: SamplerKind::Independent,
         }
     }
 }

@@ -34,6 +34,10 @@
 //! uniforms instead of asserting, and narrow cones are described by `1 - cos` (computed without
 //! cancellation by [`one_minus_cos`]) rather than by `cos`.
 //!
+//! [`SobolSampler`] serves Owen-scrambled Sobol points (through the `sobol_burley` crate) as a
+//! [`rand::Rng`], one dimension per draw of a path, for renderers that want low-discrepancy
+//! sampling without changing the code that draws the uniforms.
+//!
 //! The [`stats`] module holds the chi-square and Kolmogorov-Smirnov harness that every Spectrace
 //! crate uses in its statistical tests.
 
@@ -43,6 +47,7 @@ mod error;
 mod frame;
 mod piecewise_constant;
 mod piecewise_linear;
+mod sobol;
 pub mod stats;
 mod table;
 mod uniform;
@@ -54,6 +59,7 @@ pub use error::SamplingError;
 pub use frame::Frame;
 pub use piecewise_constant::PiecewiseConstant;
 pub use piecewise_linear::{PiecewiseLinear, linear_segment_inverse};
+pub use sobol::{SOBOL_BLOCK, SOBOL_DIMENSIONS, SobolSampler};
 pub use table::ONE_MINUS_EPSILON;
 pub use uniform::{clamp_uniform, uniform};
 pub use warp::{

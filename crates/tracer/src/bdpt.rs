@@ -83,7 +83,7 @@ use spectrace_spectrum::{CIE_Y_INTEGRAL, SpectralPowerDistribution, cmf};
 
 use crate::light_tracer::{LightTracerScene, TraceStats, shading_correction};
 use crate::path_tracer::{camera_image_scale, pass_pixel, pass_start};
-use crate::{Effects, Integrator, Splat, chunk_rng};
+use crate::{ChunkSampler, Effects, Integrator, Splat};
 
 /// Settings of the bidirectional path tracer.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -936,7 +936,7 @@ impl Integrator for Bdpt<'_> {
         _deadline: Option<Instant>,
         film: &mut dyn Splat,
     ) -> TraceStats {
-        let mut rng = chunk_rng(seed, chunk);
+        let mut rng = ChunkSampler::new(self.scene.sampler(), seed, chunk);
         let mut stats = TraceStats::default();
         let width = u64::from(self.scene.camera.width().max(1));
         let pixels = self.pass_samples().max(1);
@@ -949,6 +949,8 @@ impl Integrator for Bdpt<'_> {
         let start = pass_start(chunk, pixels);
         for i in 0..samples {
             let (px, py) = pass_pixel(start, i, pixels, width);
+            // Sobol: the pixel's own sequence, one point per pass.
+            rng.start_path(u64::from(py) * width + u64::from(px), chunk);
             self.sample_pixel(px, py, &mut rng, &mut buffers, film, &mut stats);
             stats.beams += 1;
         }

@@ -30,6 +30,7 @@ mod light_tracer;
 mod object_light;
 mod path_tracer;
 mod render;
+mod sampler;
 mod wavelengths;
 
 pub use bdpt::{Bdpt, BdptSettings, MisVertex, mis_weight};
@@ -48,4 +49,5 @@ pub use path_tracer::{PathTracer, PathTracerSettings};
 pub use render::{
     DEFAULT_CHUNK_BEAMS, FALLBACK_MEMORY_LIMIT, MemoryLimit, RenderOutput, RenderPlan, render,
 };
+pub use sampler::{ChunkSampler, SamplerKind};
 pub use wavelengths::{CAMERA_LAMBDA_MAX, CAMERA_LAMBDA_MIN, CameraWavelengths, HERO};

@@ -44,7 +44,7 @@ pub(crate) fn shading_correction(hit: &spectrace_geometry::Hit, wi: DVec3, wo: D
 }
 use spectrace_spectrum::{CIE_Y_INTEGRAL, SpectralPowerDistribution, cmf};
 
-use crate::{Effects, PinholeCamera, SceneFeatures, Splat};
+use crate::{ChunkSampler, Effects, PinholeCamera, SamplerKind, SceneFeatures, Splat};
 
 /// Largest `max_depth` a scene may ask for (the renderer refuses more; the tracer clamps
 /// nothing). Russian roulette ends almost every beam long before: only a lossless closed scene
@@ -96,6 +96,8 @@ pub struct LightTracerScene<'a> {
     /// How many of the shapes are the scene's objects (the first ones); the rest are the
     /// surfaces of area lights, which the effects analysis does not count.
     object_shapes: usize,
+    /// Where the integrators' random numbers come from.
+    sampler: SamplerKind,
 }
 
 /// Light leaving a shape's surface: which light of the set it belongs to, so that camera paths
@@ -148,7 +150,19 @@ impl<'a> LightTracerScene<'a> {
             emitters: Vec::new(),
             light_shapes: Vec::new(),
             object_shapes: materials.len(),
+            sampler: SamplerKind::Independent,
         }
+    }
+
+    /// The same scene, rendered with random numbers from `sampler`.
+    pub fn with_sampler(mut self, sampler: SamplerKind) -> Self {
+        self.sampler = sampler;
+        self
+    }
+
+    /// Where the integrators' random numbers come from.
+    pub fn sampler(&self) -> SamplerKind {
+        self.sampler
     }
 
     /// The same scene where shape `i` emits `emitters[i]` (missing entries emit nothing), and
@@ -345,13 +359,13 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
     deadline: Option<Instant>,
     film: &mut S,
 ) -> TraceStats {
-    let mut rng = chunk_rng(seed, chunk);
+    let mut rng = ChunkSampler::new(scene.sampler, seed, chunk);
     let mut stats = TraceStats::default();
     let inv_y = 1.0 / *CIE_Y_INTEGRAL;
     let k = effects.wavelengths_per_path.clamp(1, MAX_BUNDLE);
     let light: &dyn LightSource = scene.lights;
     let mut next_check = DEADLINE_CHECK_WORK;
-    for _ in 0..beams {
+    for i in 0..beams {
         if let Some(deadline) = deadline {
             let work = stats.beams + stats.hits;
             if work >= next_check {
@@ -361,6 +375,7 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
                 }
             }
         }
+        rng.start_path(chunk, i);
         let beam = light.next_beam(&mut rng);
         stats.beams += 1;
         // The bundle: the beam's own wavelength and weight, plus k - 1 wavelengths drawn from the
@@ -369,12 +384,16 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
         let mut weights = [0.0; MAX_BUNDLE];
         weights[0] = beam.scale / k as f64;
         if k > 1 {
-            let spd = &scene.spds[beam.parent.0 as usize];
+            // Drawn as the light draws its companions (its SPD, or SPD x observer), with the
+            // weight of that density.
+            let own = scene.lights.light(beam.parent);
             for j in 1..k {
                 // Stratified: one uniform per stratum of [0, 1).
                 let u = ((j - 1) as f64 + uniform(&mut rng)) / (k - 1) as f64;
-                lambdas[j] = spd.sample_lambda(u.min(spectrace_sampling::ONE_MINUS_EPSILON));
-                weights[j] = 1.0 / k as f64;
+                let u = u.min(spectrace_sampling::ONE_MINUS_EPSILON);
+                let (lambda, scale) = own.map_or((beam.lambda, 0.0), |l| l.sample_wavelength(u));
+                lambdas[j] = lambda;
+                weights[j] = scale / k as f64;
             }
         }
         // Lights seen directly: connect the emission point to the camera.
@@ -464,7 +483,7 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
 
 /// Uniforms for a point on the camera's lens: none are drawn for a pinhole (so pinhole images do
 /// not depend on whether the camera could have a lens).
-fn lens_uniforms(scene: &LightTracerScene<'_>, rng: &mut Pcg64) -> [f64; 2] {
+fn lens_uniforms(scene: &LightTracerScene<'_>, rng: &mut ChunkSampler) -> [f64; 2] {
     if scene.camera.is_pinhole() { [0.5; 2] } else { [uniform(rng), uniform(rng)] }
 }
 

@@ -45,7 +45,7 @@ use spectrace_sampling::Discrete;
 use spectrace_spectrum::{CIE_Y_INTEGRAL, Xyz, cmf};
 
 use crate::light_tracer::{LightTracerScene, TraceStats};
-use crate::{CameraWavelengths, Effects, HERO, Integrator, Splat, chunk_rng};
+use crate::{CameraWavelengths, ChunkSampler, Effects, HERO, Integrator, Splat};
 
 /// Settings of the path tracer.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -463,7 +463,7 @@ impl Integrator for PathTracer<'_> {
         _deadline: Option<Instant>,
         film: &mut dyn Splat,
     ) -> TraceStats {
-        let mut rng = chunk_rng(seed, chunk);
+        let mut rng = ChunkSampler::new(self.scene.sampler(), seed, chunk);
         let mut stats = TraceStats::default();
         let width = u64::from(self.scene.camera.width().max(1));
         let pixels = self.pass_samples().max(1);
@@ -473,6 +473,8 @@ impl Integrator for PathTracer<'_> {
         }
         for i in 0..samples {
             let (px, py) = pass_pixel(start, i, pixels, width);
+            // Sobol: the pixel's own sequence, one point per pass.
+            rng.start_path(u64::from(py) * width + u64::from(px), chunk);
             let xyz = self.sample_pixel(px, py, &mut rng, &mut stats);
             stats.beams += 1;
             // A rejected (non-finite) sample is counted by the film, never added.

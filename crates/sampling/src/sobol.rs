@@ -1,0 +1,226 @@
+//! [`SobolSampler`]: Owen-scrambled Sobol points served as a random generator, so that code that
+//! draws its uniforms one `next_u64` at a time (lights, materials, cameras) gets low-discrepancy
+//! points without knowing it.
+
+use std::convert::Infallible;
+
+use rand::{Rng, TryRng};
+
+/// Dimensions of a path served from the Sobol table (the Joe-Kuo direction numbers of the
+/// `sobol_burley` crate); later draws of a path come from the fallback generator.
+pub const SOBOL_DIMENSIONS: u32 = sobol_burley::NUM_DIMENSIONS;
+
+/// Points of one scrambled sequence: `sobol_burley` serves indices below `2^16`; a path index
+/// beyond starts another, independently scrambled, block of `2^16` points.
+pub const SOBOL_BLOCK: u64 = 1 << 16;
+
+/// Bits of a draw that come from the Sobol point (the precision of `sobol_burley`'s output); the
+/// 41 low bits come from the fallback generator.
+const SOBOL_BITS: u32 = 23;
+
+/// An Owen-scrambled Sobol sampler (Burley 2020, hash-based nested uniform scrambling) exposed as
+/// a [`rand::Rng`].
+///
+/// Each path calls [`start_path`](Self::start_path)`(stream, index)`; after it, the `k`-th
+/// `next_u64` (or `next_u32`) returns dimension `k` of point `index` of the sequence scrambled
+/// for `(seed, stream)`: its top 23 bits are the scrambled Sobol coordinate and the low 41 bits
+/// come from the fallback generator, so each draw is exactly uniform over the 64-bit integers
+/// and [`crate::uniform`] keeps its 53 bits. Draws beyond [`SOBOL_DIMENSIONS`] in one path, and
+/// draws before the first `start_path`, come from the fallback generator alone. Index `i` uses
+/// point `i mod 2^16` of a sequence whose scramble also depends on `i / 2^16` (see
+/// [`SOBOL_BLOCK`]). `fill_bytes` always uses the fallback.
+///
+/// Every coordinate is uniform on `[0, 1)` for any scramble, so estimators stay unbiased; the
+/// gain is stratification: the first `2^m` points of every dimension of one block have one point
+/// in each interval of length `2^-m`, and those of dimensions 0 and 1 (a (0, 2)-sequence) one
+/// point in each elementary interval of area `2^-m`. Stratification holds per dimension, so code that draws a variable number
+/// of uniforms (rejection loops) shifts the later dimensions of its path: still unbiased, but
+/// the shifted draws lose their stratification.
+#[derive(Debug, Clone)]
+pub struct SobolSampler<R> {
+    fallback: R,
+    seed: u64,
+    /// Scramble of the current path's sequence (from seed, stream and block).
+    scramble: u32,
+    /// Point index within the block.
+    index: u32,
+    /// Next dimension to serve; [`SOBOL_DIMENSIONS`] or more: fallback only.
+    dimension: u32,
+}
+
+impl<R: Rng> SobolSampler<R> {
+    /// A sampler whose scrambles derive from `seed`, with `fallback` for the low bits and the
+    /// dimensions beyond the table. Until [`start_path`](Self::start_path) it is the fallback.
+    pub fn new(seed: u64, fallback: R) -> Self {
+        Self { fallback, seed, scramble: 0, index: 0, dimension: SOBOL_DIMENSIONS }
+    }
+
+    /// Starts a path: point `index` of the sequence scrambled for `stream` (and the sampler's
+    /// seed); the next draw is its dimension 0.
+    pub fn start_path(&mut self, stream: u64, index: u64) {
+        let block = index / SOBOL_BLOCK;
+        let key = mix(mix(mix(self.seed) ^ stream) ^ block.wrapping_mul(0xD6E8_FEB8_6659_FD93));
+        self.scramble = (key ^ (key >> 32)) as u32;
+        self.index = (index % SOBOL_BLOCK) as u32;
+        self.dimension = 0;
+    }
+
+    /// The dimension the next draw will serve (`>= SOBOL_DIMENSIONS`: the fallback alone).
+    pub fn dimension(&self) -> u32 {
+        self.dimension
+    }
+
+    /// The fallback generator.
+    pub fn fallback_mut(&mut self) -> &mut R {
+        &mut self.fallback
+    }
+}
+
+/// SplitMix64's finaliser: a bijective mix of 64 bits.
+fn mix(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+impl<R: Rng> TryRng for SobolSampler<R> {
+    type Error = Infallible;
+
+    fn try_next_u32(&mut self) -> Result<u32, Infallible> {
+        self.try_next_u64().map(|x| (x >> 32) as u32)
+    }
+
+    fn try_next_u64(&mut self) -> Result<u64, Infallible> {
+        let low = self.fallback.next_u64();
+        if self.dimension >= SOBOL_DIMENSIONS {
+            return Ok(low);
+        }
+        let x = sobol_burley::sample(self.index, self.dimension, self.scramble);
+        self.dimension += 1;
+        // `x` is a multiple of 2^-23 in [0, 1): exactly an integer below 2^23 after scaling.
+        let high = (f64::from(x) * f64::from(1u32 << SOBOL_BITS)) as u64;
+        Ok((high << (64 - SOBOL_BITS)) | (low >> SOBOL_BITS))
+    }
+
+    fn try_fill_bytes(&mut self, dst: &mut [u8]) -> Result<(), Infallible> {
+        self.fallback.fill_bytes(dst);
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+
+    use rand::SeedableRng;
+    use rand_pcg::Pcg64;
+
+    use super::*;
+    use crate::uniform;
+
+    fn sampler(seed: u64) -> SobolSampler<Pcg64> {
+        SobolSampler::new(seed, Pcg64::seed_from_u64(seed))
+    }
+
+    /// The first `dims` uniforms of points `0..n` of stream `stream`.
+    fn points(s: &mut SobolSampler<Pcg64>, stream: u64, n: u64, dims: usize) -> Vec<Vec<f64>> {
+        (0..n)
+            .map(|i| {
+                s.start_path(stream, i);
+                (0..dims).map(|_| uniform(s)).collect()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn every_one_dimensional_projection_is_stratified() {
+        let mut s = sampler(5);
+        for m in [4u32, 8, 12] {
+            let n = 1u64 << m;
+            let p = points(&mut s, 3, n, 40);
+            for d in 0..40 {
+                let mut cells = vec![0u32; n as usize];
+                for x in &p {
+                    cells[(x[d] * n as f64) as usize] += 1;
+                }
+                assert!(cells.iter().all(|&c| c == 1), "m = {m}, dimension {d}");
+            }
+        }
+    }
+
+    #[test]
+    fn pairs_of_dimensions_have_one_point_per_elementary_interval() {
+        let mut s = sampler(9);
+        let m = 10u32;
+        let n = 1u64 << m;
+        for stream in [0u64, 77] {
+            let p = points(&mut s, stream, n, 2);
+            // Every elementary interval [a 2^-i, (a+1) 2^-i) x [b 2^-(m-i), (b+1) 2^-(m-i)).
+            for i in 0..=m {
+                let (nx, ny) = (1u64 << i, 1u64 << (m - i));
+                let mut cells = vec![0u32; n as usize];
+                for x in &p {
+                    let cx = (x[0] * nx as f64) as u64;
+                    let cy = (x[1] * ny as f64) as u64;
+                    cells[(cx * ny + cy) as usize] += 1;
+                }
+                assert!(cells.iter().all(|&c| c == 1), "stream {stream}, split {i}");
+            }
+        }
+    }
+
+    #[test]
+    fn streams_and_blocks_are_scrambled_differently_and_reproducibly() {
+        let mut a = sampler(1);
+        let mut b = sampler(1);
+        a.start_path(0, 5);
+        b.start_path(0, 5);
+        assert_eq!(a.next_u64() >> 41, b.next_u64() >> 41);
+        let first = |s: &mut SobolSampler<Pcg64>, stream, index| {
+            s.start_path(stream, index);
+            s.next_u64() >> 41
+        };
+        let base: Vec<u64> = (0..16).map(|i| first(&mut a, 0, i)).collect();
+        let other_stream: Vec<u64> = (0..16).map(|i| first(&mut a, 1, i)).collect();
+        let other_block: Vec<u64> = (0..16).map(|i| first(&mut a, 0, SOBOL_BLOCK + i)).collect();
+        let other_seed: Vec<u64> = (0..16).map(|i| first(&mut sampler(2), 0, i)).collect();
+        assert_ne!(base, other_stream);
+        assert_ne!(base, other_block);
+        assert_ne!(base, other_seed);
+    }
+
+    #[test]
+    fn dimensions_beyond_the_table_and_draws_before_a_path_use_the_fallback() {
+        let mut s = sampler(4);
+        let mut f = Pcg64::seed_from_u64(4);
+        // Before any path: the fallback alone.
+        assert_eq!(s.next_u64(), f.next_u64());
+        s.start_path(0, 3);
+        for _ in 0..SOBOL_DIMENSIONS {
+            let _ = s.next_u64();
+            let _ = f.next_u64();
+        }
+        assert_eq!(s.dimension(), SOBOL_DIMENSIONS);
+        assert_eq!(s.next_u64(), f.next_u64());
+    }
+
+    #[test]
+    fn draws_are_uniform_with_random_low_bits() {
+        // Mean and variance of 4096 points x 8 dimensions match U(0, 1) closely (stratified:
+        // much closer than 1/sqrt(n)); the low bits vary between two seeds of the fallback.
+        let mut s = sampler(12);
+        let p = points(&mut s, 0, 4096, 8);
+        let n = (p.len() * 8) as f64;
+        let mean: f64 = p.iter().flatten().sum::<f64>() / n;
+        let var: f64 = p.iter().flatten().map(|x| (x - mean).powi(2)).sum::<f64>() / n;
+        assert!((mean - 0.5).abs() < 1e-3, "{mean}");
+        assert!((var - 1.0 / 12.0).abs() < 1e-3, "{var}");
+        let mut t = SobolSampler::new(12, Pcg64::seed_from_u64(13));
+        s.start_path(0, 0);
+        t.start_path(0, 0);
+        let (a, b) = (s.next_u64(), t.next_u64());
+        assert_eq!(a >> 41, b >> 41);
+        assert_ne!(a & ((1 << 41) - 1), b & ((1 << 41) - 1));
+    }
+}

@@ -1,0 +1,133 @@
+//! Where the integrators' random numbers come from: an independent stream per chunk (the
+//! default) or Owen-scrambled Sobol points ([`spectrace_sampling::SobolSampler`]).
+//!
+//! Lights, materials and cameras draw their uniforms one `next_u64` at a time from a
+//! `&mut dyn Rng`; [`ChunkSampler`] is that generator. With [`SamplerKind::Sobol`], every path
+//! (a beam, or a camera sample with its light path) first calls
+//! [`ChunkSampler::start_path`]`(stream, index)`, and its `k`-th draw is dimension `k` of point
+//! `index` of a sequence scrambled for `(seed, stream)`:
+//! - the light tracer: stream = the chunk, index = the beam's index in its chunk (each chunk is
+//!   an independently scrambled sequence, stratified over its beams);
+//! - the path tracer and BDPT: stream = the pixel, index = the pass (the chunk), so the samples
+//!   of one pixel over the passes are the points of one sequence, stratified pixel by pixel.
+//!
+//! Both depend only on the seed and the chunk, so images stay bit-identical for any thread count
+//! or shard split. Draws past the sampler's table (256 dimensions), the low bits of every draw
+//! and draws outside a path come from the chunk's independent stream ([`crate::chunk_rng`]).
+//! Lights that draw a variable number of uniforms (rejection loops) shift the dimensions of the
+//! rest of their path: unbiased, but those draws lose their stratification.
+
+use std::convert::Infallible;
+
+use rand::{Rng, TryRng};
+use rand_pcg::Pcg64;
+use serde::{Deserialize, Serialize};
+use spectrace_sampling::SobolSampler;
+
+use crate::chunk_rng;
+
+/// Which random numbers the integrators draw (`settings.sampler` in scene files).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SamplerKind {
+    /// Independent uniforms from each chunk's own stream. The default.
+    #[default]
+    Independent,
+    /// Owen-scrambled Sobol points, one dimension per draw of a path (see the module docs).
+    Sobol,
+}
+
+impl SamplerKind {
+    /// The name used in scene files and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Independent => "independent",
+            Self::Sobol => "sobol",
+        }
+    }
+}
+
+/// The generator of one chunk: the chunk's independent stream, or Sobol points over it.
+#[derive(Debug, Clone)]
+pub enum ChunkSampler {
+    /// [`crate::chunk_rng`] alone.
+    Independent(Pcg64),
+    /// Sobol points; [`crate::chunk_rng`] for the low bits and beyond the table.
+    Sobol(SobolSampler<Pcg64>),
+}
+
+impl ChunkSampler {
+    /// The generator of chunk `chunk` of a render with seed `seed`.
+    pub fn new(kind: SamplerKind, seed: u64, chunk: u64) -> Self {
+        let rng = chunk_rng(seed, chunk);
+        match kind {
+            SamplerKind::Independent => Self::Independent(rng),
+            SamplerKind::Sobol => Self::Sobol(SobolSampler::new(seed, rng)),
+        }
+    }
+
+    /// Starts a path: point `index` of the sequence of `stream` (nothing for independent
+    /// sampling).
+    #[inline]
+    pub fn start_path(&mut self, stream: u64, index: u64) {
+        if let Self::Sobol(s) = self {
+            s.start_path(stream, index);
+        }
+    }
+}
+
+impl TryRng for ChunkSampler {
+    type Error = Infallible;
+
+    #[inline]
+    fn try_next_u32(&mut self) -> Result<u32, Infallible> {
+        Ok(match self {
+            Self::Independent(r) => r.next_u32(),
+            Self::Sobol(s) => s.next_u32(),
+        })
+    }
+
+    #[inline]
+    fn try_next_u64(&mut self) -> Result<u64, Infallible> {
+        Ok(match self {
+            Self::Independent(r) => r.next_u64(),
+            Self::Sobol(s) => s.next_u64(),
+        })
+    }
+
+    fn try_fill_bytes(&mut self, dst: &mut [u8]) -> Result<(), Infallible> {
+        match self {
+            Self::Independent(r) => r.fill_bytes(dst),
+            Self::Sobol(s) => s.fill_bytes(dst),
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn independent_sampling_is_the_chunk_stream_and_ignores_paths() {
+        let mut a = ChunkSampler::new(SamplerKind::Independent, 3, 8);
+        let mut b = chunk_rng(3, 8);
+        a.start_path(1, 2);
+        for _ in 0..10 {
+            assert_eq!(a.next_u64(), b.next_u64());
+        }
+    }
+
+    #[test]
+    fn sobol_sampling_depends_on_the_path_not_on_what_came_before() {
+        let mut a = ChunkSampler::new(SamplerKind::Sobol, 3, 8);
+        let mut b = ChunkSampler::new(SamplerKind::Sobol, 3, 8);
+        for _ in 0..5 {
+            let _ = b.next_u64();
+        }
+        a.start_path(4, 9);
+        b.start_path(4, 9);
+        // The top 23 bits are the Sobol coordinate: the same whatever the stream's position.
+        assert_eq!(a.next_u64() >> 41, b.next_u64() >> 41);
+    }
+}
