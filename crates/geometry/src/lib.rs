@@ -26,6 +26,7 @@
 //! Layering: this crate depends on none of Spectrace's crates.
 
 mod bounds;
+mod bvh;
 mod cylinder;
 mod disk;
 mod error;
