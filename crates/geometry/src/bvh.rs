@@ -25,12 +25,17 @@
 //! plane, `inf - inf`) are replaced by the widest value (`0` for an entry, `+inf` for an exit), so
 //! they can only widen.
 //!
+//! The boxes are stored relative to the world's centre `C` (so f32 keeps its precision for a
+//! scene far from the origin, and tiny primitives there keep distinct boxes); the ray origin is
+//! shifted by the same `C` in f64 and the result bracketed one f64 ulp either way before the
+//! directed f32 rounding, so `o_lo <= O - C <= o_hi` holds exactly.
+//!
 //! Two cases would break the relative-error argument, and are traversed in f64 instead (pbrt's
 //! test on the exact f64 copies of the same boxes): a world with a box coordinate beyond
 //! [`F32_SAFE`] (the f32 subtraction could overflow) and a ray whose origin lies beyond it or is
 //! not finite.
 
-use glam::{BVec3A, DVec3, Vec3A};
+use glam::{BVec3A, DVec3, Vec3A, Vec4};
 use obvhs::bvh2::Bvh2;
 
 use crate::Bounds;
@@ -48,28 +53,57 @@ const GAMMA3_F32: f32 = 3.0 * (f32::EPSILON * 0.5) / (1.0 - 3.0 * (f32::EPSILON 
 /// The factor applied to exits and `t_max` in the f32 test.
 const WIDEN: f32 = 1.0 + 4.0 * GAMMA3_F32;
 
-/// One inner node: the boxes of its two children and references to them.
+/// One inner node, one cache line: the boxes of its two children, with the references to them
+/// in the otherwise unused fourth lanes (as f32 bit patterns).
+///
+/// `b[0]` = child 0's lower corner (w: child 0's reference), `b[1]` = its upper corner (w: child
+/// 1's reference), `b[2]`, `b[3]` = child 1's corners (w of `b[2]`: the two leaf counts, child 0
+/// in the low 16 bits). A reference is an inner node index, or `LEAF | first slot`.
 #[derive(Debug, Clone, Copy)]
-#[repr(C)]
+#[repr(C, align(64))]
 pub(crate) struct Node {
-    /// Lower corners of the two children.
-    min: [Vec3A; 2],
-    /// Upper corners of the two children.
-    max: [Vec3A; 2],
-    /// Inner node index, or `LEAF | first slot`.
-    child: [u32; 2],
-    /// Primitive count of a leaf child (0 for an inner child).
-    count: [u32; 2],
+    b: [Vec4; 4],
 }
 
 impl Node {
-    /// A node whose children are both empty leaves (placeholder).
-    const EMPTY: Self = Self {
-        min: [Vec3A::INFINITY; 2],
-        max: [Vec3A::NEG_INFINITY; 2],
-        child: [LEAF; 2],
-        count: [0; 2],
-    };
+    /// A node whose children are both empty leaves with empty boxes (placeholder).
+    fn empty() -> Self {
+        Self::new([Vec3A::INFINITY; 2], [Vec3A::NEG_INFINITY; 2], [LEAF; 2], [0; 2])
+    }
+
+    /// Packs two children.
+    fn new(min: [Vec3A; 2], max: [Vec3A; 2], child: [u32; 2], count: [u16; 2]) -> Self {
+        let lane = |v: Vec3A, w: u32| Vec4::new(v.x, v.y, v.z, f32::from_bits(w));
+        let counts = count[0] as u32 | (count[1] as u32) << 16;
+        Self {
+            b: [
+                lane(min[0], child[0]),
+                lane(max[0], child[1]),
+                lane(min[1], counts),
+                lane(max[1], 0),
+            ],
+        }
+    }
+
+    /// Child `c`'s lower corner.
+    #[inline(always)]
+    fn min(&self, c: usize) -> Vec3A {
+        Vec3A::from_vec4(self.b[2 * c])
+    }
+
+    /// Child `c`'s upper corner.
+    #[inline(always)]
+    fn max(&self, c: usize) -> Vec3A {
+        Vec3A::from_vec4(self.b[2 * c + 1])
+    }
+
+    /// Child `c`'s reference and leaf primitive count.
+    #[inline(always)]
+    fn child(&self, c: usize) -> (u32, u32) {
+        let child = self.b[c].w.to_bits();
+        let count = (self.b[2].w.to_bits() >> (16 * c)) & 0xffff;
+        (child, count)
+    }
 }
 
 /// The converted BVH. Node 0 is a pseudo-root whose first child is the real root (so a root that
@@ -77,50 +111,49 @@ impl Node {
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Bvh {
     nodes: Vec<Node>,
+    /// The point the f32 boxes are relative to (world coordinates = box + `center`).
+    center: DVec3,
     /// Some box coordinate is beyond [`F32_SAFE`]: always traverse in f64.
     wide: bool,
 }
 
 impl Bvh {
-    /// Converts `bvh` (its primitive slots are `bvh.primitive_indices`' positions).
-    pub(crate) fn from_bvh2(bvh: &Bvh2) -> Self {
+    /// Converts `bvh`, whose boxes are relative to `center` (its primitive slots are
+    /// `bvh.primitive_indices`' positions).
+    pub(crate) fn from_bvh2(bvh: &Bvh2, center: DVec3) -> Self {
         if bvh.nodes.is_empty() {
             return Self::default();
         }
-        let mut nodes = vec![Node::EMPTY];
+        let mut nodes = vec![Node::empty()];
         let mut work: Vec<(usize, usize)> = Vec::new();
         let mut wide = false;
-        // Fills child `c` of node `k` from obvhs node `i`, queueing it if it is an inner node.
-        let mut set_child = |nodes: &mut Vec<Node>,
-                             work: &mut Vec<(usize, usize)>,
-                             k: usize,
-                             c: usize,
-                             i: usize| {
+        // The reference, count and box of obvhs node `i`, queueing it if it is an inner node.
+        let mut child = |nodes: &mut Vec<Node>, work: &mut Vec<(usize, usize)>, i: usize| {
             let n = &bvh.nodes[i];
             let a = n.aabb();
             let too_big = |v: Vec3A| !(v.abs().max_element() <= F32_SAFE);
             wide |= too_big(a.min) || too_big(a.max);
-            let (child, count) = if n.is_leaf() {
-                (LEAF | n.first_index, n.prim_count)
+            if n.is_leaf() {
+                // obvhs leaves hold at most `max_prims_per_leaf` (<= 255) primitives.
+                let count = u16::try_from(n.prim_count).unwrap_or(u16::MAX);
+                (LEAF | n.first_index, count, a.min, a.max)
             } else {
                 let index = nodes.len();
-                nodes.push(Node::EMPTY);
+                nodes.push(Node::empty());
                 work.push((i, index));
-                (index as u32, 0)
-            };
-            let node: &mut Node = &mut nodes[k];
-            node.min[c] = a.min;
-            node.max[c] = a.max;
-            node.child[c] = child;
-            node.count[c] = count;
+                (index as u32, 0, a.min, a.max)
+            }
         };
-        set_child(&mut nodes, &mut work, 0, 0, 0);
+        let (c0, n0, lo0, hi0) = child(&mut nodes, &mut work, 0);
+        nodes[0] =
+            Node::new([lo0, Vec3A::INFINITY], [hi0, Vec3A::NEG_INFINITY], [c0, LEAF], [n0, 0]);
         while let Some((i, k)) = work.pop() {
             let first = bvh.nodes[i].first_index as usize;
-            set_child(&mut nodes, &mut work, k, 0, first);
-            set_child(&mut nodes, &mut work, k, 1, first + 1);
+            let (c0, n0, lo0, hi0) = child(&mut nodes, &mut work, first);
+            let (c1, n1, lo1, hi1) = child(&mut nodes, &mut work, first + 1);
+            nodes[k] = Node::new([lo0, lo1], [hi0, hi1], [c0, c1], [n0, n1]);
         }
-        Self { nodes, wide }
+        Self { nodes, center, wide }
     }
 
     /// Number of nodes (each with two children).
@@ -143,11 +176,11 @@ impl Bvh {
             return;
         }
         if !self.wide
-            && let Some(mut slab) = SlabF32::new(origin, direction, t_max)
+            && let Some(mut slab) = SlabF32::new(origin - self.center, direction, t_max)
         {
             return self.walk(&mut slab, t_max, on_prim);
         }
-        let mut slab = SlabF64::new(origin, direction, t_max);
+        let mut slab = SlabF64::new(origin, self.center, direction, t_max);
         self.walk(&mut slab, t_max, on_prim);
     }
 
@@ -167,11 +200,12 @@ impl Bvh {
             let mut next = match (h0, h1) {
                 (Some(a), Some(b)) => {
                     let (near, far, far_t) = if b < a { (1, 0, a) } else { (0, 1, b) };
-                    stack.push((n.child[far], n.count[far], far_t));
-                    Some((n.child[near], n.count[near]))
+                    let (child, count) = n.child(far);
+                    stack.push((child, count, far_t));
+                    Some(n.child(near))
                 }
-                (Some(_), None) => Some((n.child[0], n.count[0])),
-                (None, Some(_)) => Some((n.child[1], n.count[1])),
+                (Some(_), None) => Some(n.child(0)),
+                (None, Some(_)) => Some(n.child(1)),
                 (None, None) => None,
             };
             loop {
@@ -248,18 +282,20 @@ struct SlabF32 {
 }
 
 impl SlabF32 {
-    /// The per-ray setup, or `None` when the origin is beyond [`F32_SAFE`] or not finite.
+    /// The per-ray setup from the origin relative to the boxes' centre, rounded once in f64 (so
+    /// the exact value lies within one f64 ulp of it); `None` when it is beyond [`F32_SAFE`] or
+    /// not finite.
     #[inline]
     fn new(origin: DVec3, direction: DVec3, t_max: f64) -> Option<Self> {
         if !(origin.abs().max_element() <= f64::from(F32_SAFE)) {
             return None;
         }
         let o = origin.to_array();
+        let o_lo = Vec3A::from(o.map(|x| f32_down(x.next_down())));
+        let o_hi = Vec3A::from(o.map(|x| f32_up(x.next_up())));
         let d = direction.to_array();
         let negative =
             BVec3A::new(d[0].is_sign_negative(), d[1].is_sign_negative(), d[2].is_sign_negative());
-        let o_lo = Vec3A::from(o.map(f32_down));
-        let o_hi = Vec3A::from(o.map(f32_up));
         let sign = |k: usize, m: f32| if d[k].is_sign_negative() { -m } else { m };
         let inv = d.map(|x| 1.0 / x.abs());
         let inv_near = Vec3A::new(
@@ -303,7 +339,7 @@ impl Slab for SlabF32 {
 
     #[inline(always)]
     fn test(&self, node: &Node) -> [Option<f32>; 2] {
-        [self.child(node.min[0], node.max[0]), self.child(node.min[1], node.max[1])]
+        [self.child(node.min(0), node.max(0)), self.child(node.min(1), node.max(1))]
     }
 
     #[inline]
@@ -321,19 +357,25 @@ impl Slab for SlabF32 {
 /// huge coordinates).
 struct SlabF64 {
     origin: DVec3,
+    center: DVec3,
     inv: DVec3,
     t_max: f64,
 }
 
 impl SlabF64 {
     /// The per-ray setup.
-    fn new(origin: DVec3, direction: DVec3, t_max: f64) -> Self {
-        Self { origin, inv: direction.recip(), t_max }
+    fn new(origin: DVec3, center: DVec3, direction: DVec3, t_max: f64) -> Self {
+        Self { origin, center, inv: direction.recip(), t_max }
     }
 
-    /// The entry distance of one child box, if the ray may meet it within `t_max`.
+    /// The entry distance of one child box (moved back to world coordinates, rounded outwards),
+    /// if the ray may meet it within `t_max`.
     fn child(&self, min: Vec3A, max: Vec3A) -> Option<f64> {
-        let b = Bounds { min: min.as_dvec3(), max: max.as_dvec3() };
+        let (lo, hi) = (min.as_dvec3() + self.center, max.as_dvec3() + self.center);
+        let b = Bounds {
+            min: DVec3::new(lo.x.next_down(), lo.y.next_down(), lo.z.next_down()),
+            max: DVec3::new(hi.x.next_up(), hi.y.next_up(), hi.z.next_up()),
+        };
         b.ray_interval(self.origin, self.inv, self.t_max).map(|(t0, _)| t0)
     }
 }
@@ -342,7 +384,7 @@ impl Slab for SlabF64 {
     type T = f64;
 
     fn test(&self, node: &Node) -> [Option<f64>; 2] {
-        [self.child(node.min[0], node.max[0]), self.child(node.min[1], node.max[1])]
+        [self.child(node.min(0), node.max(0)), self.child(node.min(1), node.max(1))]
     }
 
     fn set_limit(&mut self, t_max: f64) {
@@ -411,14 +453,13 @@ mod tests {
         let origin = DVec3::new(1e6 + 0.01, 5.0, 0.0);
         let x = (1e6_f32 + 0.0625) as f64; // the next f32 above 1e6
         assert!(x > origin.x);
-        let node = Node {
-            min: [Vec3A::new(1e6, 0.0, -1.0), Vec3A::INFINITY],
-            max: [Vec3A::new(x as f32, 1.0, 1.0), Vec3A::NEG_INFINITY],
-            child: [LEAF; 2],
-            count: [1, 0],
-        };
-        let slab = SlabF32::new(origin, DVec3::new(0.0, -1.0, 0.0), f64::INFINITY)
-            .unwrap_or_else(|| panic!("origin within the f32 range"));
+        let node = Node::new(
+            [Vec3A::new(1e6, 0.0, -1.0), Vec3A::INFINITY],
+            [Vec3A::new(x as f32, 1.0, 1.0), Vec3A::NEG_INFINITY],
+            [LEAF; 2],
+            [1, 0],
+        );
+        let slab = SlabF32::new(origin, DVec3::new(0.0, -1.0, 0.0), f64::INFINITY).unwrap();
         let [a, b] = slab.test(&node);
         assert!(a.is_some_and(|t| t <= 4.0), "{a:?}");
         assert!(b.is_none());

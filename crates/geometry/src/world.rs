@@ -24,9 +24,12 @@ enum SlotKind {
     Analytic,
 }
 
-/// One BVH primitive slot (in BVH leaf order): a whole analytic shape or one mesh triangle.
+/// One BVH primitive slot (in BVH leaf order): a whole analytic shape or one mesh triangle, with
+/// the triangle's world-space vertices copied in (zeros otherwise), so a leaf's primitives are
+/// contiguous and a candidate costs no further lookup.
 #[derive(Debug, Clone, Copy)]
 struct Slot {
+    vertices: [[f64; 3]; 3],
     shape: u32,
     index: u32,
     kind: SlotKind,
@@ -41,12 +44,13 @@ fn build_params() -> BvhBuildParams {
 /// The most primitives per BVH leaf (chosen by benchmark, see the crate README).
 const MAX_PRIMS_PER_LEAF: u32 = 4;
 
-/// Rounds an f64 box outwards to f32, with a small relative margin, so that it contains the f64
-/// box and every point an f64 intersection routine could report for it.
-fn conservative_aabb(b: Bounds) -> Aabb {
+/// Rounds an f64 box, relative to `center`, outwards to f32, with a small margin relative to its
+/// world coordinates, so that it contains the f64 box and every point an f64 intersection routine
+/// could report for it (the margin also covers the rounding of the shift by `center`).
+fn conservative_aabb(b: Bounds, center: DVec3) -> Aabb {
     let scale = b.min.abs().max(b.max.abs()).max_element() + b.diagonal().max_element();
     let margin = DVec3::splat(1e-9 * scale);
-    let (lo, hi) = (b.min - margin, b.max + margin);
+    let (lo, hi) = (b.min - margin - center, b.max + margin - center);
     let down = |x: f64| (x as f32).next_down();
     let up = |x: f64| (x as f32).next_up();
     Aabb::new(
@@ -64,9 +68,6 @@ pub struct World {
     shapes: Vec<Shape>,
     /// Primitive slots in BVH leaf order.
     slots: Vec<Slot>,
-    /// Per slot, the world-space vertices of a triangle (zeros for other slots), contiguous so a
-    /// leaf's triangles share cache lines.
-    triangles: Vec<[[f64; 3]; 3]>,
     bvh2: Bvh2,
     bvh: Bvh,
     bounds: Bounds,
@@ -114,15 +115,20 @@ impl World {
         let exact: Vec<Bounds> =
             prims.iter().map(|&(s, i)| shapes[s as usize].primitives().bounds(i)).collect();
         let bounds = exact.iter().fold(Bounds::EMPTY, |a, &b| a.union(b));
-        let aabbs: Vec<Aabb> = exact.into_iter().map(conservative_aabb).collect();
+        // Boxes relative to the scene's centre keep f32 precision for scenes far from the origin.
+        let center = if bounds.is_empty() || !bounds.center().is_finite() {
+            DVec3::ZERO
+        } else {
+            bounds.center()
+        };
+        let aabbs: Vec<Aabb> = exact.into_iter().map(|b| conservative_aabb(b, center)).collect();
         let bvh2 = if aabbs.is_empty() {
             Bvh2::default()
         } else {
             build_bvh2(&aabbs, build_params(), &mut Duration::default())
         };
-        let bvh = Bvh::from_bvh2(&bvh2);
+        let bvh = Bvh::from_bvh2(&bvh2, center);
         let mut slots = Vec::with_capacity(prims.len());
-        let mut triangles = Vec::with_capacity(prims.len());
         for &p in &bvh2.primitive_indices {
             let (shape, index) = prims[p as usize];
             let (kind, vertices) = match shapes[shape as usize].triangle_mesh() {
@@ -132,10 +138,9 @@ impl World {
                 },
                 None => (SlotKind::Analytic, [[0.0; 3]; 3]),
             };
-            slots.push(Slot { shape, index, kind });
-            triangles.push(vertices);
+            slots.push(Slot { vertices, shape, index, kind });
         }
-        Ok(Self { shapes, slots, triangles, bvh2, bvh, bounds })
+        Ok(Self { shapes, slots, bvh2, bvh, bounds })
     }
 
     /// Loads every OBJ mesh relative to `base_dir` (the scene file's directory), then builds.
@@ -174,11 +179,9 @@ impl World {
     /// The `t` of the slot's primitive in `(0, t_max)`, without building a [`Hit`].
     #[inline(always)]
     fn slot_t(&self, slot: u32, ray: &Ray, triangle_ray: &TriangleRay, t_max: f64) -> Option<f64> {
-        let s = self.slots[slot as usize];
+        let s = &self.slots[slot as usize];
         match s.kind {
-            SlotKind::Triangle => {
-                triangle_ray.intersect(&self.triangles[slot as usize], t_max).map(|(t, _)| t)
-            }
+            SlotKind::Triangle => triangle_ray.intersect(&s.vertices, t_max).map(|(t, _)| t),
             SlotKind::Analytic => self.shapes[s.shape as usize].hit_t(s.index, ray, t_max),
             SlotKind::Never => None,
         }
