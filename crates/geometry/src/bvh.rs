@@ -399,7 +399,7 @@ impl Slab for SlabF64 {
 /// The traversal stack of `(child, count, entry distance)`: a fixed array on the call stack,
 /// spilling to the heap only for trees deeper than it (so a ray costs no allocation).
 struct Stack<T> {
-    inline: [(u32, u32, T); 64],
+    inline: [(u32, u32, T); 32],
     len: usize,
     spill: Vec<(u32, u32, T)>,
 }
@@ -407,7 +407,7 @@ struct Stack<T> {
 impl<T: Copy + Default> Stack<T> {
     #[inline(always)]
     fn new() -> Self {
-        Self { inline: [(0, 0, T::default()); 64], len: 0, spill: Vec::new() }
+        Self { inline: [(0, 0, T::default()); 32], len: 0, spill: Vec::new() }
     }
 
     #[inline(always)]

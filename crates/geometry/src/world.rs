@@ -13,6 +13,16 @@ use crate::bvh::Bvh;
 use crate::mesh::TriangleRay;
 use crate::{Bounds, GeometryError, Hit, Ray, Shape};
 
+/// The nearest candidate so far in [`World::intersect`].
+enum Best {
+    /// None yet.
+    None,
+    /// A triangle slot and the `t_max` that accepted it (its hit is built at the end).
+    Triangle(u32, f64),
+    /// An analytic shape's full hit.
+    Hit(Hit),
+}
+
 /// What a BVH primitive slot holds, so the per-candidate test is an enum match.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum SlotKind {
@@ -68,6 +78,8 @@ pub struct World {
     shapes: Vec<Shape>,
     /// Primitive slots in BVH leaf order.
     slots: Vec<Slot>,
+    /// Some slot is a triangle (else the per-ray triangle setup is skipped).
+    has_triangles: bool,
     bvh2: Bvh2,
     bvh: Bvh,
     bounds: Bounds,
@@ -140,7 +152,8 @@ impl World {
             };
             slots.push(Slot { vertices, shape, index, kind });
         }
-        Ok(Self { shapes, slots, bvh2, bvh, bounds })
+        let has_triangles = slots.iter().any(|s| s.kind == SlotKind::Triangle);
+        Ok(Self { shapes, slots, has_triangles, bvh2, bvh, bounds })
     }
 
     /// Loads every OBJ mesh relative to `base_dir` (the scene file's directory), then builds.
@@ -178,10 +191,18 @@ impl World {
 
     /// The `t` of the slot's primitive in `(0, t_max)`, without building a [`Hit`].
     #[inline(always)]
-    fn slot_t(&self, slot: u32, ray: &Ray, triangle_ray: &TriangleRay, t_max: f64) -> Option<f64> {
+    fn slot_t(
+        &self,
+        slot: u32,
+        ray: &Ray,
+        triangle_ray: &Option<TriangleRay>,
+        t_max: f64,
+    ) -> Option<f64> {
         let s = &self.slots[slot as usize];
         match s.kind {
-            SlotKind::Triangle => triangle_ray.intersect(&s.vertices, t_max).map(|(t, _)| t),
+            SlotKind::Triangle => {
+                triangle_ray.as_ref()?.intersect(&s.vertices, t_max).map(|(t, _)| t)
+            }
             SlotKind::Analytic => self.shapes[s.shape as usize].hit_t(s.index, ray, t_max),
             SlotKind::Never => None,
         }
@@ -197,28 +218,46 @@ impl World {
 
     /// The nearest hit with `0 < t < t_max`, or `None`.
     ///
-    /// Candidates only compute `t` (triangles with the ray's permutation and shear set up once);
-    /// the full [`Hit`] is built once, for the winner, by the same routine and `t_max` that
-    /// accepted it, so it is the hit a primitive-by-primitive search reports.
+    /// Triangle candidates only compute `t` (with the ray's permutation and shear set up once);
+    /// the full [`Hit`] of a winning triangle is built once, by the same routine and `t_max` that
+    /// accepted it, so it is the hit a primitive-by-primitive search reports. An analytic shape
+    /// that is closer than the best so far returns its full hit directly (rather than solving
+    /// its quadratic or quartic a second time for the winner: scenes hold few of them).
     ///
     /// # Performance
     /// `O(log n)` box tests per ray on typical scenes, in f32 (conservative); primitives in f64.
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<Hit> {
-        let triangle_ray = TriangleRay::new(ray);
-        let mut best: Option<(u32, f64)> = None;
+        let triangle_ray = self.has_triangles.then(|| TriangleRay::new(ray));
+        let mut best = Best::None;
         self.bvh.traverse(ray.origin, ray.direction, t_max, |slot, limit| {
-            let t = self.slot_t(slot, ray, &triangle_ray, limit)?;
-            best = Some((slot, limit));
-            Some(t)
+            let s = &self.slots[slot as usize];
+            match s.kind {
+                SlotKind::Triangle => {
+                    let (t, _) = triangle_ray.as_ref()?.intersect(&s.vertices, limit)?;
+                    best = Best::Triangle(slot, limit);
+                    Some(t)
+                }
+                SlotKind::Analytic => {
+                    let shape = &self.shapes[s.shape as usize];
+                    let mut hit = shape.primitives().intersect(s.index, ray, limit)?;
+                    hit.primitive = s.shape;
+                    best = Best::Hit(hit);
+                    Some(hit.t)
+                }
+                SlotKind::Never => None,
+            }
         });
-        let (slot, limit) = best?;
-        self.slot_hit(slot, ray, limit)
+        match best {
+            Best::None => None,
+            Best::Hit(hit) => Some(hit),
+            Best::Triangle(slot, limit) => self.slot_hit(slot, ray, limit),
+        }
     }
 
     /// Whether anything lies on the ray with `0 < t < t_max` (shadow rays): stops at the first
     /// primitive hit and builds no [`Hit`].
     pub fn occluded(&self, ray: &Ray, t_max: f64) -> bool {
-        let triangle_ray = TriangleRay::new(ray);
+        let triangle_ray = self.has_triangles.then(|| TriangleRay::new(ray));
         let mut hit = false;
         self.bvh.traverse(ray.origin, ray.direction, t_max, |slot, limit| {
             self.slot_t(slot, ray, &triangle_ray, limit)?;
