@@ -136,7 +136,35 @@ impl Primitives for Cylinder {
         Bounds { min: self.center.min(top) - e, max: self.center.max(top) + e }
     }
 
+    fn hit_t(&self, _index: u32, ray: &Ray, t_max: f64) -> Option<f64> {
+        self.solve(ray, t_max).map(|h| h.0)
+    }
+
     fn intersect(&self, _index: u32, ray: &Ray, t_max: f64) -> Option<Hit> {
+        let (t, z, n) = self.solve(ray, t_max)?;
+        let (c, r, fr, h) = (self.center, self.radius, &self.frame, self.height);
+        let along = fr.n * z;
+        let point = c + along + n * r;
+        let error = (c.abs() + along.abs() + (n * r).abs()) * gamma(10);
+        let phi = n.dot(fr.v).atan2(n.dot(fr.u));
+        let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
+        Some(Hit {
+            t,
+            point,
+            geometric_normal: n,
+            shading_normal: n,
+            uv: DVec2::new(phi / (2.0 * PI), (z / h).clamp(0.0, 1.0)),
+            primitive: 0,
+            triangle: 0,
+            error,
+        })
+    }
+}
+
+impl Cylinder {
+    /// The nearest crossing of the side in `(0, t_max)`: `(t, height along the axis, normal)`.
+    #[inline]
+    fn solve(&self, ray: &Ray, t_max: f64) -> Option<(f64, f64, DVec3)> {
         let (c, r, fr) = (self.center, self.radius, &self.frame);
         let o = fr.local(ray.origin - c);
         let d = fr.local(ray.direction);
@@ -166,21 +194,6 @@ impl Primitives for Cylinder {
         if !(len > 0.0) {
             return None;
         }
-        let n = radial / len;
-        let along = fr.n * z;
-        let point = c + along + n * r;
-        let error = (c.abs() + along.abs() + (n * r).abs()) * gamma(10);
-        let phi = n.dot(fr.v).atan2(n.dot(fr.u));
-        let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
-        Some(Hit {
-            t,
-            point,
-            geometric_normal: n,
-            shading_normal: n,
-            uv: DVec2::new(phi / (2.0 * PI), (z / h).clamp(0.0, 1.0)),
-            primitive: 0,
-            triangle: 0,
-            error,
-        })
+        Some((t, z, radial / len))
     }
 }

@@ -96,6 +96,20 @@ impl Disk {
     }
 }
 
+impl Disk {
+    /// The plane crossing inside the radius: `(t, point, error, local point, rho)`.
+    #[inline]
+    fn solve(&self, ray: &Ray, t_max: f64) -> Option<(f64, DVec3, DVec3, DVec3, f64)> {
+        let (t, point, error) = plane_hit(self.center, self.frame.n, ray, t_max)?;
+        let local = self.frame.local(point - self.center);
+        let rho = local.x.hypot(local.y);
+        if !(rho <= self.radius) {
+            return None;
+        }
+        Some((t, point, error, local, rho))
+    }
+}
+
 /// Half-extents of a circle of `radius` with unit `normal`, per axis: `r sqrt(1 - n_i^2)`.
 pub(crate) fn circle_extent(normal: DVec3, radius: f64) -> DVec3 {
     (DVec3::ONE - normal * normal).max(DVec3::ZERO).powf(0.5) * radius
@@ -111,13 +125,12 @@ impl Primitives for Disk {
         Bounds { min: self.center - e, max: self.center + e }
     }
 
+    fn hit_t(&self, _index: u32, ray: &Ray, t_max: f64) -> Option<f64> {
+        self.solve(ray, t_max).map(|s| s.0)
+    }
+
     fn intersect(&self, _index: u32, ray: &Ray, t_max: f64) -> Option<Hit> {
-        let (t, point, error) = plane_hit(self.center, self.frame.n, ray, t_max)?;
-        let local = self.frame.local(point - self.center);
-        let rho = local.x.hypot(local.y);
-        if !(rho <= self.radius) {
-            return None;
-        }
+        let (t, point, error, local, rho) = self.solve(ray, t_max)?;
         let phi = local.y.atan2(local.x);
         let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
         Some(Hit {

@@ -15,9 +15,11 @@
 //! closed-form quartic for the torus) and re-projects its hit onto the surface, so the error of
 //! the point is small and known. [`Hit::spawn_ray`] then offsets the next ray's origin just past
 //! that error along the normal, so a bounce never re-hits its own surface at `t ~ 0`, at the
-//! origin or `1e5` m away, without a scene-dependent epsilon. The BVH is `obvhs`'s, built from f32
-//! boxes rounded outwards from the exact f64 bounds; traversal is done here in f64, so the BVH can
-//! only cost time, never a hit.
+//! origin or `1e5` m away, without a scene-dependent epsilon. The BVH is built by `obvhs` from f32
+//! boxes rounded outwards from the exact f64 bounds, then converted into compact nodes traversed
+//! here with a conservative f32 slab test (the origin's f32 rounding widens the interval), so the
+//! BVH can only cost time, never a hit; candidates compute only `t`, and the full [`Hit`] is built
+//! once, for the nearest.
 //!
 //! For emitting objects, [`Shape::area`] and [`Shape::sample_area`] draw a [`SurfacePoint`]
 //! uniformly by area on any shape (the torus by inverting its tube-angle CDF, meshes by a
@@ -26,6 +28,7 @@
 //! Layering: this crate depends on none of Spectrace's crates.
 
 mod bounds;
+mod bvh;
 mod cylinder;
 mod disk;
 mod error;

@@ -413,65 +413,106 @@ impl Mesh {
 
 /// The watertight ray/triangle test: `(t, [b0, b1, b2])` with `0 < t < t_max`.
 pub(crate) fn intersect_triangle(p: [DVec3; 3], ray: &Ray, t_max: f64) -> Option<(f64, [f64; 3])> {
-    let d = ray.direction;
-    let ad = d.abs();
-    let kz = if ad.x > ad.y {
-        if ad.x > ad.z { 0 } else { 2 }
-    } else if ad.y > ad.z {
-        1
-    } else {
-        2
-    };
-    let kx = (kz + 1) % 3;
-    let ky = (kx + 1) % 3;
-    let perm = |v: DVec3| DVec3::new(v[kx], v[ky], v[kz]);
-    let d = perm(d);
-    let mut q = p.map(|v| perm(v - ray.origin));
-    let sx = -d.x / d.z;
-    let sy = -d.y / d.z;
-    let sz = 1.0 / d.z;
-    for v in &mut q {
-        v.x += sx * v.z;
-        v.y += sy * v.z;
+    TriangleRay::new(ray).intersect(&p.map(|v| v.to_array()), t_max)
+}
+
+/// The per-ray part of the watertight triangle test (Woop, Benthin and Wald 2013): the axis
+/// permutation that makes the ray's largest direction component `z`, and the shear that maps the
+/// ray onto `+z`. Computed once per ray; [`TriangleRay::intersect`] then does only the
+/// per-triangle work, with exactly the arithmetic of the single-triangle test.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct TriangleRay {
+    origin: [f64; 3],
+    kx: usize,
+    ky: usize,
+    kz: usize,
+    sx: f64,
+    sy: f64,
+    sz: f64,
+}
+
+impl TriangleRay {
+    /// The permutation and shear of `ray`.
+    #[inline]
+    pub(crate) fn new(ray: &Ray) -> Self {
+        let d = ray.direction;
+        let ad = d.abs();
+        let kz = if ad.x > ad.y {
+            if ad.x > ad.z { 0 } else { 2 }
+        } else if ad.y > ad.z {
+            1
+        } else {
+            2
+        };
+        let kx = (kz + 1) % 3;
+        let ky = (kx + 1) % 3;
+        let d = d.to_array();
+        let (dx, dy, dz) = (d[kx], d[ky], d[kz]);
+        Self { origin: ray.origin.to_array(), kx, ky, kz, sx: -dx / dz, sy: -dy / dz, sz: 1.0 / dz }
     }
-    let e0 = q[1].x * q[2].y - q[1].y * q[2].x;
-    let e1 = q[2].x * q[0].y - q[2].y * q[0].x;
-    let e2 = q[0].x * q[1].y - q[0].y * q[1].x;
-    if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
-        return None;
+
+    /// The watertight test against the triangle `p` (world-space vertices): `(t, [b0, b1, b2])`
+    /// with `0 < t < t_max`, `t` above pbrt's conservative bound on its rounding error.
+    #[inline]
+    pub(crate) fn intersect(&self, p: &[[f64; 3]; 3], t_max: f64) -> Option<(f64, [f64; 3])> {
+        let (o, kx, ky, kz) = (&self.origin, self.kx.min(2), self.ky.min(2), self.kz.min(2));
+        let mut q = p.map(|v| [v[kx] - o[kx], v[ky] - o[ky], v[kz] - o[kz]]);
+        for v in &mut q {
+            v[0] += self.sx * v[2];
+            v[1] += self.sy * v[2];
+        }
+        let e0 = q[1][0] * q[2][1] - q[1][1] * q[2][0];
+        let e1 = q[2][0] * q[0][1] - q[2][1] * q[0][0];
+        let e2 = q[0][0] * q[1][1] - q[0][1] * q[1][0];
+        if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
+            return None;
+        }
+        let det = e0 + e1 + e2;
+        if det == 0.0 || !det.is_finite() {
+            return None;
+        }
+        for v in &mut q {
+            v[2] *= self.sz;
+        }
+        let t_scaled = e0 * q[0][2] + e1 * q[1][2] + e2 * q[2][2];
+        if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
+            return None;
+        }
+        if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
+            return None;
+        }
+        let inv_det = 1.0 / det;
+        let b = [e0 * inv_det, e1 * inv_det, e2 * inv_det];
+        let t = t_scaled * inv_det;
+        // Conservative t > 0 (pbrt-v3, section 3.9.6).
+        let max_z = q.iter().map(|v| v[2].abs()).fold(0.0, f64::max);
+        let max_x = q.iter().map(|v| v[0].abs()).fold(0.0, f64::max);
+        let max_y = q.iter().map(|v| v[1].abs()).fold(0.0, f64::max);
+        let delta_z = gamma(3) * max_z;
+        let delta_x = gamma(5) * (max_x + max_z);
+        let delta_y = gamma(5) * (max_y + max_z);
+        let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+        let max_e = e0.abs().max(e1.abs()).max(e2.abs());
+        let delta_t =
+            3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv_det.abs();
+        if !(t > delta_t && t < t_max) {
+            return None;
+        }
+        Some((t, b))
     }
-    let det = e0 + e1 + e2;
-    if det == 0.0 || !det.is_finite() {
-        return None;
+}
+
+impl Mesh {
+    /// The world-space vertices of triangle `index` and whether a hit on it is reported at all
+    /// (its normal `(p1 - p0) x (p2 - p0)` must have a length `> 0`, as [`Primitives::intersect`]
+    /// requires); `None` for an unloaded mesh or an index out of range.
+    pub(crate) fn triangle(&self, index: u32) -> Option<([[f64; 3]; 3], bool)> {
+        let d = self.data.as_ref()?;
+        let tri = d.triangles.get(index as usize)?;
+        let p = tri.map(|i| d.positions[i as usize]);
+        let valid = (p[1] - p[0]).cross(p[2] - p[0]).length() > 0.0;
+        Some((p.map(|v| v.to_array()), valid))
     }
-    for v in &mut q {
-        v.z *= sz;
-    }
-    let t_scaled = e0 * q[0].z + e1 * q[1].z + e2 * q[2].z;
-    if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
-        return None;
-    }
-    if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
-        return None;
-    }
-    let inv_det = 1.0 / det;
-    let b = [e0 * inv_det, e1 * inv_det, e2 * inv_det];
-    let t = t_scaled * inv_det;
-    // Conservative t > 0 (pbrt-v3, section 3.9.6).
-    let max_z = q.iter().map(|v| v.z.abs()).fold(0.0, f64::max);
-    let max_x = q.iter().map(|v| v.x.abs()).fold(0.0, f64::max);
-    let max_y = q.iter().map(|v| v.y.abs()).fold(0.0, f64::max);
-    let delta_z = gamma(3) * max_z;
-    let delta_x = gamma(5) * (max_x + max_z);
-    let delta_y = gamma(5) * (max_y + max_z);
-    let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
-    let max_e = e0.abs().max(e1.abs()).max(e2.abs());
-    let delta_t =
-        3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv_det.abs();
-    if !(t > delta_t && t < t_max) {
-        return None;
-    }
-    Some((t, b))
 }
 
 impl Primitives for Mesh {

@@ -212,6 +212,21 @@ pub(crate) fn plane_hit(
     Some((t, p, error))
 }
 
+impl Rectangle {
+    /// The plane crossing inside the parallelogram: `(t, point, error, s, t)`.
+    #[inline]
+    fn solve(&self, ray: &Ray, t_max: f64) -> Option<(f64, DVec3, DVec3, f64, f64)> {
+        let (t, point, error) = plane_hit(self.corner, self.normal, ray, t_max)?;
+        let q = point - self.corner;
+        let s = q.dot(self.dual_u);
+        let v = q.dot(self.dual_v);
+        if !((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&v)) {
+            return None;
+        }
+        Some((t, point, error, s, v))
+    }
+}
+
 impl Primitives for Rectangle {
     fn count(&self) -> usize {
         1
@@ -222,14 +237,12 @@ impl Primitives for Rectangle {
         Bounds::from_points([c, c + self.edge_u, c + self.edge_v, c + self.edge_u + self.edge_v])
     }
 
+    fn hit_t(&self, _index: u32, ray: &Ray, t_max: f64) -> Option<f64> {
+        self.solve(ray, t_max).map(|h| h.0)
+    }
+
     fn intersect(&self, _index: u32, ray: &Ray, t_max: f64) -> Option<Hit> {
-        let (t, point, error) = plane_hit(self.corner, self.normal, ray, t_max)?;
-        let q = point - self.corner;
-        let s = q.dot(self.dual_u);
-        let v = q.dot(self.dual_v);
-        if !((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&v)) {
-            return None;
-        }
+        let (t, point, error, s, v) = self.solve(ray, t_max)?;
         Some(Hit {
             t,
             point,

@@ -19,6 +19,11 @@ pub(crate) trait Primitives {
     fn bounds(&self, index: u32) -> Bounds;
     /// The hit with primitive `index` in `(0, t_max)`, with `primitive = 0` (the world fills it).
     fn intersect(&self, index: u32, ray: &Ray, t_max: f64) -> Option<Hit>;
+    /// Only the `t` that [`Primitives::intersect`] would report (same arithmetic, bit for bit),
+    /// without building the [`Hit`]: the BVH's per-candidate test.
+    fn hit_t(&self, index: u32, ray: &Ray, t_max: f64) -> Option<f64> {
+        self.intersect(index, ray, t_max).map(|h| h.t)
+    }
 }
 
 /// The uniform scale of `t` if it is a similarity, else an error naming `shape.transform`.
@@ -86,6 +91,29 @@ impl Shape {
             Shape::Torus(s) => s,
             Shape::Mesh(s) => s,
             Shape::Prism(s) => s.mesh(),
+        }
+    }
+
+    /// [`Primitives::hit_t`] of primitive `index`, dispatched by an enum match (no vtable).
+    #[inline]
+    pub(crate) fn hit_t(&self, index: u32, ray: &Ray, t_max: f64) -> Option<f64> {
+        match self {
+            Shape::Sphere(s) => s.hit_t(index, ray, t_max),
+            Shape::Rectangle(s) => s.hit_t(index, ray, t_max),
+            Shape::Disk(s) => s.hit_t(index, ray, t_max),
+            Shape::Cylinder(s) => s.hit_t(index, ray, t_max),
+            Shape::Torus(s) => s.hit_t(index, ray, t_max),
+            Shape::Mesh(s) => s.hit_t(index, ray, t_max),
+            Shape::Prism(s) => s.mesh().hit_t(index, ray, t_max),
+        }
+    }
+
+    /// The triangle mesh behind a `Mesh` or `Prism` (its triangles are BVH primitives).
+    pub(crate) fn triangle_mesh(&self) -> Option<&Mesh> {
+        match self {
+            Shape::Mesh(m) => Some(m),
+            Shape::Prism(p) => Some(p.mesh()),
+            _ => None,
         }
     }
 

@@ -122,7 +122,37 @@ impl Primitives for Sphere {
         Bounds { min: self.center - self.radius, max: self.center + self.radius }
     }
 
+    fn hit_t(&self, _index: u32, ray: &Ray, t_max: f64) -> Option<f64> {
+        self.solve(ray, t_max).map(|(t, _)| t)
+    }
+
     fn intersect(&self, _index: u32, ray: &Ray, t_max: f64) -> Option<Hit> {
+        let (t, n) = self.solve(ray, t_max)?;
+        let (c, r) = (self.center, self.radius);
+        let v = n * r;
+        let point = c + v;
+        let error = (c.abs() + v.abs()) * gamma(6);
+        let local = self.frame.local(n);
+        let phi = local.y.atan2(local.x);
+        let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
+        let uv = DVec2::new(phi / (2.0 * PI), local.z.clamp(-1.0, 1.0).acos() / PI);
+        Some(Hit {
+            t,
+            point,
+            geometric_normal: n,
+            shading_normal: n,
+            uv,
+            primitive: 0,
+            triangle: 0,
+            error,
+        })
+    }
+}
+
+impl Sphere {
+    /// The nearest root in `(0, t_max)` and the unit normal there.
+    #[inline]
+    fn solve(&self, ray: &Ray, t_max: f64) -> Option<(f64, DVec3)> {
         let (c, r) = (self.center, self.radius);
         let f = ray.origin - c;
         let d = ray.direction;
@@ -148,23 +178,6 @@ impl Primitives for Sphere {
         if !(len > 0.0) {
             return None;
         }
-        let n = v / len;
-        let v = n * r;
-        let point = c + v;
-        let error = (c.abs() + v.abs()) * gamma(6);
-        let local = self.frame.local(n);
-        let phi = local.y.atan2(local.x);
-        let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
-        let uv = DVec2::new(phi / (2.0 * PI), local.z.clamp(-1.0, 1.0).acos() / PI);
-        Some(Hit {
-            t,
-            point,
-            geometric_normal: n,
-            shading_normal: n,
-            uv,
-            primitive: 0,
-            triangle: 0,
-            error,
-        })
+        Some((t, v / len))
     }
 }

@@ -229,7 +229,48 @@ impl Primitives for Torus {
         Bounds { min: self.center - e, max: self.center + e }
     }
 
+    fn hit_t(&self, _index: u32, ray: &Ray, t_max: f64) -> Option<f64> {
+        self.solve(ray, t_max).map(|h| h.0)
+    }
+
     fn intersect(&self, _index: u32, ray: &Ray, t_max: f64) -> Option<Hit> {
+        let (t, q) = self.solve(ray, t_max)?;
+        let (big_r, r, fr) = (self.major, self.minor, &self.frame);
+        // Nearest point on the tube.
+        let rho = q.x.hypot(q.y);
+        let ring = if rho > 0.0 {
+            DVec3::new(q.x / rho, q.y / rho, 0.0) * big_r
+        } else {
+            DVec3::new(big_r, 0.0, 0.0)
+        };
+        let m = q - ring;
+        let ml = m.length();
+        let nl = if ml > 0.0 { m / ml } else { ring / big_r };
+        let local = ring + nl * r;
+        let offset = fr.world(local);
+        let point = self.center + offset;
+        let error =
+            (self.center.abs() + offset.abs()) * gamma(10) + DVec3::splat(gamma(10) * (big_r + r));
+        let n = fr.world(nl).normalize();
+        let phi = ring.y.atan2(ring.x);
+        let theta = nl.z.atan2(nl.dot(ring) / big_r);
+        let wrap = |x: f64| (if x < 0.0 { x + 2.0 * PI } else { x }) / (2.0 * PI);
+        Some(Hit {
+            t,
+            point,
+            geometric_normal: n,
+            shading_normal: n,
+            uv: DVec2::new(wrap(phi), wrap(theta)),
+            primitive: 0,
+            triangle: 0,
+            error,
+        })
+    }
+}
+
+impl Torus {
+    /// The first crossing in `(0, t_max)`: `(t, local point on the ray there)`.
+    fn solve(&self, ray: &Ray, t_max: f64) -> Option<(f64, DVec3)> {
         let (big_r, r, fr) = (self.major, self.minor, &self.frame);
         let o = fr.local(ray.origin - self.center);
         let d = fr.local(ray.direction);
@@ -300,36 +341,7 @@ impl Primitives for Torus {
         if !(t > 0.0 && t < t_max) {
             return None;
         }
-        // Nearest point on the tube.
-        let q = o + d * s;
-        let rho = q.x.hypot(q.y);
-        let ring = if rho > 0.0 {
-            DVec3::new(q.x / rho, q.y / rho, 0.0) * big_r
-        } else {
-            DVec3::new(big_r, 0.0, 0.0)
-        };
-        let m = q - ring;
-        let ml = m.length();
-        let nl = if ml > 0.0 { m / ml } else { ring / big_r };
-        let local = ring + nl * r;
-        let offset = fr.world(local);
-        let point = self.center + offset;
-        let error =
-            (self.center.abs() + offset.abs()) * gamma(10) + DVec3::splat(gamma(10) * (big_r + r));
-        let n = fr.world(nl).normalize();
-        let phi = ring.y.atan2(ring.x);
-        let theta = nl.z.atan2(nl.dot(ring) / big_r);
-        let wrap = |x: f64| (if x < 0.0 { x + 2.0 * PI } else { x }) / (2.0 * PI);
-        Some(Hit {
-            t,
-            point,
-            geometric_normal: n,
-            shading_normal: n,
-            uv: DVec2::new(wrap(phi), wrap(theta)),
-            primitive: 0,
-            triangle: 0,
-            error,
-        })
+        Some((t, o + d * s))
     }
 }
 

@@ -9,32 +9,64 @@ use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
 use obvhs::bvh2::builder::build_bvh2;
 
+use crate::bvh::Bvh;
+use crate::mesh::TriangleRay;
 use crate::{Bounds, GeometryError, Hit, Ray, Shape};
 
-/// One BVH primitive: a whole analytic shape or one triangle of a mesh.
-#[derive(Debug, Clone, Copy)]
-struct PrimRef {
-    shape: u32,
-    index: u32,
+/// The nearest candidate so far in [`World::intersect`].
+enum Best {
+    /// None yet.
+    None,
+    /// A triangle slot and the `t_max` that accepted it (its hit is built at the end).
+    Triangle(u32, f64),
+    /// An analytic shape's full hit.
+    Hit(Hit),
 }
 
-/// Rounds an f64 box outwards to f32, with a small relative margin, so that it contains the f64
-/// box and every point an f64 intersection routine could report for it.
-fn conservative_aabb(b: Bounds) -> Aabb {
+/// What a BVH primitive slot holds, so the per-candidate test is an enum match.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SlotKind {
+    /// A mesh triangle: the watertight test on the slot's copied vertices.
+    Triangle,
+    /// A triangle that no ray hits (its normal has zero length, which `Mesh` refuses).
+    Never,
+    /// A whole analytic shape: its `t`-only routine.
+    Analytic,
+}
+
+/// One BVH primitive slot (in BVH leaf order): a whole analytic shape or one mesh triangle, with
+/// the triangle's world-space vertices copied in (zeros otherwise), so a leaf's primitives are
+/// contiguous and a candidate costs no further lookup.
+#[derive(Debug, Clone, Copy)]
+struct Slot {
+    vertices: [[f64; 3]; 3],
+    shape: u32,
+    index: u32,
+    kind: SlotKind,
+}
+
+/// The build settings of the BVH: `obvhs`'s medium-quality PLOC build with leaves of at most
+/// `MAX_PRIMS_PER_LEAF` primitives.
+fn build_params() -> BvhBuildParams {
+    BvhBuildParams { max_prims_per_leaf: MAX_PRIMS_PER_LEAF, ..BvhBuildParams::medium_build() }
+}
+
+/// The most primitives per BVH leaf (chosen by benchmark, see the crate README).
+const MAX_PRIMS_PER_LEAF: u32 = 4;
+
+/// Rounds an f64 box, relative to `center`, outwards to f32, with a small margin relative to its
+/// world coordinates, so that it contains the f64 box and every point an f64 intersection routine
+/// could report for it (the margin also covers the rounding of the shift by `center`).
+fn conservative_aabb(b: Bounds, center: DVec3) -> Aabb {
     let scale = b.min.abs().max(b.max.abs()).max_element() + b.diagonal().max_element();
     let margin = DVec3::splat(1e-9 * scale);
-    let (lo, hi) = (b.min - margin, b.max + margin);
+    let (lo, hi) = (b.min - margin - center, b.max + margin - center);
     let down = |x: f64| (x as f32).next_down();
     let up = |x: f64| (x as f32).next_up();
     Aabb::new(
         Vec3A::new(down(lo.x), down(lo.y), down(lo.z)),
         Vec3A::new(up(hi.x), up(hi.y), up(hi.z)),
     )
-}
-
-/// The f64 copy of an obvhs node's f32 box (exact conversion).
-fn node_bounds(a: &Aabb) -> Bounds {
-    Bounds { min: a.min.as_dvec3(), max: a.max.as_dvec3() }
 }
 
 /// The scene's geometry: shapes and one BVH over all their primitives.
@@ -44,9 +76,12 @@ fn node_bounds(a: &Aabb) -> Bounds {
 #[derive(Clone)]
 pub struct World {
     shapes: Vec<Shape>,
-    prims: Vec<PrimRef>,
-    bvh: Bvh2,
-    boxes: Vec<Bounds>,
+    /// Primitive slots in BVH leaf order.
+    slots: Vec<Slot>,
+    /// Some slot is a triangle (else the per-ray triangle setup is skipped).
+    has_triangles: bool,
+    bvh2: Bvh2,
+    bvh: Bvh,
     bounds: Bounds,
 }
 
@@ -54,13 +89,12 @@ impl std::fmt::Debug for World {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("World")
             .field("shapes", &self.shapes.len())
-            .field("primitives", &self.prims.len())
-            .field("bvh_nodes", &self.bvh.nodes.len())
+            .field("primitives", &self.slots.len())
+            .field("bvh_nodes", &self.bvh.node_count())
             .field("bounds", &self.bounds)
             .finish()
     }
 }
-
 impl World {
     /// Builds the BVH over all primitives of `shapes` (every OBJ mesh must already be loaded).
     ///
@@ -81,22 +115,45 @@ impl World {
             let n = s.primitive_count();
             let n32 =
                 u32::try_from(n).map_err(|_| GeometryError::TooManyPrimitives { count: n })?;
-            prims.extend((0..n32).map(|index| PrimRef { shape, index }));
+            prims.extend((0..n32).map(|index| (shape, index)));
         }
         if u32::try_from(prims.len()).is_err() {
             return Err(GeometryError::TooManyPrimitives { count: prims.len() });
         }
+        // Slots address primitives by `LEAF | index` in the converted BVH.
+        if prims.len() >= 1 << 31 {
+            return Err(GeometryError::TooManyPrimitives { count: prims.len() });
+        }
         let exact: Vec<Bounds> =
-            prims.iter().map(|p| shapes[p.shape as usize].primitives().bounds(p.index)).collect();
+            prims.iter().map(|&(s, i)| shapes[s as usize].primitives().bounds(i)).collect();
         let bounds = exact.iter().fold(Bounds::EMPTY, |a, &b| a.union(b));
-        let aabbs: Vec<Aabb> = exact.into_iter().map(conservative_aabb).collect();
-        let bvh = if aabbs.is_empty() {
+        // Boxes relative to the scene's centre keep f32 precision for scenes far from the origin.
+        let center = if bounds.is_empty() || !bounds.center().is_finite() {
+            DVec3::ZERO
+        } else {
+            bounds.center()
+        };
+        let aabbs: Vec<Aabb> = exact.into_iter().map(|b| conservative_aabb(b, center)).collect();
+        let bvh2 = if aabbs.is_empty() {
             Bvh2::default()
         } else {
-            build_bvh2(&aabbs, BvhBuildParams::medium_build(), &mut Duration::default())
+            build_bvh2(&aabbs, build_params(), &mut Duration::default())
         };
-        let boxes = bvh.nodes.iter().map(|n| node_bounds(n.aabb())).collect();
-        Ok(Self { shapes, prims, bvh, boxes, bounds })
+        let bvh = Bvh::from_bvh2(&bvh2, center);
+        let mut slots = Vec::with_capacity(prims.len());
+        for &p in &bvh2.primitive_indices {
+            let (shape, index) = prims[p as usize];
+            let (kind, vertices) = match shapes[shape as usize].triangle_mesh() {
+                Some(mesh) => match mesh.triangle(index) {
+                    Some((v, true)) => (SlotKind::Triangle, v),
+                    _ => (SlotKind::Never, [[0.0; 3]; 3]),
+                },
+                None => (SlotKind::Analytic, [[0.0; 3]; 3]),
+            };
+            slots.push(Slot { vertices, shape, index, kind });
+        }
+        let has_triangles = slots.iter().any(|s| s.kind == SlotKind::Triangle);
+        Ok(Self { shapes, slots, has_triangles, bvh2, bvh, bounds })
     }
 
     /// Loads every OBJ mesh relative to `base_dir` (the scene file's directory), then builds.
@@ -117,7 +174,7 @@ impl World {
 
     /// Number of BVH primitives (triangles count one each).
     pub fn primitive_count(&self) -> usize {
-        self.prims.len()
+        self.slots.len()
     }
 
     /// The box around all shapes (empty for an empty world).
@@ -125,129 +182,105 @@ impl World {
         self.bounds
     }
 
-    /// Exact intersection of one primitive, with the world's indices filled in.
-    fn intersect_primitive(&self, prim: u32, ray: &Ray, t_max: f64) -> Option<Hit> {
-        let p = self.prims[prim as usize];
-        let mut hit = self.shapes[p.shape as usize].primitives().intersect(p.index, ray, t_max)?;
-        hit.primitive = p.shape;
-        Some(hit)
+    /// The `obvhs` BVH (over the primitives numbered shape by shape, triangle by triangle) that
+    /// the traversal structure was converted from: for comparisons such as the benchmark against
+    /// `obvhs`'s own traversal.
+    pub fn obvhs_bvh(&self) -> &Bvh2 {
+        &self.bvh2
     }
 
-    /// Traverses the BVH; `on_leaf` tests one primitive with the current `t_max` and returns
-    /// whether to stop.
-    fn traverse(&self, ray: &Ray, t_max: f64, mut on_prim: impl FnMut(u32, f64) -> Option<f64>) {
-        if self.boxes.is_empty() || !(t_max > 0.0) {
-            return;
-        }
-        let inv = ray.direction.recip();
-        let mut t_max = t_max;
-        let mut stack = NodeStack::new();
-        stack.push(0);
-        while let Some(i) = stack.pop() {
-            let node = &self.bvh.nodes[i as usize];
-            if self.boxes[i as usize].ray_interval(ray.origin, inv, t_max).is_none() {
-                continue;
+    /// The `t` of the slot's primitive in `(0, t_max)`, without building a [`Hit`].
+    #[inline(always)]
+    fn slot_t(
+        &self,
+        slot: u32,
+        ray: &Ray,
+        triangle_ray: &Option<TriangleRay>,
+        t_max: f64,
+    ) -> Option<f64> {
+        let s = &self.slots[slot as usize];
+        match s.kind {
+            SlotKind::Triangle => {
+                triangle_ray.as_ref()?.intersect(&s.vertices, t_max).map(|(t, _)| t)
             }
-            if node.is_leaf() {
-                for k in node.first_index..node.first_index + node.prim_count {
-                    match on_prim(self.bvh.primitive_indices[k as usize], t_max) {
-                        Some(t) if t < 0.0 => return,
-                        Some(t) => t_max = t,
-                        None => {}
-                    }
-                }
-            } else {
-                let (l, r) = (node.first_index, node.first_index + 1);
-                let tl = self.boxes[l as usize].ray_interval(ray.origin, inv, t_max);
-                let tr = self.boxes[r as usize].ray_interval(ray.origin, inv, t_max);
-                match (tl, tr) {
-                    (Some(a), Some(b)) => {
-                        if a.0 <= b.0 {
-                            stack.push(r);
-                            stack.push(l);
-                        } else {
-                            stack.push(l);
-                            stack.push(r);
-                        }
-                    }
-                    (Some(_), None) => stack.push(l),
-                    (None, Some(_)) => stack.push(r),
-                    (None, None) => {}
-                }
-            }
+            SlotKind::Analytic => self.shapes[s.shape as usize].hit_t(s.index, ray, t_max),
+            SlotKind::Never => None,
         }
+    }
+
+    /// The full hit of the slot's primitive, with the world's indices filled in.
+    fn slot_hit(&self, slot: u32, ray: &Ray, t_max: f64) -> Option<Hit> {
+        let s = self.slots[slot as usize];
+        let mut hit = self.shapes[s.shape as usize].primitives().intersect(s.index, ray, t_max)?;
+        hit.primitive = s.shape;
+        Some(hit)
     }
 
     /// The nearest hit with `0 < t < t_max`, or `None`.
     ///
+    /// Triangle candidates only compute `t` (with the ray's permutation and shear set up once);
+    /// the full [`Hit`] of a winning triangle is built once, by the same routine and `t_max` that
+    /// accepted it, so it is the hit a primitive-by-primitive search reports. An analytic shape
+    /// that is closer than the best so far returns its full hit directly (rather than solving
+    /// its quadratic or quartic a second time for the winner: scenes hold few of them).
+    ///
     /// # Performance
-    /// `O(log n)` box tests per ray on typical scenes; all arithmetic in f64.
+    /// `O(log n)` box tests per ray on typical scenes, in f32 (conservative); primitives in f64.
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<Hit> {
-        let mut best: Option<Hit> = None;
-        self.traverse(ray, t_max, |prim, limit| {
-            let h = self.intersect_primitive(prim, ray, limit)?;
-            best = Some(h);
-            Some(h.t)
+        let triangle_ray = self.has_triangles.then(|| TriangleRay::new(ray));
+        let mut best = Best::None;
+        self.bvh.traverse(ray.origin, ray.direction, t_max, |slot, limit| {
+            let s = &self.slots[slot as usize];
+            match s.kind {
+                SlotKind::Triangle => {
+                    let (t, _) = triangle_ray.as_ref()?.intersect(&s.vertices, limit)?;
+                    best = Best::Triangle(slot, limit);
+                    Some(t)
+                }
+                SlotKind::Analytic => {
+                    let shape = &self.shapes[s.shape as usize];
+                    let mut hit = shape.primitives().intersect(s.index, ray, limit)?;
+                    hit.primitive = s.shape;
+                    best = Best::Hit(hit);
+                    Some(hit.t)
+                }
+                SlotKind::Never => None,
+            }
         });
-        best
+        match best {
+            Best::None => None,
+            Best::Hit(hit) => Some(hit),
+            Best::Triangle(slot, limit) => self.slot_hit(slot, ray, limit),
+        }
     }
 
-    /// Whether anything lies on the ray with `0 < t < t_max` (shadow rays; stops at the first hit).
+    /// Whether anything lies on the ray with `0 < t < t_max` (shadow rays): stops at the first
+    /// primitive hit and builds no [`Hit`].
     pub fn occluded(&self, ray: &Ray, t_max: f64) -> bool {
+        let triangle_ray = self.has_triangles.then(|| TriangleRay::new(ray));
         let mut hit = false;
-        self.traverse(ray, t_max, |prim, limit| {
-            self.intersect_primitive(prim, ray, limit)?;
+        self.bvh.traverse(ray.origin, ray.direction, t_max, |slot, limit| {
+            self.slot_t(slot, ray, &triangle_ray, limit)?;
             hit = true;
             Some(-1.0)
         });
         hit
     }
 
-    /// The nearest hit by testing every primitive (no BVH): a reference for tests and benchmarks.
+    /// The nearest hit by testing every primitive (no BVH), each through the shape's full
+    /// intersection routine: a reference for tests and benchmarks.
     pub fn intersect_brute_force(&self, ray: &Ray, t_max: f64) -> Option<Hit> {
         let mut best: Option<Hit> = None;
-        for prim in 0..self.prims.len() as u32 {
-            let limit = best.map_or(t_max, |h| h.t);
-            if let Some(h) = self.intersect_primitive(prim, ray, limit) {
-                best = Some(h);
+        for (shape, s) in self.shapes.iter().enumerate() {
+            let p = s.primitives();
+            for index in 0..p.count() as u32 {
+                let limit = best.map_or(t_max, |h| h.t);
+                if let Some(mut h) = p.intersect(index, ray, limit) {
+                    h.primitive = shape as u32;
+                    best = Some(h);
+                }
             }
         }
         best
-    }
-}
-
-/// The traversal stack: a fixed array on the call stack, spilling to the heap only for trees
-/// deeper than it (so a ray costs no allocation).
-struct NodeStack {
-    inline: [u32; 96],
-    len: usize,
-    spill: Vec<u32>,
-}
-
-impl NodeStack {
-    fn new() -> Self {
-        Self { inline: [0; 96], len: 0, spill: Vec::new() }
-    }
-
-    #[inline]
-    fn push(&mut self, node: u32) {
-        if self.len < self.inline.len() {
-            self.inline[self.len] = node;
-            self.len += 1;
-        } else {
-            self.spill.push(node);
-        }
-    }
-
-    #[inline]
-    fn pop(&mut self) -> Option<u32> {
-        if let Some(node) = self.spill.pop() {
-            return Some(node);
-        }
-        if self.len == 0 {
-            return None;
-        }
-        self.len -= 1;
-        Some(self.inline[self.len])
     }
 }

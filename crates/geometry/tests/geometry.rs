@@ -1279,3 +1279,174 @@ fn degenerate_and_unloaded_meshes_sample_without_panicking() {
         }
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// The f32 BVH traversal against brute force: meshes and analytic shapes, rays from surfaces,
+// far from the origin (where an f32 ulp exceeds the triangles), tiny and huge scales.
+
+/// `{"scale": s, "translate": far}` as JSON.
+fn scale_then_move(s: f64, far: DVec3) -> String {
+    format!(r#"{{"scale": {}, "translate": {}}}"#, js(s), jv(far.to_array()))
+}
+
+/// A bumpy UV sphere of radius ~1 (`4 n^2` triangles) as a Mesh, scaled by `s` and moved to `far`.
+fn bumpy_mesh(n: u32, s: f64, far: DVec3) -> Shape {
+    let mut positions = Vec::new();
+    for i in 0..=n {
+        let theta = PI * f64::from(i) / f64::from(n);
+        for j in 0..2 * n {
+            let phi = PI * f64::from(j) / f64::from(n);
+            let r = 1.0 + 0.05 * (7.0 * theta).sin() * (5.0 * phi).cos();
+            positions.push(
+                [theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin()].map(|c| c * r),
+            );
+        }
+    }
+    let idx = |i: u32, j: u32| i * 2 * n + j % (2 * n);
+    let mut triangles = Vec::new();
+    for i in 0..n {
+        for j in 0..2 * n {
+            triangles.push([idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)]);
+            triangles.push([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]);
+        }
+    }
+    let positions: Vec<String> = positions.into_iter().map(jv).collect();
+    let triangles: Vec<String> = triangles.iter().map(|t| format!("{t:?}")).collect();
+    shape(&format!(
+        r#"{{"type": "Mesh", "positions": [{}], "triangles": [{}], "transform": {}}}"#,
+        positions.join(","),
+        triangles.join(","),
+        scale_then_move(s, far)
+    ))
+}
+
+/// Every analytic shape type plus a mesh and a prism, all within `s * 5` of `far`.
+fn scaled_scene(r: &mut Pcg64, s: f64, far: DVec3) -> Vec<Shape> {
+    let t = scale_then_move(s, far);
+    let mut p = || jv([0; 3].map(|_| r.random_range(-4.0..4.0)));
+    let mut shapes: Vec<Shape> = Vec::new();
+    for k in 0..4 {
+        let json = [
+            format!(r#"{{"type": "Sphere", "center": {}, "radius": 0.6, "transform": {t}}}"#, p()),
+            format!(
+                r#"{{"type": "Rectangle", "corner": {}, "edge_u": [1, 0.2, 0], "edge_v": [0, 0.3, 1.5], "transform": {t}}}"#,
+                p()
+            ),
+            format!(
+                r#"{{"type": "Disk", "center": {}, "normal": [0.3, 1, 0.2], "radius": 0.7, "transform": {t}}}"#,
+                p()
+            ),
+            format!(
+                r#"{{"type": "Cylinder", "center": {}, "axis": [0.2, 1, 0.1], "radius": 0.4, "transform": {t}}}"#,
+                p()
+            ),
+            format!(
+                r#"{{"type": "Torus", "center": {}, "axis": [0, 1, 0.4], "major_radius": 0.8, "minor_radius": 0.2, "transform": {t}}}"#,
+                p()
+            ),
+            format!(
+                r#"{{"type": "Prism", "center": {}, "side": 1, "length": 1.5, "transform": {t}}}"#,
+                p()
+            ),
+        ];
+        shapes.extend(json.iter().map(|j| shape(j)));
+        if k == 0 {
+            shapes.push(bumpy_mesh(24, s, far));
+        }
+    }
+    shapes
+}
+
+/// Asserts `intersect` == `intersect_brute_force` (same `t` to the bit, same hit unless two
+/// primitives tie at that `t`) and `occluded` == `is_some`, for one ray.
+fn check_ray(world: &World, ray: &Ray, t_max: f64) -> Option<Hit> {
+    let a = world.intersect(ray, t_max);
+    let b = world.intersect_brute_force(ray, t_max);
+    assert_eq!(a.map(|h| h.t), b.map(|h| h.t), "{ray:?} t_max {t_max}");
+    if let (Some(a), Some(b)) = (a, b)
+        && (a.primitive, a.triangle) == (b.primitive, b.triangle)
+    {
+        assert_eq!(a, b, "{ray:?}");
+    }
+    assert_eq!(world.occluded(ray, t_max), b.is_some(), "{ray:?} t_max {t_max}");
+    b
+}
+
+#[test]
+fn f32_bvh_equals_brute_force_from_surfaces_far_away_and_at_tiny_and_huge_scales() {
+    let mut r = rng(10);
+    // (scale, distance from the origin): 1e6 and 1e7 put f32 ulps (0.06, 1) above the mesh's
+    // triangle size (0.13 s); 3e30 (beyond 1e30) takes the f64 fallback.
+    let cases = [
+        (1.0, 0.0),
+        (1.0, 1e6),
+        (1.0, 1e7),
+        (1e-6, 0.0),
+        (1e-6, 1.0),
+        (1e-6, 1e3),
+        (1e6, 0.0),
+        (1e6, 1e9),
+        (1e26, 3e30),
+    ];
+    let mut hits = 0;
+    for (s, distance) in cases {
+        let far = unit(&mut r) * distance;
+        let world = World::new(scaled_scene(&mut r, s, far)).unwrap();
+        for _ in 0..600 {
+            let origin = far + unit(&mut r) * (s * r.random_range(0.0..9.0));
+            let ray = Ray::new(origin, unit(&mut r));
+            let t_max =
+                if r.random_bool(0.2) { s * r.random_range(0.0..6.0) } else { f64::INFINITY };
+            let Some(h) = check_ray(&world, &ray, t_max) else { continue };
+            hits += 1;
+            // Rays starting on the surface just hit: bounced, transmitted, and towards a point.
+            let n = h.geometric_normal;
+            for d in [hemisphere(&mut r, n), hemisphere(&mut r, -n), reflect(ray.direction, n)] {
+                check_ray(&world, &h.spawn_ray(d), f64::INFINITY);
+            }
+            let (shadow, dist) = h.spawn_ray_to(far + unit(&mut r) * (s * 3.0));
+            check_ray(&world, &shadow, dist);
+        }
+    }
+    assert!(hits > 800, "too few hits to test anything: {hits}");
+}
+
+#[test]
+fn rays_skimming_a_dense_mesh_far_from_the_origin_match_brute_force() {
+    // Triangles of ~0.03 at 1e6 (f32 ulp 0.0625): rays aimed at vertices and edge midpoints.
+    let far = v(1e6, -1e6, 5e5);
+    let mesh = bumpy_mesh(100, 1.0, far);
+    let world = World::new(vec![mesh.clone()]).unwrap();
+    let Shape::Mesh(m) = &mesh else { unreachable!() };
+    let mut r = rng(11);
+    let mut hits = 0;
+    for k in 0..3000 {
+        let tri = m.triangles()[r.random_range(0..m.triangles().len())];
+        let p = tri.map(|i| m.positions()[i as usize]);
+        let target = match k % 3 {
+            0 => p[0],
+            1 => (p[0] + p[1]) * 0.5,
+            _ => (p[0] + p[1] + p[2]) / 3.0,
+        };
+        let origin = if k % 2 == 0 { far + unit(&mut r) * 3.0 } else { far + unit(&mut r) * 0.3 };
+        hits += usize::from(
+            check_ray(&world, &Ray::new(origin, target - origin), f64::INFINITY).is_some(),
+        );
+    }
+    assert!(hits > 2500, "{hits}");
+}
+
+#[test]
+fn occluded_equals_intersect_is_some_with_finite_distances() {
+    let mut r = rng(12);
+    let world = World::new(random_scene(&mut r, DVec3::ZERO)).unwrap();
+    let (mut blocked, mut free) = (0, 0);
+    for _ in 0..5000 {
+        let ray = Ray::new(unit(&mut r) * r.random_range(0.0..8.0), unit(&mut r));
+        let t_max = r.random_range(0.0..6.0);
+        let o = world.occluded(&ray, t_max);
+        assert_eq!(o, world.intersect(&ray, t_max).is_some(), "{ray:?} {t_max}");
+        if o { blocked += 1 } else { free += 1 }
+    }
+    assert!(blocked > 500 && free > 500, "{blocked} {free}");
+}
