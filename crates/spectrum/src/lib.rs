@@ -44,6 +44,7 @@ mod cie;
 pub mod data;
 mod error;
 mod illuminant;
+mod inverse;
 mod mixture;
 mod reflectance;
 mod spd;
@@ -57,7 +58,7 @@ pub use cie::{
 };
 pub use error::SpectrumError;
 pub use illuminant::{CieIlluminant, KNOWN_ILLUMINANTS, daylight};
-pub use mixture::{Component, Mixture};
+pub use mixture::{Component, MAX_TABLE_PANELS, Mixture};
 pub use reflectance::{Reflectance, Transmittance};
 pub use spd::{SpectralPowerDistribution, integrate_panels};
 pub use tabulated::{Binned, Tabulated};
