@@ -15,11 +15,11 @@
 //! |---|---|---|
 //! | [`Tabulated`] | piecewise linear through `(nm, value)` points | exact (cancellation-free quadratic) |
 //! | [`Binned`] | piecewise constant bins | exact |
-//! | [`Blackbody`] | Planck's law, 100 K to 10^6 K and beyond | exact (tabulated CDF + Newton) |
-//! | [`Gaussian`] | truncated Gaussian line, fwhm down to 1e-6 nm | exact (inverse normal CDF) |
+//! | [`Blackbody`] | Planck's law, 100 K to 10^6 K and beyond | exact (tabulated inverse CDF, O(1)) |
+//! | [`Gaussian`] | truncated Gaussian line, fwhm down to 1e-6 nm | exact (tabulated inverse CDF, O(1)) |
 //! | [`Monochromatic`] | a delta line | trivially exact |
 //! | [`Uniform`] | equal energy | exact |
-//! | [`Mixture`] | weighted sum of SPDs | component by power, then the component's sampler |
+//! | [`Mixture`] | weighted sum of SPDs | its own tabulated inverse CDF; with delta lines, component by power |
 //! | [`CieIlluminant`] | A, D50, D55, D65, D75, E, F1-F12 | as their shapes |
 //!
 //! The key design decision is that spectra are *normalised densities*, not radiometric
