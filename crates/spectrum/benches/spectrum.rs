@@ -1,7 +1,8 @@
 //! ns per `sample_lambda` and per `value` for every SPD type: `cargo bench -p spectrace-spectrum`.
 //!
 //! Each iteration evaluates `BATCH` uniforms (or wavelengths) drawn beforehand from a fixed seed,
-//! so the time per item is the cost of one call; `Uniform` is the peer to compare against.
+//! so the time per item is the cost of one call; `Uniform` is the peer to compare against, and the
+//! 471-point `Tabulated` the peer for the tabulated inverse CDFs (blackbody, Gaussian, mixture).
 #![allow(clippy::unwrap_used)]
 
 use divan::{Bencher, black_box, counter::ItemsCount};
@@ -16,15 +17,17 @@ fn main() {
 const BATCH: usize = 1000;
 
 /// The SPDs measured, by name.
-const NAMES: [&str; 10] = [
+const NAMES: [&str; 12] = [
     "Uniform",
     "Tabulated (471 points)",
     "Binned (47 bins)",
     "Gaussian",
     "Gaussian 1e-6 nm",
     "Monochromatic",
+    "Blackbody 2856 K",
     "Blackbody 6500 K",
     "Mixture (blackbody + line)",
+    "Mixture (blackbody + Gaussian)",
     "CIE D65",
     "CIE F11",
 ];
@@ -43,7 +46,21 @@ fn build(name: &str) -> Box<dyn SpectralPowerDistribution> {
         "Gaussian" => Box::new(Gaussian::new(550.0, 40.0).unwrap()),
         "Gaussian 1e-6 nm" => Box::new(Gaussian::new(632.8, 1e-6).unwrap()),
         "Monochromatic" => Box::new(Monochromatic::new(589.0).unwrap()),
+        "Blackbody 2856 K" => Box::new(Blackbody::new(2856.0).unwrap()),
         "Blackbody 6500 K" => Box::new(Blackbody::new(6500.0).unwrap()),
+        "Mixture (blackbody + Gaussian)" => Box::new(
+            Mixture::new(vec![
+                Component {
+                    weight: 0.8,
+                    spd: std::sync::Arc::new(Blackbody::new(3000.0).unwrap()),
+                },
+                Component {
+                    weight: 0.2,
+                    spd: std::sync::Arc::new(Gaussian::new(450.0, 20.0).unwrap()),
+                },
+            ])
+            .unwrap(),
+        ),
         "Mixture (blackbody + line)" => Box::new(
             Mixture::new(vec![
                 Component {

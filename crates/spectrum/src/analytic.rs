@@ -9,6 +9,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::{SpectrumError, check_range};
+use crate::inverse::{InverseCdf, Shape};
 use crate::spd::SpectralPowerDistribution;
 
 /// Default lower end of the analytic spectra's range (nm): where the CIE 1931 tables start.
@@ -89,9 +90,10 @@ impl SpectralPowerDistribution for Uniform {
 }
 
 /// A Gaussian line (laser lines, LEDs) truncated to `[min_nm, max_nm]` and normalised over it;
-/// sampled exactly through the inverse normal CDF, stable down to `fwhm_nm = 1e-6` and for
-/// centres outside the range (as long as some mass lies inside it).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+/// sampled exactly through a tabulated inverse CDF of the truncated standard normal (built by the
+/// constructor, see [`crate::inverse`]), stable down to `fwhm_nm = 1e-6` and for centres outside
+/// the range (as long as some mass lies inside it).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "GaussianRepr", into = "GaussianRepr")]
 pub struct Gaussian {
     center_nm: f64,
@@ -104,6 +106,14 @@ pub struct Gaussian {
     b: f64,
     /// Mass of the standard normal inside `[a, b]`.
     mass: f64,
+    /// Inverse CDF of the standard normal truncated to `[a, b]` (never serialised:
+    /// deserialisation goes through [`Gaussian::with_range`]).
+    sampler: InverseCdf,
+}
+
+/// `ln` of the standard normal density, up to a constant.
+fn ln_standard_normal(z: f64) -> f64 {
+    -0.5 * z * z
 }
 
 /// Scene-file form of [`Gaussian`].
@@ -186,7 +196,27 @@ impl Gaussian {
                 "the line has no representable mass inside [min_nm, max_nm]",
             ));
         }
-        Ok(Self { center_nm, fwhm_nm, min_nm, max_nm, sigma, a, b, mass })
+        // The peak of the truncated normal, and its width: 1 inside, the decay length 1 / |z|
+        // at a peak on a range end far in the tail.
+        let mode = 0.0_f64.clamp(a, b);
+        let scale = 1.0 / mode.abs().max(1.0);
+        let d_ln_f = |z: f64| -z;
+        let shape = Shape {
+            ln_f: &ln_standard_normal,
+            min: a,
+            max: b,
+            mode,
+            scale,
+            extra: &[],
+            d_ln_f: Some(&d_ln_f),
+        };
+        let sampler = InverseCdf::new(&shape).ok_or(SpectrumError::parameter(
+            S,
+            "center_nm",
+            center_nm,
+            "the line has no representable mass inside [min_nm, max_nm]",
+        ))?;
+        Ok(Self { center_nm, fwhm_nm, min_nm, max_nm, sigma, a, b, mass, sampler })
     }
 
     /// Centre wavelength (nm).
@@ -203,16 +233,7 @@ impl Gaussian {
 #[typetag::serde]
 impl SpectralPowerDistribution for Gaussian {
     fn sample_lambda(&self, u: f64) -> f64 {
-        let u = crate::unit(u);
-        // Work in the tail that keeps precision: for the lower half of the mass measure from
-        // the lower end, for the upper half from the upper end.
-        let z = if u < 0.5 {
-            let p = lower_tail(self.a) + u * self.mass;
-            normal_quantile(p.max(f64::MIN_POSITIVE))
-        } else {
-            let q = upper_tail(self.b) + (1.0 - u) * self.mass;
-            -normal_quantile(q.max(f64::MIN_POSITIVE))
-        };
+        let z = self.sampler.sample(&ln_standard_normal, u);
         (self.center_nm + self.sigma * z.clamp(self.a, self.b)).clamp(self.min_nm, self.max_nm)
     }
     fn value(&self, lambda: f64) -> f64 {
@@ -250,72 +271,6 @@ fn normal_mass(a: f64, b: f64) -> f64 {
         lower_tail(b) - lower_tail(a)
     } else {
         1.0 - lower_tail(a) - upper_tail(b)
-    }
-}
-
-/// The standard normal quantile `z` with `P(Z < z) = p`, for `p` in `(0, 1)`: Acklam's rational
-/// approximation (relative error 1.2e-9) refined by one Halley step on `erfc`, which brings it to
-/// full double precision.
-pub(crate) fn normal_quantile(p: f64) -> f64 {
-    const A: [f64; 6] = [
-        -3.969_683_028_665_376e1,
-        2.209_460_984_245_205e2,
-        -2.759_285_104_469_687e2,
-        1.383_577_518_672_69e2,
-        -3.066_479_806_614_716e1,
-        2.506_628_277_459_239,
-    ];
-    const B: [f64; 5] = [
-        -5.447_609_879_822_406e1,
-        1.615_858_368_580_409e2,
-        -1.556_989_798_598_866e2,
-        6.680_131_188_771_972e1,
-        -1.328_068_155_288_572e1,
-    ];
-    const C: [f64; 6] = [
-        -7.784_894_002_430_293e-3,
-        -3.223_964_580_411_365e-1,
-        -2.400_758_277_161_838,
-        -2.549_732_539_343_734,
-        4.374_664_141_464_968,
-        2.938_163_982_698_783,
-    ];
-    const D: [f64; 4] = [
-        7.784_695_709_041_462e-3,
-        3.224_671_290_700_398e-1,
-        2.445_134_137_142_996,
-        3.754_408_661_907_416,
-    ];
-    const P_LOW: f64 = 0.024_25;
-    if !(p > 0.0) {
-        return f64::NEG_INFINITY;
-    }
-    if !(p < 1.0) {
-        return f64::INFINITY;
-    }
-    let x = if p < P_LOW {
-        let q = (-2.0 * p.ln()).sqrt();
-        (((((C[0] * q + C[1]) * q + C[2]) * q + C[3]) * q + C[4]) * q + C[5])
-            / ((((D[0] * q + D[1]) * q + D[2]) * q + D[3]) * q + 1.0)
-    } else if p <= 1.0 - P_LOW {
-        let q = p - 0.5;
-        let r = q * q;
-        (((((A[0] * r + A[1]) * r + A[2]) * r + A[3]) * r + A[4]) * r + A[5]) * q
-            / (((((B[0] * r + B[1]) * r + B[2]) * r + B[3]) * r + B[4]) * r + 1.0)
-    } else {
-        let q = (-2.0 * (1.0 - p).ln()).sqrt();
-        -(((((C[0] * q + C[1]) * q + C[2]) * q + C[3]) * q + C[4]) * q + C[5])
-            / ((((D[0] * q + D[1]) * q + D[2]) * q + D[3]) * q + 1.0)
-    };
-    // One Halley step on f(x) = Phi(x) - p, with Phi from erfc (accurate in the lower tail; for
-    // the upper tail measure the error from 1 - p instead).
-    let e = if x <= 0.0 { lower_tail(x) - p } else { (1.0 - p) - upper_tail(x) };
-    let density = (-0.5 * x * x).exp() / std::f64::consts::TAU.sqrt();
-    if density > 0.0 && e.is_finite() {
-        let u = e / density;
-        x - u / (1.0 + 0.5 * x * u)
-    } else {
-        x
     }
 }
 
@@ -397,17 +352,6 @@ impl SpectralPowerDistribution for Monochromatic {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn normal_quantile_inverts_the_cdf_to_full_precision() {
-        for p in [1e-300, 1e-20, 1e-5, 0.01, 0.2, 0.5, 0.7, 0.975, 0.999_999] {
-            let z = normal_quantile(p);
-            let back = lower_tail(z);
-            assert!(((back - p) / p).abs() < 1e-13, "p = {p}: z = {z}, Phi(z) = {back}");
-        }
-        assert!((normal_quantile(0.975) - 1.959_963_984_540_054).abs() < 1e-14);
-        assert_eq!(normal_quantile(0.5), 0.0);
-    }
 
     #[test]
     fn normal_mass_is_accurate_in_both_tails() {

@@ -1,5 +1,5 @@
-//! [`Blackbody`]: Planck's law at a temperature, normalised over a wavelength range, and the
-//! exact inverse-CDF sampler for smooth densities that it uses.
+//! [`Blackbody`]: Planck's law at a temperature, normalised over a wavelength range, sampled
+//! exactly through the tabulated inverse CDF of [`crate::inverse`].
 //!
 //! | type | JSON | parameters (default) |
 //! |---|---|---|
@@ -10,14 +10,25 @@
 //! tiny); any positive finite temperature gives a finite, normalised spectrum.
 
 use serde::{Deserialize, Serialize};
-use spectrace_sampling::{Discrete, linear_segment_inverse};
 
 use crate::analytic::{DEFAULT_MAX_NM, DEFAULT_MIN_NM};
 use crate::error::{SpectrumError, check_range};
-use crate::spd::{SpectralPowerDistribution, gauss_legendre};
+use crate::inverse::{InverseCdf, Shape};
+use crate::spd::SpectralPowerDistribution;
 
 /// Second radiation constant `c2 = h c / k_B` in nm K (CODATA 2018: 1.438776877e-2 m K).
 pub const PLANCK_C2_NM_K: f64 = 1.438_776_877e7;
+
+/// `d/d lambda` of [`ln_planck`]: `(x / (1 - e^-x) - 5) / lambda` with `x = c2 / (lambda T)`.
+fn d_ln_planck(lambda_nm: f64, kelvin: f64, c2: f64) -> f64 {
+    let x = c2 / (lambda_nm * kelvin);
+    // x / (1 - e^-x) -> 1 as x -> 0 (the Rayleigh-Jeans limit); -expm1(-x) keeps it accurate.
+    let ratio = if x > 0.0 { x / -(-x).exp_m1() } else { 1.0 };
+    (ratio - 5.0) / lambda_nm
+}
+
+/// The root of `x = 5 (1 - e^-x)`: Planck's law in wavelength peaks at `c2 / (WIEN_X T)`.
+const WIEN_X: f64 = 4.965_114_231_744_276;
 
 /// `ln` of Planck's spectral radiance up to a constant: `-5 ln(lambda) - ln(expm1(c2 / (lambda T)))`.
 fn ln_planck(lambda_nm: f64, kelvin: f64, c2: f64) -> f64 {
@@ -25,91 +36,6 @@ fn ln_planck(lambda_nm: f64, kelvin: f64, c2: f64) -> f64 {
     // ln(expm1(x)) = x + ln(1 - e^-x) for large x (no overflow); ln(expm1(x)) directly otherwise.
     let ln_em1 = if x > 30.0 { x + (-(-x).exp()).ln_1p() } else { x.exp_m1().ln() };
     -5.0 * lambda_nm.ln() - ln_em1
-}
-
-/// A normalised smooth density on `[min, max]`, sampled exactly: the CDF is tabulated on a fine grid
-/// by Gauss-Legendre quadrature, the segment is found by bisection, and inside it a first guess
-/// from the linear interpolation of the density is refined by safeguarded Newton steps on the
-/// exact in-segment CDF.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct SmoothSampler {
-    grid: Vec<f64>,
-    segments: Discrete,
-    /// Density at each grid point, normalised.
-    node_density: Vec<f64>,
-    /// The normalisation constant subtracted in log space (`ln` of the integral).
-    ln_norm: f64,
-}
-
-impl SmoothSampler {
-    /// Tabulates `exp(ln_f)` on `[min, max]` with roughly `step` nm between grid points.
-    pub(crate) fn new(ln_f: &dyn Fn(f64) -> f64, min: f64, max: f64, step: f64) -> Option<Self> {
-        let n = (((max - min) / step).ceil() as usize).clamp(8, 1 << 20);
-        let grid: Vec<f64> = (0..=n)
-            .map(|i| if i == n { max } else { min + (max - min) * i as f64 / n as f64 })
-            .collect();
-        // Work relative to the largest value on the grid so nothing overflows or underflows.
-        let peak = grid.iter().map(|&l| ln_f(l)).fold(f64::NEG_INFINITY, f64::max);
-        if !peak.is_finite() {
-            return None;
-        }
-        let rel = |l: f64| (ln_f(l) - peak).exp();
-        let masses: Vec<f64> = grid.windows(2).map(|p| gauss_legendre(&rel, p[0], p[1])).collect();
-        let segments = Discrete::new(&masses).ok()?;
-        let integral = segments.total();
-        let ln_norm = peak + integral.ln();
-        let node_density = grid.iter().map(|&l| (ln_f(l) - ln_norm).exp()).collect();
-        Some(Self { grid, segments, node_density, ln_norm })
-    }
-
-    /// The normalised density at `lambda` given the unnormalised log-density there.
-    pub(crate) fn density(&self, ln_f_at_lambda: f64) -> f64 {
-        (ln_f_at_lambda - self.ln_norm).exp()
-    }
-
-    /// Inverse CDF.
-    pub(crate) fn sample(&self, ln_f: &dyn Fn(f64) -> f64, u: f64) -> f64 {
-        let (i, s) = self.segments.sample_remapped(u);
-        let (x0, x1) = (self.grid[i], self.grid[i + 1]);
-        let width = x1 - x0;
-        let target = s * self.segments.pmf(i); // mass to cover inside the segment (normalised)
-        let pdf = |l: f64| (ln_f(l) - self.ln_norm).exp();
-        // First guess: the exact inverse of the linear interpolation of the density.
-        let t = linear_segment_inverse(self.node_density[i], self.node_density[i + 1], s);
-        let (mut lo, mut hi) = (x0, x1);
-        let mut x = x0 + t * width;
-        // On a 0.25 nm grid the linear guess is off by ~1e-6 of the segment; Newton converges
-        // quadratically, so one or two steps reach the quadrature's precision.
-        for _ in 0..64 {
-            let g = gauss_legendre(&pdf, x0, x) - target;
-            if g == 0.0 {
-                break;
-            }
-            if g > 0.0 {
-                hi = x
-            } else {
-                lo = x
-            }
-            let d = pdf(x);
-            let newton = if d > 0.0 { x - g / d } else { f64::NAN };
-            if newton == x {
-                // The correction is below one ulp of x: converged.
-                break;
-            }
-            // Keep Newton inside the bracket; bisect when it leaves it (always converges).
-            let (next, was_newton) =
-                if newton > lo && newton < hi { (newton, true) } else { (0.5 * (lo + hi), false) };
-            let step = (next - x).abs();
-            x = next;
-            // Newton's error after a step of size h is about |f' / 2f| h^2, and |f' / f| < 2 per
-            // nm for Planck's law above 100 K in 360-830 nm: a Newton step below 1e-4 of the
-            // 0.25 nm segment leaves an error under 1e-9 nm, below the quadrature's precision.
-            if (was_newton && step <= 1e-4 * width) || hi - lo <= 4.0 * f64::EPSILON * hi.abs() {
-                break;
-            }
-        }
-        x.clamp(x0, x1)
-    }
 }
 
 /// Planck's blackbody spectrum at `kelvin`, normalised over `[min_nm, max_nm]`.
@@ -121,7 +47,9 @@ pub struct Blackbody {
     max_nm: f64,
     /// `c2` in nm K: Planck's constant for a physical blackbody, 1.435e7 for CIE illuminant A.
     c2: f64,
-    sampler: SmoothSampler,
+    /// The inverse CDF, built by the constructor (never serialised: deserialisation goes through
+    /// [`Blackbody::with_range`]).
+    sampler: InverseCdf,
 }
 
 /// Scene-file form of [`Blackbody`].
@@ -191,13 +119,28 @@ impl Blackbody {
             ));
         }
         check_range(spectrum, min_nm, max_nm)?;
-        let sampler = SmoothSampler::new(&|l| ln_planck(l, kelvin, c2), min_nm, max_nm, 0.25)
-            .ok_or(SpectrumError::parameter(
-                spectrum,
-                "kelvin",
-                kelvin,
-                "the spectrum cannot be normalised over the range",
-            ))?;
+        let ln_f = |l: f64| ln_planck(l, kelvin, c2);
+        // Planck's law peaks where x = c2 / (lambda T) solves x = 5 (1 - e^-x) (Wien).
+        let mode = (c2 / (WIEN_X * kelvin)).clamp(min_nm, max_nm);
+        // |d ln f / d lambda| <= 5 / lambda + c2 / (lambda^2 T): its inverse is the shortest
+        // length over which the density can change by a factor e near the mode.
+        let scale = 1.0 / (5.0 / mode + c2 / (mode * mode * kelvin));
+        let d_ln_f = |l: f64| d_ln_planck(l, kelvin, c2);
+        let shape = Shape {
+            ln_f: &ln_f,
+            min: min_nm,
+            max: max_nm,
+            mode,
+            scale,
+            extra: &[],
+            d_ln_f: Some(&d_ln_f),
+        };
+        let sampler = InverseCdf::new(&shape).ok_or(SpectrumError::parameter(
+            spectrum,
+            "kelvin",
+            kelvin,
+            "the spectrum cannot be normalised over the range",
+        ))?;
         Ok(Self { kelvin, min_nm, max_nm, c2, sampler })
     }
 

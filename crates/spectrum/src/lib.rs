@@ -15,11 +15,11 @@
 //! |---|---|---|
 //! | [`Tabulated`] | piecewise linear through `(nm, value)` points | exact (cancellation-free quadratic) |
 //! | [`Binned`] | piecewise constant bins | exact |
-//! | [`Blackbody`] | Planck's law, 100 K to 10^6 K and beyond | exact (tabulated CDF + Newton) |
-//! | [`Gaussian`] | truncated Gaussian line, fwhm down to 1e-6 nm | exact (inverse normal CDF) |
+//! | [`Blackbody`] | Planck's law, 100 K to 10^6 K and beyond | exact (tabulated inverse CDF, O(1)) |
+//! | [`Gaussian`] | truncated Gaussian line, fwhm down to 1e-6 nm | exact (tabulated inverse CDF, O(1)) |
 //! | [`Monochromatic`] | a delta line | trivially exact |
 //! | [`Uniform`] | equal energy | exact |
-//! | [`Mixture`] | weighted sum of SPDs | component by power, then the component's sampler |
+//! | [`Mixture`] | weighted sum of SPDs | its own tabulated inverse CDF; with delta lines, component by power |
 //! | [`CieIlluminant`] | A, D50, D55, D65, D75, E, F1-F12 | as their shapes |
 //!
 //! The key design decision is that spectra are *normalised densities*, not radiometric
@@ -44,6 +44,7 @@ mod cie;
 pub mod data;
 mod error;
 mod illuminant;
+mod inverse;
 mod mixture;
 mod reflectance;
 mod spd;
@@ -57,7 +58,7 @@ pub use cie::{
 };
 pub use error::SpectrumError;
 pub use illuminant::{CieIlluminant, KNOWN_ILLUMINANTS, daylight};
-pub use mixture::{Component, Mixture};
+pub use mixture::{Component, MAX_TABLE_PANELS, Mixture};
 pub use reflectance::{Reflectance, Transmittance};
 pub use spd::{SpectralPowerDistribution, integrate_panels};
 pub use tabulated::{Binned, Tabulated};

@@ -14,6 +14,7 @@ use serde::{Deserialize, Serialize};
 use spectrace_sampling::Discrete;
 
 use crate::error::SpectrumError;
+use crate::inverse::{InverseCdf, Shape};
 use crate::spd::SpectralPowerDistribution;
 
 /// One component of a [`Mixture`]: a relative power weight and a spectrum.
@@ -26,15 +27,27 @@ pub struct Component {
     pub spd: Arc<dyn SpectralPowerDistribution>,
 }
 
-/// A weighted sum of spectra, sampled by choosing a component in proportion to its weight and then
-/// sampling it with the same uniform, remapped.
+/// A weighted sum of spectra.
+///
+/// Without delta lines it is sampled by its own exact inverse CDF, tabulated by the constructor
+/// (see [`crate::inverse`]; monotone in `u`, one table lookup per sample). With a delta line, or
+/// when that table would exceed [`MAX_TABLE_PANELS`] panels (components with hundreds of kinks),
+/// it chooses a component in proportion to its weight and samples it with the same uniform,
+/// remapped (exact in distribution, but not monotone in `u`).
 #[derive(Debug, Deserialize)]
 #[serde(try_from = "MixtureRepr")]
 pub struct Mixture {
     components: Vec<Component>,
     choice: Discrete,
     range: (f64, f64),
+    /// The mixture's inverse CDF (never serialised: deserialisation goes through
+    /// [`Mixture::new`]); `None` when sampling by component.
+    inverse: Option<InverseCdf>,
 }
+
+/// Largest inverse-CDF table a mixture builds (about 60 bytes a panel); beyond it the mixture
+/// samples by component.
+pub const MAX_TABLE_PANELS: usize = 1024;
 
 /// Scene-file form of [`Mixture`].
 #[derive(Deserialize)]
@@ -78,7 +91,49 @@ impl Mixture {
             .filter(|(_, w)| **w > 0.0)
             .map(|(c, _)| c.spd.range())
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (lo, hi)| (a.min(lo), b.max(hi)));
-        Ok(Self { components, choice, range })
+        let mut mixture = Self { components, choice, range, inverse: None };
+        mixture.inverse = mixture.build_inverse();
+        Ok(mixture)
+    }
+
+    /// The mixture's inverse-CDF table, if it has no delta line and the table stays small.
+    fn build_inverse(&self) -> Option<InverseCdf> {
+        let (min, max) = self.range;
+        let active =
+            || self.components.iter().enumerate().filter(|(i, _)| self.choice.pmf(*i) > 0.0);
+        if !(min < max) || active().any(|(_, c)| c.spd.is_delta()) {
+            return None;
+        }
+        // Panel edges at every component's kinks and range ends; the mode at the highest of
+        // those and of a coarse grid.
+        let mut extra = self.breakpoints();
+        for (_, c) in active() {
+            let (lo, hi) = c.spd.range();
+            extra.extend([lo, hi]);
+        }
+        let ln_f = |l: f64| self.value(l).ln();
+        let grid = (0..=64).map(|k| min + (max - min) * k as f64 / 64.0);
+        let mode = grid
+            .chain(extra.iter().copied())
+            .filter(|x| (min..=max).contains(x))
+            .max_by(|a, b| self.value(*a).total_cmp(&self.value(*b)))
+            .unwrap_or(min);
+        let shape = Shape {
+            ln_f: &ln_f,
+            min,
+            max,
+            mode,
+            scale: (max - min) / 64.0,
+            extra: &extra,
+            d_ln_f: None,
+        };
+        InverseCdf::new(&shape).filter(|t| t.len() <= MAX_TABLE_PANELS)
+    }
+
+    /// `true` if the mixture samples through its own inverse CDF (monotone in `u`), `false` if
+    /// it samples by component (it has a delta line, or too many kinks for a small table).
+    pub fn has_inverse_cdf(&self) -> bool {
+        self.inverse.is_some()
     }
 
     /// The components.
@@ -90,7 +145,10 @@ impl Mixture {
 #[typetag::serde]
 impl SpectralPowerDistribution for Mixture {
     fn sample_lambda(&self, u: f64) -> f64 {
-        let (i, v) = self.choice.sample_remapped(crate::unit(u));
+        if let Some(inverse) = &self.inverse {
+            return inverse.sample(&|l| self.value(l).ln(), u);
+        }
+        let (i, v) = self.choice.sample_remapped(spectrace_sampling::clamp_uniform(u));
         self.components[i].spd.sample_lambda(v)
     }
     fn value(&self, lambda: f64) -> f64 {

@@ -440,3 +440,192 @@ fn blackbody_sampling_inverts_its_exact_cdf() {
         }
     }
 }
+
+/// Adaptive Simpson with Richardson correction on `[a, b]`, to `tol` absolute.
+#[allow(clippy::too_many_arguments)]
+fn adaptive_simpson(
+    f: &dyn Fn(f64) -> f64,
+    a: f64,
+    b: f64,
+    fa: f64,
+    fm: f64,
+    fb: f64,
+    whole: f64,
+    tol: f64,
+    depth: u32,
+) -> f64 {
+    let m = 0.5 * (a + b);
+    let (lm, rm) = (0.5 * (a + m), 0.5 * (m + b));
+    let (flm, frm) = (f(lm), f(rm));
+    let left = (m - a) / 6.0 * (fa + 4.0 * flm + fm);
+    let right = (b - m) / 6.0 * (fm + 4.0 * frm + fb);
+    let delta = left + right - whole;
+    // The tolerance halves with each level but never drops below the rounding of the sum itself.
+    let floor = 1e-15 * (left + right).abs();
+    if depth == 0 || delta.abs() <= 15.0 * tol.max(floor) || !(lm > a && rm < b) {
+        return left + right + delta / 15.0;
+    }
+    adaptive_simpson(f, a, m, fa, flm, fm, left, tol / 2.0, depth - 1)
+        + adaptive_simpson(f, m, b, fm, frm, fb, right, tol / 2.0, depth - 1)
+}
+
+/// The CDF of `spd` at `x`, independent of the crate's quadrature and tables: adaptive Simpson
+/// of `value` from the range's start to `x`, on pieces split at the SPD's breakpoints and at 256
+/// equal steps of the range (one-sided values at the piece ends, for jumps).
+fn exact_cdf(spd: &dyn SpectralPowerDistribution, x: f64) -> f64 {
+    let (min, max) = spd.range();
+    let x = x.clamp(min, max);
+    let mut cuts: Vec<f64> = spd.breakpoints();
+    cuts.extend((0..=256).map(|k| min + (max - min) * k as f64 / 256.0));
+    cuts.extend([min, x]);
+    cuts.retain(|&c| c >= min && c <= x);
+    cuts.sort_by(f64::total_cmp);
+    cuts.dedup();
+    let f = |l: f64| spd.value(l);
+    let mut total = 0.0;
+    for p in cuts.windows(2) {
+        let (a, b) = (p[0], p[1]);
+        let (fa, fm, fb) = (f(a.next_up().min(b)), f(0.5 * (a + b)), f(b.next_down().max(a)));
+        let whole = (b - a) / 6.0 * (fa + 4.0 * fm + fb);
+        total += adaptive_simpson(&f, a, b, fa, fm, fb, whole, 1e-14, 40);
+    }
+    total
+}
+
+/// `|exact_cdf(sample(u)) - u|` must stay within 1e-9 plus the CDF's step between adjacent floats
+/// at the sample (which exceeds 1e-9 only for lines narrower than ~1e-4 nm).
+fn assert_inverts(spd: &dyn SpectralPowerDistribution, u: f64) -> Result<(), TestCaseError> {
+    let x = spd.sample_lambda(u);
+    let (min, max) = spd.range();
+    prop_assert!(x >= min && x <= max, "{x} outside [{min}, {max}]");
+    let cdf = exact_cdf(spd, x);
+    let float_step = spd.value(x) * (x.next_up() - x);
+    prop_assert!(
+        (cdf - u).abs() <= 1e-9 + 2.0 * float_step,
+        "u = {u}: sample {x}, exact cdf {cdf}, error {:e}",
+        cdf - u
+    );
+    Ok(())
+}
+
+/// `u` with the ends of the unit interval over-represented.
+fn any_u() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        Just(0.0),
+        Just(spectrace_sampling::ONE_MINUS_EPSILON),
+        Just(1.0 - 1e-12),
+        (-30.0..0.0f64).prop_map(|e| 10f64.powf(e)),
+        (-30.0..0.0f64).prop_map(|e| 1.0 - 10f64.powf(e)),
+        0.0..1.0f64,
+    ]
+    .prop_map(|u| u.min(spectrace_sampling::ONE_MINUS_EPSILON))
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 150, failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// Blackbodies from 100 K to 1e6 K over ranges from 0.01 nm to 5000 nm wide, anywhere from
+    /// 50 nm to 10 um (the peak inside, or far in either tail): the sample inverts the exact CDF.
+    #[test]
+    fn prop_blackbody_sampling_inverts_the_exact_cdf(
+        log_k in 2.0..6.0f64, log_min in 1.7..4.0f64, log_width in -2.0..3.7f64, u in any_u(),
+    ) {
+        let (min, width) = (10f64.powf(log_min), 10f64.powf(log_width));
+        let b = Blackbody::with_range(10f64.powf(log_k), min, min + width).unwrap();
+        assert_inverts(&b, u)?;
+    }
+
+    /// The default range at any temperature from 100 K to 1e6 K.
+    #[test]
+    fn prop_blackbody_default_range_inverts_the_exact_cdf(log_k in 2.0..6.0f64, u in any_u()) {
+        assert_inverts(&Blackbody::new(10f64.powf(log_k)).unwrap(), u)?;
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 150, failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// Gaussian lines from 1e-3 nm to 1e4 nm wide, centred anywhere from 200 nm to 1000 nm (so
+    /// also far outside the range, in either tail), over the default range.
+    #[test]
+    fn prop_gaussian_sampling_inverts_the_exact_cdf(
+        center in 200.0..1000.0f64, log_fwhm in -3.0..4.0f64, u in any_u(),
+    ) {
+        let fwhm = 10f64.powf(log_fwhm);
+        // Keep to lines with some mass inside the range (the constructor refuses the others).
+        if let Ok(g) = Gaussian::new(center, fwhm) {
+            assert_inverts(&g, u)?;
+        }
+    }
+
+    /// Blackbody plus Gaussian mixtures, the line's weight from 1e-12 to 1e2 of the body's: the
+    /// mixture has its own inverse CDF (monotone in u), and the sample inverts the exact CDF.
+    #[test]
+    fn prop_mixture_sampling_inverts_the_exact_cdf(
+        log_k in 2.5..5.0f64, center in 380.0..800.0f64, log_fwhm in -2.0..2.0f64,
+        log_weight in -12.0..2.0f64, u in any_u(),
+    ) {
+        let m = Mixture::new(vec![
+            Component { weight: 1.0, spd: std::sync::Arc::new(Blackbody::new(10f64.powf(log_k)).unwrap()) },
+            Component {
+                weight: 10f64.powf(log_weight),
+                spd: std::sync::Arc::new(Gaussian::new(center, 10f64.powf(log_fwhm)).unwrap()),
+            },
+        ])
+        .unwrap();
+        prop_assert!(m.has_inverse_cdf());
+        assert_inverts(&m, u)?;
+    }
+}
+
+#[test]
+fn sampling_is_monotone_and_tolerates_bad_uniforms() {
+    // NaN and out-of-range u are clamped (NaN to 0) by the tabulated samplers, never a panic or
+    // a NaN wavelength; and the samples are non-decreasing in u.
+    let spds: Vec<Box<dyn SpectralPowerDistribution>> = vec![
+        Box::new(Blackbody::new(2856.0).unwrap()),
+        Box::new(Gaussian::new(550.0, 40.0).unwrap()),
+        Box::new(
+            Mixture::new(vec![
+                Component {
+                    weight: 1.0,
+                    spd: std::sync::Arc::new(Blackbody::new(3000.0).unwrap()),
+                },
+                Component {
+                    weight: 1e-12,
+                    spd: std::sync::Arc::new(Gaussian::new(450.0, 10.0).unwrap()),
+                },
+            ])
+            .unwrap(),
+        ),
+    ];
+    for spd in &spds {
+        let (min, max) = spd.range();
+        assert_eq!(spd.sample_lambda(f64::NAN), spd.sample_lambda(0.0), "{:?}", spd.range());
+        assert_eq!(spd.sample_lambda(-1.0), min);
+        let top = spd.sample_lambda(2.0);
+        assert!(top <= max && top > min);
+        let mut previous = min;
+        for k in 0..=100_000 {
+            let l = spd
+                .sample_lambda((k as f64 / 100_000.0).min(spectrace_sampling::ONE_MINUS_EPSILON));
+            assert!(l >= previous, "{l} after {previous} at step {k}");
+            previous = l;
+        }
+    }
+}
+
+#[test]
+fn tables_are_built_by_deserialisation_and_not_serialised() {
+    let b: Box<dyn SpectralPowerDistribution> =
+        serde_json::from_str(r#"{"type": "Blackbody", "kelvin": 2856}"#).unwrap();
+    let direct = Blackbody::new(2856.0).unwrap();
+    for k in 0..100 {
+        let u = k as f64 / 100.0;
+        assert_eq!(b.sample_lambda(u), direct.sample_lambda(u));
+    }
+    let json = serde_json::to_string(&b).unwrap();
+    assert_eq!(json, r#"{"type":"Blackbody","kelvin":2856.0,"min_nm":360.0,"max_nm":830.0}"#);
+    let g = serde_json::to_string(&Gaussian::new(550.0, 40.0).unwrap()).unwrap();
+    assert_eq!(g, r#"{"center_nm":550.0,"fwhm_nm":40.0,"min_nm":360.0,"max_nm":830.0}"#);
+}
