@@ -1,4 +1,5 @@
-//! [`World`]: all shapes in one BVH (built by `obvhs`), traversed in f64.
+//! [`World`]: all shapes in one BVH (built by `obvhs`), traversed in f32 with conservatively
+//! rounded boxes (see `bvh.rs`); every primitive test runs in f64.
 
 use std::path::Path;
 use std::time::Duration;
