@@ -13,7 +13,8 @@
 //! from the node) at five interior points, is below [`TOLERANCE`] in `u`; otherwise it is split
 //! into as many equal pieces as the sixth-power error law says are needed, recursively. A panel
 //! whose whole mass is below [`NEGLIGIBLE`] needs no interpolant (any point in it is within that
-//! mass of the right `u`). A panel that still fails after [`MAX_SPLITS`] splits is flagged and
+//! mass of the right `u`). A panel that still fails after [`MAX_SPLITS`] levels of splitting, or
+//! once the table holds [`MAX_PANELS`] panels, is flagged and
 //! sampled at run time by safeguarded Newton steps on its exact CDF (a safety net: none of the
 //! tables measured while writing this needed it).
 //!
@@ -33,8 +34,13 @@ pub(crate) const TOLERANCE: f64 = 1e-10;
 /// further than this from the right `u`.
 pub(crate) const NEGLIGIBLE: f64 = 1e-13;
 
-/// Most bisections of one quadrature panel before it is flagged for the exact run-time fallback.
-const MAX_SPLITS: u32 = 40;
+/// Most levels of splitting of one quadrature panel before it is flagged for the exact run-time
+/// fallback.
+const MAX_SPLITS: u32 = 16;
+
+/// Most panels in a table: past it, failing panels are flagged instead of split (densities whose
+/// own rounding exceeds [`TOLERANCE`], e.g. Planck's law at 1e-5 K, where `ln f` is ~1e9).
+pub(crate) const MAX_PANELS: usize = 1024;
 
 /// Most bisections of one initial panel by the adaptive quadrature.
 const MAX_QUADRATURE_SPLITS: u32 = 60;
@@ -166,6 +172,7 @@ impl InverseCdf {
                 let halves = left + right;
                 if (whole - halves).abs() <= tol
                     || depth >= MAX_QUADRATURE_SPLITS
+                    || quad.len() + stack.len() >= MAX_PANELS
                     || !(mid > a && mid < b)
                 {
                     quad.push((a, b, halves));
@@ -203,7 +210,8 @@ impl InverseCdf {
                     }
                     Err(pieces) => {
                         let mid = 0.5 * (a + b);
-                        if depth >= MAX_SPLITS || !(mid > a && mid < b) {
+                        let budget = quad.len() + panels.len() + stack.len() + pieces;
+                        if depth >= MAX_SPLITS || budget > MAX_PANELS || !(mid > a && mid < b) {
                             us.push(u_a);
                             panels.push(Panel::linear(a, b, u_b - u_a, true));
                         } else {
@@ -250,6 +258,11 @@ impl InverseCdf {
     /// The number of panels.
     pub(crate) fn len(&self) -> usize {
         self.panels.len() - 1
+    }
+
+    /// `true` if every panel is interpolated (none falls back to Newton on the exact CDF).
+    pub(crate) fn is_interpolated(&self) -> bool {
+        !self.panels.iter().any(Panel::exact)
     }
 
     /// Inverse CDF at `u` (NaN or out-of-range `u` is clamped into `[0, 1)`, NaN to 0); `ln_f`

@@ -33,7 +33,8 @@ pub struct Component {
 /// (see [`crate::inverse`]; monotone in `u`, one table lookup per sample). With a delta line, or
 /// when that table would exceed [`MAX_TABLE_PANELS`] panels (components with hundreds of kinks),
 /// it chooses a component in proportion to its weight and samples it with the same uniform,
-/// remapped (exact in distribution, but not monotone in `u`).
+/// remapped (exact in distribution, but not monotone in `u`); so it does too if some panel of the
+/// table could not be interpolated to the tolerance.
 #[derive(Debug, Deserialize)]
 #[serde(try_from = "MixtureRepr")]
 pub struct Mixture {
@@ -47,7 +48,7 @@ pub struct Mixture {
 
 /// Largest inverse-CDF table a mixture builds (about 60 bytes a panel); beyond it the mixture
 /// samples by component.
-pub const MAX_TABLE_PANELS: usize = 1024;
+pub const MAX_TABLE_PANELS: usize = 512;
 
 /// Scene-file form of [`Mixture`].
 #[derive(Deserialize)]
@@ -127,7 +128,7 @@ impl Mixture {
             extra: &extra,
             d_ln_f: None,
         };
-        InverseCdf::new(&shape).filter(|t| t.len() <= MAX_TABLE_PANELS)
+        InverseCdf::new(&shape).filter(|t| t.len() <= MAX_TABLE_PANELS && t.is_interpolated())
     }
 
     /// `true` if the mixture samples through its own inverse CDF (monotone in `u`), `false` if

@@ -219,6 +219,7 @@ fn blackbody_chromaticities_follow_the_planckian_locus() {
 fn extreme_parameters_stay_finite() {
     let mut rng = Pcg64::seed_from_u64(9);
     let spds: Vec<Box<dyn SpectralPowerDistribution>> = vec![
+        Box::new(Blackbody::new(2.772e-5).unwrap()),
         Box::new(Blackbody::new(1.0).unwrap()),
         Box::new(Blackbody::new(100.0).unwrap()),
         Box::new(Blackbody::new(1e6).unwrap()),
