@@ -253,6 +253,12 @@ trait Slab {
     fn alive(&self, near: Self::T) -> bool;
 }
 
+/// Relative widening of the fast per-ray bounds (see [`SlabF32::new`]): four f32 half-ulps.
+const FAST_REL: f32 = 1.0 / (1u32 << 22) as f32;
+/// Smallest `1/|d|` the fast bounds take: well inside the normal f32 range (smaller ones would
+/// round to subnormals, whose relative error the widening does not cover).
+const FAST_INV_MIN: f64 = 1e-30;
+
 /// `x` rounded to f32 downwards (so the result is `<= x`; NaN stays NaN).
 fn f32_down(x: f64) -> f32 {
     let f = x as f32;
@@ -290,21 +296,38 @@ impl SlabF32 {
         if !(origin.abs().max_element() <= f64::from(F32_SAFE)) {
             return None;
         }
-        let o = origin.to_array();
-        let o_lo = Vec3A::from(o.map(|x| f32_down(x.next_down())));
-        let o_hi = Vec3A::from(o.map(|x| f32_up(x.next_up())));
         let d = direction.to_array();
         let negative =
             BVec3A::new(d[0].is_sign_negative(), d[1].is_sign_negative(), d[2].is_sign_negative());
-        let sign = |k: usize, m: f32| if d[k].is_sign_negative() { -m } else { m };
-        let inv = d.map(|x| 1.0 / x.abs());
-        let inv_near = Vec3A::new(
-            sign(0, f32_down(inv[0])),
-            sign(1, f32_down(inv[1])),
-            sign(2, f32_down(inv[2])),
-        );
-        let inv_far =
-            Vec3A::new(sign(0, f32_up(inv[0])), sign(1, f32_up(inv[1])), sign(2, f32_up(inv[2])));
+        let inv = direction.abs().recip();
+        // The fast, branch-free bounds (the common case): round to nearest in f32, then widen by
+        // 2^-22 relative plus the smallest normal f32. Rounding to nearest errs by at most 2^-24
+        // relative (the f64 origin's own ulp is far below that), and widening `f` by `|f| 2^-22`
+        // moves it at least `3 * 2^-24 |f|` after its own rounding, so `o_lo <= o <= o_hi` and
+        // `inv_near <= 1/|d| <= inv_far`; zero and subnormal values are covered by `MIN_POSITIVE`.
+        // Reciprocals below the normal f32 range take the exact directed roundings below.
+        let (o_lo, o_hi, inv_lo, inv_hi) = if inv.cmpge(DVec3::splat(FAST_INV_MIN)).all() {
+            let o = origin.as_vec3a();
+            let o_margin = o.abs() * FAST_REL + Vec3A::splat(f32::MIN_POSITIVE);
+            // `1/|d|` beyond f32 (a zero or tiny component) rounds to infinity: the lower bound
+            // takes the largest finite f32 instead (any finite value is below the truth), the
+            // upper bound stays infinite.
+            let g = inv.as_vec3a();
+            let g_low = g.min(Vec3A::splat(f32::MAX));
+            (o - o_margin, o + o_margin, g_low - g_low * FAST_REL, g + g * FAST_REL)
+        } else {
+            let o = origin.to_array();
+            let i = inv.to_array();
+            (
+                Vec3A::from(o.map(|x| f32_down(x.next_down()))),
+                Vec3A::from(o.map(|x| f32_up(x.next_up()))),
+                Vec3A::from(i.map(f32_down)),
+                Vec3A::from(i.map(f32_up)),
+            )
+        };
+        let signs = Vec3A::select(negative, Vec3A::NEG_ONE, Vec3A::ONE);
+        let inv_near = inv_lo * signs;
+        let inv_far = inv_hi * signs;
         let mut s = Self {
             negative,
             o_near: Vec3A::select(negative, o_lo, o_hi),
