@@ -34,7 +34,7 @@ use crate::ior::IorRepr;
 use crate::vectors::normalise;
 use crate::{
     BundleScattered, Incoming, Ior, Material, MaterialError, ScatterKind, Scattered, Transport,
-    scatter_each,
+    scale_bundle, scatter_each,
 };
 
 /// A smooth dielectric boundary (glass) with a possibly dispersive index of refraction.
@@ -192,22 +192,9 @@ impl Material for Dielectric {
         }
         let first = weights.iter().zip(lambdas).find(|(w, _)| **w > 0.0).map(|(_, &l)| l)?;
         let lobe = self.lobe(direction, normal, first, u[0]);
-        let mut any = false;
-        for (w, &lambda) in weights.iter_mut().zip(lambdas) {
-            if *w > 0.0 {
-                let t = if lobe.transmission {
-                    self.refraction_weight(&lobe, lambda, transport)
-                } else {
-                    1.0
-                };
-                if t > 0.0 {
-                    *w *= t;
-                    any = true;
-                } else {
-                    *w = 0.0;
-                }
-            }
-        }
+        let any = scale_bundle(lambdas, weights, |lambda| {
+            if lobe.transmission { self.refraction_weight(&lobe, lambda, transport) } else { 1.0 }
+        });
         any.then_some(BundleScattered {
             direction: lobe.direction,
             kind: ScatterKind::Specular,

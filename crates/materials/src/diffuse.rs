@@ -22,7 +22,7 @@ use spectrace_spectrum::Reflectance;
 use spectrace_sampling::{Frame, clamp_uniform, pdf_cosine_hemisphere, sample_cosine_hemisphere};
 
 use crate::vectors::{facing, normalise};
-use crate::{BundleScattered, Incoming, Material, ScatterKind, Scattered, Transport};
+use crate::{BundleScattered, Incoming, Material, ScatterKind, Scattered, Transport, scale_bundle};
 
 /// A Lambertian (ideal diffuse) reflector, two-sided.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -78,19 +78,7 @@ impl Material for Diffuse {
         u: [f64; 3],
         _transport: Transport,
     ) -> Option<BundleScattered> {
-        let mut any = false;
-        for (w, &lambda) in weights.iter_mut().zip(lambdas) {
-            if *w > 0.0 {
-                let albedo = self.reflectance.value(lambda);
-                if albedo > 0.0 {
-                    *w *= albedo;
-                    any = true;
-                } else {
-                    *w = 0.0;
-                }
-            }
-        }
-        if !any {
+        if !scale_bundle(lambdas, weights, |lambda| self.reflectance.value(lambda)) {
             return None;
         }
         let n = facing(direction, normal);

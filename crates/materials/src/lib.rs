@@ -56,7 +56,8 @@ pub use fresnel::{Polarised, fresnel_dielectric, fresnel_dielectric_polarised, r
 pub use glass::{GLASSES, Glass, find_glass, known_glasses};
 pub use ior::{FRAUNHOFER_C_NM, FRAUNHOFER_D_NM, FRAUNHOFER_F_NM, Ior, VALID_MAX_NM, VALID_MIN_NM};
 pub use material::{
-    BundleScattered, Incoming, Material, ScatterKind, Scattered, Transport, scatter_each,
+    BundleScattered, Incoming, Material, ScatterKind, Scattered, Transport, scale_bundle,
+    scatter_each,
 };
 pub use mirror::Mirror;
 

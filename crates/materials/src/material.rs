@@ -232,3 +232,23 @@ pub fn scatter_each<M: Material + ?Sized>(
     }
     out
 }
+
+/// Multiplies each live weight (`> 0`) of a bundle by `factor(lambda)`, setting it to 0 where the
+/// factor is not positive (the wavelength is absorbed); dead weights are left alone. Returns
+/// whether any wavelength is still live: the shared step of every `scatter_bundle` whose
+/// direction does not depend on the wavelength.
+pub fn scale_bundle(lambdas: &[f64], weights: &mut [f64], factor: impl Fn(f64) -> f64) -> bool {
+    let mut any = false;
+    for (w, &lambda) in weights.iter_mut().zip(lambdas) {
+        if *w > 0.0 {
+            let f = factor(lambda);
+            if f > 0.0 {
+                *w *= f;
+                any = true;
+            } else {
+                *w = 0.0;
+            }
+        }
+    }
+    any
+}

@@ -17,7 +17,7 @@ use spectrace_spectrum::Reflectance;
 
 use crate::fresnel::reflect;
 use crate::vectors::facing;
-use crate::{BundleScattered, Incoming, Material, ScatterKind, Scattered, Transport};
+use crate::{BundleScattered, Incoming, Material, ScatterKind, Scattered, Transport, scale_bundle};
 
 /// A perfect mirror, two-sided, with a wavelength-dependent reflectance.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -65,19 +65,7 @@ impl Material for Mirror {
         _u: [f64; 3],
         _transport: Transport,
     ) -> Option<BundleScattered> {
-        let mut any = false;
-        for (w, &lambda) in weights.iter_mut().zip(lambdas) {
-            if *w > 0.0 {
-                let r = self.reflectance.value(lambda);
-                if r > 0.0 {
-                    *w *= r;
-                    any = true;
-                } else {
-                    *w = 0.0;
-                }
-            }
-        }
-        if !any {
+        if !scale_bundle(lambdas, weights, |lambda| self.reflectance.value(lambda)) {
             return None;
         }
         let n = facing(direction, normal);
