@@ -2,6 +2,7 @@
 //! tracer and BDPT must give the same image wherever they all apply (fixed seeds; tolerances in
 //! standard errors measured from independent seeds).
 
+use crate::variance::pixel_noise;
 use spectrace_renderer::{InMemoryRender, Scene, choose_integrator};
 use spectrace_spectrum::Uniform;
 use spectrace_tracer::IntegratorChoice;
@@ -381,29 +382,6 @@ fn render_in(
     spectrace_renderer::render_in_memory(s, &options).unwrap()
 }
 
-/// Mean over pixels of the variance over seeds of X, Y and Z (summed), relative to the squared
-/// image mean of Y: the colour noise of one render.
-fn pixel_noise(s: &Scene, effort: u64, seeds: u64) -> f64 {
-    let images: Vec<_> =
-        (0..seeds).map(|k| render_with(s, IntegratorChoice::Path, effort, 500 + k).image).collect();
-    let n = seeds as f64;
-    let pixels = images[0].len();
-    let mut total = 0.0;
-    let mut mean_y = 0.0;
-    for p in 0..pixels {
-        for c in 0..3 {
-            let v: Vec<f64> = images.iter().map(|img| [img[p].x, img[p].y, img[p].z][c]).collect();
-            let m = v.iter().sum::<f64>() / n;
-            total += v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
-            if c == 1 {
-                mean_y += m;
-            }
-        }
-    }
-    let mean_y = mean_y / pixels as f64;
-    total / pixels as f64 / (mean_y * mean_y)
-}
-
 #[test]
 fn observer_weighted_wavelengths_have_less_colour_noise_than_uniform_ones() {
     // The same scene, samples and seeds; only the camera paths' wavelength density differs.
@@ -417,8 +395,8 @@ fn observer_weighted_wavelengths_have_less_colour_noise_than_uniform_ones() {
     );
     let uniform = visible
         .replace(r#""lights""#, r#""settings": {"camera_wavelengths": "uniform"}, "lights""#);
-    let a = pixel_noise(&scene(&visible), 32 * 32 * 4, 12);
-    let b = pixel_noise(&scene(&uniform), 32 * 32 * 4, 12);
+    let a = pixel_noise(&scene(&visible), IntegratorChoice::Path, 32 * 32 * 4, 12, 500);
+    let b = pixel_noise(&scene(&uniform), IntegratorChoice::Path, 32 * 32 * 4, 12, 500);
     eprintln!("colour noise: visible {a:.4e}, uniform {b:.4e}, ratio {:.3}", a / b);
     assert!(a < 0.75 * b, "visible {a} vs uniform {b}");
 }

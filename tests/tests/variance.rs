@@ -11,10 +11,17 @@ use spectrace_tracer::IntegratorChoice;
 use crate::rendering::{POINT_OVER_PLANE, assert_lit_plane_matches_with, render_with, scene};
 
 /// Mean over pixels of the variance over seeds of X, Y and Z (summed), relative to the squared
-/// image mean of Y: the colour noise of one render with `integrator` and `effort` paths.
-fn pixel_noise(s: &Scene, integrator: IntegratorChoice, effort: u64, seeds: u64) -> f64 {
+/// image mean of Y: the colour noise of one render with `integrator` and `effort` paths, over the
+/// seeds `seed_base..seed_base + seeds` (shared with `integrators.rs`).
+pub(crate) fn pixel_noise(
+    s: &Scene,
+    integrator: IntegratorChoice,
+    effort: u64,
+    seeds: u64,
+    seed_base: u64,
+) -> f64 {
     let images: Vec<_> =
-        (0..seeds).map(|k| render_with(s, integrator, effort, 700 + k).image).collect();
+        (0..seeds).map(|k| render_with(s, integrator, effort, seed_base + k).image).collect();
     let n = seeds as f64;
     let pixels = images[0].len();
     let (mut total, mut mean_y) = (0.0, 0.0);
@@ -70,8 +77,8 @@ fn observer_ratio(name: &str, beams: u64, seeds: u64) -> f64 {
     let size = Some((64, 40));
     let importance = variant(&json, &path, "importance", size);
     let observer = variant(&json, &path, "observer", size);
-    let a = pixel_noise(&observer, IntegratorChoice::Light, beams, seeds);
-    let b = pixel_noise(&importance, IntegratorChoice::Light, beams, seeds);
+    let a = pixel_noise(&observer, IntegratorChoice::Light, beams, seeds, 700);
+    let b = pixel_noise(&importance, IntegratorChoice::Light, beams, seeds, 700);
     eprintln!("{name}: colour noise observer {a:.4e}, importance {b:.4e}, ratio {:.3}", a / b);
     a / b
 }
@@ -128,12 +135,14 @@ fn observer_weighted_light_wavelengths_have_less_colour_noise() {
             IntegratorChoice::Light,
             60_000,
             10,
+            700,
         );
         let b = pixel_noise(
             &variant(json, path, "importance", None),
             IntegratorChoice::Light,
             60_000,
             10,
+            700,
         );
         a / b
     };
@@ -182,8 +191,8 @@ fn sobol_has_less_pixel_noise_than_independent_sampling() {
     for (integrator, effort, bound) in
         [(IntegratorChoice::Path, 32 * 32 * 16, 0.5), (IntegratorChoice::Light, 200_000, 0.65)]
     {
-        let a = pixel_noise(&sobol, integrator, effort, 10);
-        let b = pixel_noise(&independent, integrator, effort, 10);
+        let a = pixel_noise(&sobol, integrator, effort, 10, 700);
+        let b = pixel_noise(&independent, integrator, effort, 10, 700);
         eprintln!(
             "{}: pixel noise sobol {a:.4e}, independent {b:.4e}, ratio {:.3}",
             integrator.name(),
