@@ -278,7 +278,10 @@ impl InverseCdf {
         if p.exact() {
             return self.newton(ln_f, p.x0, x1, u - self.us[i]);
         }
-        p.eval(((u - self.us[i]) * p.inv_du).clamp(0.0, 1.0), x1)
+        // A panel whose mass underflows to 0 has an infinite `inv_du`: `0 * inf` is NaN, and the
+        // sample is then the panel's start (where the CDF still equals `u`).
+        let t = (u - self.us[i]) * p.inv_du;
+        p.eval(if t > 0.0 { t.min(1.0) } else { 0.0 }, x1)
     }
 
     /// Solves `integral of pdf over [x0, x] = target` in `[x0, x1]` by safeguarded Newton steps.

@@ -630,3 +630,14 @@ fn tables_are_built_by_deserialisation_and_not_serialised() {
     let g = serde_json::to_string(&Gaussian::new(550.0, 40.0).unwrap()).unwrap();
     assert_eq!(g, r#"{"center_nm":550.0,"fwhm_nm":40.0,"min_nm":360.0,"max_nm":830.0}"#);
 }
+
+/// Regression (found by the property test above): a Gaussian centred 26 sigma outside its range
+/// has tail panels whose mass underflows to 0, and `u = 0` used to land in one and return NaN.
+#[test]
+fn a_gaussian_far_outside_its_range_samples_every_u_inside_it() {
+    let g = Gaussian::new(995.748_296_095_940_4, 10f64.powf(1.174_598_590_535_879_1)).unwrap();
+    for u in [0.0, 1e-300, 1e-20, 0.5, 1.0 - f64::EPSILON] {
+        let l = g.sample_lambda(u);
+        assert!((360.0..=830.0).contains(&l), "u = {u}: {l}");
+    }
+}
