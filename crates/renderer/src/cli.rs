@@ -50,9 +50,14 @@ enum Command {
         /// settings.integrator).
         #[arg(long, value_parser = parse_integrator)]
         integrator: Option<IntegratorChoice>,
-        /// Render for this many seconds instead of a fixed number of beams.
+        /// Render for this many seconds instead of a fixed number of beams (with
+        /// --target-error: at most this long).
         #[arg(long, allow_negative_numbers = true, value_parser = parse_seconds)]
         time: Option<f64>,
+        /// Render until the estimated relative RMSE of the image is at most E (0.05 = 5%;
+        /// overrides settings.target_error); --time and --beams/--spp cap it.
+        #[arg(long, value_name = "E", allow_negative_numbers = true, value_parser = parse_target_error)]
+        target_error: Option<f64>,
         /// Output directory.
         #[arg(long, default_value = "out")]
         out: PathBuf,
@@ -114,6 +119,30 @@ enum Command {
         #[arg(long, default_value = "docs")]
         out: PathBuf,
     },
+    /// Predict, from a short pilot render of each estimator, how long the scene takes to reach a
+    /// target error, and recommend the fastest estimator.
+    Estimate {
+        /// The scene file (JSON; see scenes/README.md).
+        scene: PathBuf,
+        /// The target relative RMSE (0.05 = 5%).
+        #[arg(long, value_name = "E", allow_negative_numbers = true, value_parser = parse_target_error)]
+        target_error: f64,
+        /// Pilot time per estimator, in seconds (the pilot renders at least 4 whole chunks).
+        #[arg(long, default_value_t = crate::pilot::DEFAULT_PILOT_SECONDS, allow_negative_numbers = true, value_parser = parse_seconds)]
+        pilot_seconds: f64,
+        /// The estimators to try, comma-separated (default: light,path,bdpt).
+        #[arg(long, value_delimiter = ',', value_parser = parse_integrator)]
+        integrators: Vec<IntegratorChoice>,
+        /// Worker threads (0: one per core).
+        #[arg(long, default_value_t = 0, allow_negative_numbers = true, value_parser = parse_threads)]
+        threads: usize,
+        /// Also write the report as JSON to this file (it must not be the scene file).
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Refuse any file the scene names outside the scene file's folder.
+        #[arg(long)]
+        restrict_paths: bool,
+    },
     /// Merge partial films (from `render --shard`) into the final outputs.
     Merge {
         /// The partial films (.bin).
@@ -161,6 +190,13 @@ fn parse_seconds(s: &str) -> Result<f64, String> {
         Ok(_) => Err(format!("`{s}`: must be a positive, finite number of seconds")),
         Err(_) => Err(format!("`{s}`: not a number of seconds")),
     }
+}
+
+/// A target relative error in (0, 1).
+fn parse_target_error(s: &str) -> Result<f64, String> {
+    let e: f64 = s.trim().parse().map_err(|_| format!("`{s}`: not a number"))?;
+    crate::check_target_error(e)?;
+    Ok(e)
 }
 
 /// A thread count (0: one per core).
@@ -252,6 +288,52 @@ fn bench(scenes: &[PathBuf], beams: u64, threads: usize) -> ExitCode {
     ExitCode::SUCCESS
 }
 
+/// `spectrace estimate`: the pilots, a Markdown table on stdout, and optionally the JSON.
+fn estimate_command(
+    scene: &std::path::Path,
+    target_error: f64,
+    pilot_seconds: f64,
+    integrators: Vec<IntegratorChoice>,
+    threads: usize,
+    json: Option<&std::path::Path>,
+    restrict_paths: bool,
+) -> ExitCode {
+    let run = || -> Result<String, String> {
+        if let Some(out) = json {
+            crate::check_no_input_replaced(&[out.to_path_buf()], &[scene.to_path_buf()])?;
+        }
+        let scene = crate::Scene::load_with(scene, crate::LoadOptions { restrict_paths })
+            .map_err(|e| e.to_string())?;
+        let mut options = crate::pilot::EstimateOptions {
+            target_error,
+            pilot_seconds,
+            threads,
+            ..Default::default()
+        };
+        if !integrators.is_empty() {
+            options.integrators =
+                integrators.into_iter().filter(|&i| i != IntegratorChoice::Auto).collect();
+        }
+        let report = crate::pilot::estimate(&scene, &options).map_err(|e| e.to_string())?;
+        if let Some(out) = json {
+            let text = serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?;
+            crate::write_atomically(out, |p| std::fs::write(p, &text).map_err(|e| e.to_string()))
+                .map_err(|e| format!("{}: {e}", out.display()))?;
+        }
+        Ok(crate::pilot::markdown(&report))
+    };
+    match run() {
+        Ok(md) => {
+            print!("{md}");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
 /// Runs the `spectrace` command line on the process's arguments ([`std::env::args_os`]).
 pub fn main() -> ExitCode {
     main_with_args(std::env::args_os())
@@ -286,8 +368,10 @@ where
             restrict_paths,
             spp,
             integrator,
+            target_error,
         } => {
             let options = RenderOptions {
+                target_error,
                 spp,
                 integrator,
                 beams,
@@ -303,6 +387,25 @@ where
             render_file(&scene, &options)
         }
         Command::Merge { parts, out } => merge_parts(&parts, &out),
+        Command::Estimate {
+            scene,
+            target_error,
+            pilot_seconds,
+            integrators,
+            threads,
+            json,
+            restrict_paths,
+        } => {
+            return estimate_command(
+                &scene,
+                target_error,
+                pilot_seconds,
+                integrators,
+                threads,
+                json.as_deref(),
+                restrict_paths,
+            );
+        }
         Command::Bench { scenes, beams, threads } => return bench(&scenes, beams, threads),
         Command::Accuracy {
             scenes,

@@ -18,6 +18,7 @@ pub mod cli;
 mod files;
 mod output;
 mod part;
+pub mod pilot;
 mod scene;
 
 use std::path::{Path, PathBuf};
@@ -28,7 +29,7 @@ use spectrace_lights::LightSource;
 use spectrace_tracer::{
     Bdpt, Effects, EffectsMode, Film, FilmError, Integrator, IntegratorChoice, LightTracer,
     LightTracerScene, MemoryLimit, PathTracer, RenderOutput, RenderPlan, SamplerKind, TraceStats,
-    image_scale, render,
+    image_scale, render, render_observed,
 };
 
 pub use files::{
@@ -38,7 +39,7 @@ pub use files::{
 pub use output::{EncodedImage, OUTPUT_BYTES_PER_PIXEL, encode_image, write_exr, write_png};
 pub use part::{PARTIAL_VERSION, PartialFilm};
 pub use scene::{
-    DEFAULT_SPP, EffectsSettings, LoadOptions, Object, OutputSettings, Scene, SceneError,
+    DEFAULT_SPP, check_target_error, EffectsSettings, LoadOptions, Object, OutputSettings, Scene, SceneError,
     SceneFile, Settings,
 };
 
@@ -67,6 +68,9 @@ pub struct RenderOptions {
     pub integrator: Option<IntegratorChoice>,
     /// Camera samples per pixel for `path` and `bdpt` (overrides `settings.spp`).
     pub spp: Option<u64>,
+    /// Render until the estimated relative error reaches this (overrides
+    /// `settings.target_error`).
+    pub target_error: Option<f64>,
 }
 
 /// Why a render failed.
@@ -131,6 +135,10 @@ pub struct RenderReport {
     pub out_of_range_values: u64,
     /// Anything the user should know about the result (also printed).
     pub warnings: Vec<String>,
+    /// How accurate the image is, estimated from the spread between its chunks (absent when
+    /// the image was too large to keep the estimate's moments).
+    #[serde(default)]
+    pub error_estimate: Option<AccuracyEstimate>,
     /// Tracer counters.
     pub stats: TraceStats,
     /// Total power of the lights (W).
@@ -139,6 +147,104 @@ pub struct RenderReport {
     pub outputs: Vec<String>,
     /// Spectrace version.
     pub version: String,
+}
+
+/// The relative errors the sidecar predicts render times for (10%, 5%, 2%, 1%).
+pub const PREDICTED_ERRORS: [f64; 4] = [0.10, 0.05, 0.02, 0.01];
+
+/// How accurate a rendered image is and what more accuracy costs: the sidecar's
+/// `error_estimate`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AccuracyEstimate {
+    /// Estimated relative RMSE against the converged image (over all pixels and X, Y, Z: the
+    /// accuracy report's measure); `null` with fewer than two batches or a black image.
+    pub relative_rmse: Option<f64>,
+    /// One-sigma relative uncertainty of that estimate itself.
+    pub relative_uncertainty: f64,
+    /// Independent batches (work chunks) it comes from.
+    pub batches: u64,
+    /// `true` with at least [`spectrace_tracer::MIN_BATCHES`] batches.
+    pub trusted: bool,
+    /// The target asked for (`--target-error`, `settings.target_error`), if any.
+    pub target_error: Option<f64>,
+    /// Whether the estimate reached the target (`null` without one).
+    pub target_reached: Option<bool>,
+    /// Predicted total render time (s, at this render's speed) to reach each relative error in
+    /// [`PREDICTED_ERRORS`], with error falling as `1 / sqrt(work)`; `[error, seconds]` pairs,
+    /// only for errors below the current one.
+    pub predicted_seconds: Vec<[f64; 2]>,
+    /// More render time (s) that would halve the error (three times this render's: four
+    /// times the work).
+    pub seconds_to_halve: f64,
+}
+
+impl AccuracyEstimate {
+    /// The sidecar's estimate of a render of `seconds` that ended with `estimate`.
+    pub fn new(
+        estimate: &spectrace_tracer::ErrorEstimate,
+        target: Option<f64>,
+        seconds: f64,
+    ) -> Self {
+        let e = estimate.relative_rmse;
+        let predicted_seconds = match e {
+            Some(e) if e > 0.0 => PREDICTED_ERRORS
+                .iter()
+                .filter(|&&t| t < e)
+                .map(|&t| [t, seconds * (e / t).powi(2)])
+                .collect(),
+            _ => Vec::new(),
+        };
+        Self {
+            relative_rmse: e,
+            relative_uncertainty: estimate.relative_uncertainty(),
+            batches: estimate.batches,
+            trusted: estimate.is_trusted(),
+            target_error: target,
+            target_reached: target.map(|t| e.is_some_and(|e| e <= t) && estimate.is_trusted()),
+            predicted_seconds,
+            seconds_to_halve: 3.0 * seconds,
+        }
+    }
+
+    /// One line for the terminal: `error 3.2% ±0.1% (64 batches); 2%: ~41 s`.
+    pub fn summary(&self) -> String {
+        let Some(e) = self.relative_rmse else {
+            return format!("error: no estimate ({} batches, need 2 and a lit image)", self.batches);
+        };
+        let mut line = format!(
+            "estimated error {:.2}% ±{:.2}% ({} batches{})",
+            e * 100.0,
+            e * self.relative_uncertainty * 100.0,
+            self.batches,
+            if self.trusted { "" } else { ", too few to trust" }
+        );
+        if let (Some(t), Some(reached)) = (self.target_error, self.target_reached) {
+            line.push_str(&format!(
+                "; target {:.2}% {}",
+                t * 100.0,
+                if reached { "reached" } else { "not reached" }
+            ));
+        }
+        if let Some([t, s]) = self.predicted_seconds.first() {
+            line.push_str(&format!("; {:.0}% would take ~{} in all", t * 100.0, duration(*s)));
+        }
+        line
+    }
+}
+
+/// Seconds in words: `850 ms`, `12.3 s`, `4.1 min`, `2.5 h`.
+pub fn duration(seconds: f64) -> String {
+    if !seconds.is_finite() {
+        "forever".to_owned()
+    } else if seconds < 1.0 {
+        format!("{:.0} ms", seconds * 1e3)
+    } else if seconds < 120.0 {
+        format!("{seconds:.1} s")
+    } else if seconds < 7200.0 {
+        format!("{:.1} min", seconds / 60.0)
+    } else {
+        format!("{:.1} h", seconds / 3600.0)
+    }
 }
 
 /// The integrator of sidecars written before the field existed: the light tracer.
@@ -243,7 +349,8 @@ pub fn plan_with(
             (None, None) => scene.settings.spp,
         };
         plan.chunk_beams = pixels;
-        plan.beams = if options.time.is_some() && options.spp.is_none() && options.beams.is_none() {
+        let open_ended = options.time.is_some() || plan.target_error.is_some();
+        plan.beams = if open_ended && options.spp.is_none() && options.beams.is_none() {
             (u64::MAX / 2 / pixels) * pixels
         } else {
             spp.checked_mul(pixels).ok_or_else(|| {
@@ -270,6 +377,18 @@ fn plan_light(scene: &Scene, options: &RenderOptions) -> Result<RenderPlan, Rend
             )));
         }
         plan.time_budget = Some(t);
+        if options.beams.is_none() {
+            plan.beams = u64::MAX / 2;
+        }
+    }
+    if let Some(e) = options.target_error {
+        scene::check_target_error(e)
+            .map_err(|m| RenderError::Options(format!("--target-error {m}")))?;
+        plan.target_error = Some(e);
+    }
+    if plan.target_error.is_some() {
+        // The target decides how much to render; --beams caps it.
+        plan.error_estimate = true;
         if options.beams.is_none() {
             plan.beams = u64::MAX / 2;
         }
@@ -439,10 +558,17 @@ pub fn probe_with(
 /// What a user should know about the chosen estimator: light a camera integrator cannot reach.
 fn integrator_warnings(scene: &Scene, choice: IntegratorChoice) -> Vec<String> {
     let mut warnings = Vec::new();
+    let features = tracer_scene(scene).features(&scene.non_convex);
+    if choice == IntegratorChoice::Light && features.specular {
+        warnings.push(
+            "the light tracer cannot see into mirrors and glass: what they reflect or refract \
+             toward the camera is missing from this image (use --integrator bdpt or auto)"
+                .to_owned(),
+        );
+    }
     if choice != IntegratorChoice::Path {
         return warnings;
     }
-    let features = tracer_scene(scene).features(&scene.non_convex);
     if features.beam_only_lights + features.delta_direction_lights > 0 {
         warnings.push(
             "the path tracer cannot reach lasers, skies or lights that only generate beams: \
@@ -497,6 +623,9 @@ fn planned_outputs(
             if settings.png {
                 v.push(out_dir.join(format!("{name}.png")));
             }
+            if settings.error_image {
+                v.push(out_dir.join(format!("{name}.error.exr")));
+            }
             v.push(out_dir.join(format!("{name}.json")));
             v
         }
@@ -513,6 +642,7 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
     let plan = plan_with(scene, options, choice)?;
     let name = scene.output_name();
     planned_outputs(&options.out_dir, &name, &scene.output, plan.shard, &scene.inputs)?;
+    let (plan, _) = fit_estimate(scene, plan);
     let effects = decide_effects(scene, options.effects);
     if options.verbose {
         eprintln!("{}", effects.summary());
@@ -521,6 +651,30 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
     with_integrator(scene, choice, effects, |tracer| {
         render_with(scene, options, choice, &reason, effects, plan, &name, tracer)
     })
+}
+
+/// The plan without the error estimate when its moments would not fit in memory but the
+/// render would (a very large image), with a warning saying so; the plan unchanged otherwise.
+/// With a target error the estimate is needed: the plan is kept and the render refused.
+fn fit_estimate(scene: &Scene, plan: RenderPlan) -> (RenderPlan, Option<String>) {
+    if plan.target_error.is_some() || !plan.keeps_estimate() {
+        return (plan, None);
+    }
+    let (w, h) = (scene.camera.width(), scene.camera.height());
+    let limit = MemoryLimit::system();
+    let without = RenderPlan { error_estimate: false, ..plan };
+    if plan.check_memory(w, h, &limit).is_err() && without.check_memory(w, h, &limit).is_ok() {
+        let warning = format!(
+            "no error estimate: its moments for a {w}x{h} image ({} more) do not fit in the \
+             memory a render may use ({})",
+            spectrace_geometry::human_bytes(
+                plan.memory_bytes(w, h).saturating_sub(without.memory_bytes(w, h))
+            ),
+            limit.source
+        );
+        return (without, Some(warning));
+    }
+    (plan, None)
 }
 
 /// Runs `f` with the estimator `choice` for `scene`, following `effects`.
@@ -586,7 +740,10 @@ fn render_with(
     tracer: &dyn Integrator,
 ) -> Result<RenderReport, RenderError> {
     let name = name.to_owned();
-    let warnings = integrator_warnings(scene, choice);
+    let mut warnings = integrator_warnings(scene, choice);
+    if let (_, Some(w)) = fit_estimate(scene, plan) {
+        warnings.push(w);
+    }
     // The light tracer's probe checks that light can reach the camera (for camera integrators a
     // black image is reported after the render).
     let probed = probe_with(scene, &plan, tracer)?;
@@ -599,8 +756,15 @@ fn render_with(
     }
     let bar = progress_bar(&plan, options.verbose);
     let started = Instant::now();
-    let update = |done: u64| bar.set_position(done.min(bar.length().unwrap_or(u64::MAX)));
-    let output = render(tracer, &plan, &update).map_err(|e| RenderError::Options(e.to_string()))?;
+    let target = plan.shard_target_error();
+    let update = |p: &spectrace_tracer::Progress| {
+        bar.set_position(p.items.min(bar.length().unwrap_or(u64::MAX)));
+        if let Some(e) = &p.estimate {
+            bar.set_message(progress_message(e, target, p.seconds));
+        }
+    };
+    let output = render_observed(tracer, &plan, &update)
+        .map_err(|e| RenderError::Options(e.to_string()))?;
     let pixels = u64::from(scene.camera.width()) * u64::from(scene.camera.height());
     let numerator = normalisation(choice, scene.lights.power(), pixels);
     bar.finish_and_clear();
@@ -705,6 +869,9 @@ fn report(
         wall_seconds: wall,
         beams_per_second: if wall > 0.0 { output.beams as f64 / wall } else { 0.0 },
         rejected_contributions: output.film.rejected(),
+        error_estimate: output
+            .estimate()
+            .map(|e| AccuracyEstimate::new(&e, plan.target_error, output.seconds)),
         stats: output.stats,
         light_power,
         outputs: written.files,
@@ -726,16 +893,34 @@ fn progress_bar(plan: &RenderPlan, visible: bool) -> indicatif::ProgressBar {
     if !visible {
         return indicatif::ProgressBar::hidden();
     }
+    let open_ended = plan.time_budget.is_some() || plan.target_error.is_some();
     let bar = indicatif::ProgressBar::new(plan.shard_beams());
-    let template = if plan.time_budget.is_some() {
-        "{spinner} {elapsed_precise} {pos} beams ({per_sec})"
+    let template = if open_ended {
+        "{spinner} {elapsed_precise} {pos} items ({per_sec}) {msg}"
     } else {
-        "{bar:40} {percent:>3}% {pos}/{len} beams, {per_sec}, ETA {eta}"
+        "{bar:30} {percent:>3}% {pos}/{len} items, {per_sec}, ETA {eta} {msg}"
     };
     if let Ok(style) = indicatif::ProgressStyle::with_template(template) {
         bar.set_style(style);
     }
     bar
+}
+
+/// The progress bar's message for a live estimate: the error and, with a target, the time
+/// still needed (error falling as `1 / sqrt(time)`).
+fn progress_message(e: &spectrace_tracer::ErrorEstimate, target: Option<f64>, seconds: f64) -> String {
+    let Some(r) = e.relative_rmse else {
+        return format!("error: waiting for batches ({})", e.batches);
+    };
+    let mut m = format!("error {:.2}%", r * 100.0);
+    if !e.is_trusted() {
+        m.push_str(&format!(" ({} of {} batches)", e.batches, spectrace_tracer::MIN_BATCHES));
+    }
+    if let Some(t) = target {
+        let left = (seconds * (r / t).powi(2) - seconds).max(0.0);
+        m.push_str(&format!(" -> {:.2}%, ~{} to go", t * 100.0, duration(left)));
+    }
+    m
 }
 
 /// The final image of a render: XYZ per pixel in film units.
@@ -787,6 +972,27 @@ pub fn write_outputs(
         })
         .map_err(file_error(&path))?;
         written.files.push(path.display().to_string());
+    }
+    if settings.error_image {
+        match &output.moments {
+            Some(moments) => {
+                let path = dir.join(format!("{name}.error.exr"));
+                // In the image's units and with the image's EXR scale, so the two compare
+                // pixel by pixel.
+                let factor = numerator.scale(output.beams) * 2f64.powi(image.scale_log2);
+                let rgb: Vec<[f32; 3]> = moments
+                    .standard_error_rgb(factor)
+                    .into_iter()
+                    .map(|p| p.map(|v| v.min(f64::from(f32::MAX)) as f32))
+                    .collect();
+                write_atomically(&path, |p| write_exr(p, w, h, &rgb, image.scale_log2))
+                    .map_err(file_error(&path))?;
+                written.files.push(path.display().to_string());
+            }
+            None => written.warnings.push(
+                "output.error_image: no error image, the render kept no error estimate".to_owned(),
+            ),
+        }
     }
     Ok(written)
 }
@@ -840,6 +1046,7 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
         chunks: Vec::new(),
         beams: 0,
         seconds: 0.0,
+        moments: None,
     };
     let mut merged = std::mem::replace(&mut first.output, placeholder);
     // Which part holds each chunk: coverage is checked by chunk identity, not by count.
@@ -895,7 +1102,8 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
             .map_err(|e| RenderError::Options(format!("{}: {e}", path.display())))?;
         seconds.push(part.output.seconds);
     }
-    if first.plan.time_budget.is_none() {
+    // Time budgets and targets stop early: only they may leave chunks out.
+    if first.plan.time_budget.is_none() && first.plan.target_error.is_none() {
         let expected = first.plan.chunks();
         if owner.len() as u64 != expected {
             let missing =

@@ -45,7 +45,7 @@ pub struct PartialFilm {
 }
 
 /// Current [`PartialFilm::version`].
-pub const PARTIAL_VERSION: u32 = 3;
+pub const PARTIAL_VERSION: u32 = 4;
 
 /// bincode's configuration for part files: the standard encoding, with every claimed length
 /// bounded by the file-size limit so a forged length cannot make the decoder reserve memory.
@@ -139,6 +139,9 @@ impl PartialFilm {
         {
             return bad("plan.time_budget", format!("{t}: must be a positive number of seconds"));
         }
+        if let Some(e) = plan.target_error {
+            crate::check_target_error(e).or_else(|m| bad("plan.target_error", m))?;
+        }
         let decided = Effects::decide(self.effects.features, self.effects.mode);
         if decided != self.effects {
             return bad(
@@ -197,6 +200,40 @@ impl PartialFilm {
                     capacity,
                     out.chunks.len()
                 ),
+            );
+        }
+        if let Some(m) = &out.moments {
+            if (m.width(), m.height()) != (w, h) {
+                return bad(
+                    "output.moments",
+                    format!("size {}x{} differs from the film's {w}x{h}", m.width(), m.height()),
+                );
+            }
+            // Chunks cut short by a time budget are rendered but not in the moments.
+            let cut_short_allowed = plan.time_budget.is_some();
+            let (chunks, items) = (out.chunks.len() as u64, out.beams);
+            let matches = if cut_short_allowed {
+                m.chunks() <= chunks && m.items() <= items
+            } else {
+                m.chunks() == chunks && m.items() == items
+            };
+            if !matches {
+                return bad(
+                    "output.moments",
+                    format!(
+                        "{} chunks of {} items, but the part rendered {} chunks of {} items",
+                        m.chunks(),
+                        m.items(),
+                        out.chunks.len(),
+                        out.beams
+                    ),
+                );
+            }
+            m.validate().or_else(|e| bad("output.moments", e))?;
+        } else if plan.target_error.is_some() {
+            return bad(
+                "output.moments",
+                "missing: a render to a target error keeps its estimate".to_owned(),
             );
         }
         if !(out.seconds >= 0.0 && out.seconds.is_finite()) {

@@ -94,6 +94,9 @@ pub struct Settings {
     /// stream, the default) or `"sobol"` (Owen-scrambled Sobol points, see
     /// [`spectrace_tracer::ChunkSampler`]).
     pub sampler: SamplerKind,
+    /// Render until the estimated relative RMSE of the image is at most this (e.g. `0.05`),
+    /// instead of a fixed number of beams or samples; `time_seconds` caps it.
+    pub target_error: Option<f64>,
 }
 
 impl Default for Settings {
@@ -110,6 +113,7 @@ impl Default for Settings {
             spp: DEFAULT_SPP,
             camera_wavelengths: CameraWavelengths::Visible,
             sampler: SamplerKind::Independent,
+            target_error: None,
         }
     }
 }
@@ -138,11 +142,14 @@ pub struct OutputSettings {
     pub png: bool,
     /// Write the linear EXR.
     pub exr: bool,
+    /// Write `NAME.error.exr`: the standard error of every pixel of the image, per linear sRGB
+    /// channel, in the image's units.
+    pub error_image: bool,
 }
 
 impl Default for OutputSettings {
     fn default() -> Self {
-        Self { name: None, exposure: 0.0, png: true, exr: true }
+        Self { name: None, exposure: 0.0, png: true, exr: true, error_image: false }
     }
 }
 
@@ -351,6 +358,9 @@ impl Scene {
                 format!("{t}: must be a positive number of seconds"),
             ));
         }
+        if let Some(e) = s.target_error {
+            check_target_error(e).map_err(|m| scene_error("settings.target_error", m))?;
+        }
         if let Some(name) = &file.output.name {
             check_output_name(name).map_err(|e| scene_error("output.name", e))?;
         }
@@ -493,6 +503,8 @@ impl Scene {
             threads: self.settings.threads,
             shard: None,
             time_budget: self.settings.time_seconds,
+            error_estimate: true,
+            target_error: self.settings.target_error,
         }
     }
 
@@ -566,5 +578,21 @@ fn strip_position(message: &str) -> String {
     match message.rfind(" at line ") {
         Some(i) => message[..i].to_owned(),
         None => message.to_owned(),
+    }
+}
+
+/// Checks a target relative error (`settings.target_error`, `--target-error`): a number in
+/// (0, 1), i.e. above 0% and below 100%.
+///
+/// # Errors
+/// Why it is not.
+pub fn check_target_error(e: f64) -> Result<(), String> {
+    if e > 0.0 && e < 1.0 {
+        Ok(())
+    } else {
+        Err(format!(
+            "{e}: must be a relative error between 0 and 1 (0.05 is 5%); 1 or more is no accuracy \
+             at all"
+        ))
     }
 }

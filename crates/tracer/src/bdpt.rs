@@ -1148,6 +1148,8 @@ mod tests {
                     threads: 2,
                     shard: None,
                     time_budget: None,
+                    error_estimate: false,
+                    target_error: None,
                 };
                 let out = render(integrator, &plan, &|_| {}).unwrap();
                 let image = out.film.to_xyz(integrator.image_scale(out.beams));

@@ -14,6 +14,8 @@ use serde::{Deserialize, Serialize};
 use spectrace_geometry::human_bytes;
 use spectrace_spectrum::{Xyz, cmf};
 
+use crate::estimate::{ChunkTally, Moments};
+
 /// Fractional bits of the fixed-point sums.
 const FRAC_BITS: i32 = 64;
 /// `2^FRAC_BITS`.
@@ -296,6 +298,8 @@ pub struct FilmWriter<'a> {
     height: u32,
     entries: Vec<Entry>,
     rejected: u64,
+    /// The current chunk's sums for the error estimate, if the render keeps one.
+    tally: Option<ChunkTally<'a>>,
 }
 
 impl<'a> FilmWriter<'a> {
@@ -313,7 +317,42 @@ impl<'a> FilmWriter<'a> {
             let f = film.lock().unwrap_or_else(PoisonError::into_inner);
             (f.width, f.height)
         };
-        Self { film, width, height, entries: Vec::with_capacity(Self::CAPACITY), rejected: 0 }
+        Self {
+            film,
+            width,
+            height,
+            entries: Vec::with_capacity(Self::CAPACITY),
+            rejected: 0,
+            tally: None,
+        }
+    }
+
+    /// A writer into `film` that also keeps each chunk's sums and folds them into `moments`
+    /// at [`FilmWriter::end_chunk`], for the error estimate ([`Moments`]).
+    pub fn with_moments(film: &'a Mutex<Film>, moments: &'a Mutex<Moments>) -> Self {
+        let mut writer = Self::new(film);
+        writer.tally = Some(ChunkTally::new(moments));
+        writer
+    }
+
+    /// Ends a chunk of `items` work items: flushes, and folds the chunk's sums into the
+    /// moments (if the writer keeps them). Every contribution since the previous call belongs
+    /// to this chunk.
+    pub fn end_chunk(&mut self, items: u64) {
+        self.flush();
+        if let Some(t) = &mut self.tally {
+            t.end_chunk(items);
+        }
+    }
+
+    /// Ends a chunk that was cut short (by a time budget): flushes it into the film but leaves
+    /// it out of the moments, since a camera pass cut short samples only part of the image
+    /// and is no unbiased estimate of it.
+    pub fn discard_chunk(&mut self) {
+        self.flush();
+        if let Some(t) = &mut self.tally {
+            t.discard();
+        }
     }
 
     /// Adds the buffered contributions (and rejections) to the film.
@@ -324,7 +363,12 @@ impl<'a> FilmWriter<'a> {
         self.entries.sort_unstable_by_key(|e| e.0);
         let mut film = self.film.lock().unwrap_or_else(PoisonError::into_inner);
         for &(index, fixed) in &self.entries {
-            film.add_fixed(index as usize, fixed);
+            // Only what the film accepts counts for the estimate.
+            if film.add_fixed(index as usize, fixed)
+                && let Some(t) = &mut self.tally
+            {
+                t.add(index as usize, fixed.map(|v| v as f64 / SCALE));
+            }
         }
         film.rejected += self.rejected;
         drop(film);

@@ -188,7 +188,16 @@ mod tests {
 
     fn plan(threads: usize, shard: Option<(u64, u64)>) -> RenderPlan {
         // 23 chunks of 1000 items, the last one of 700.
-        RenderPlan { beams: 22_700, chunk_beams: 1000, seed: 7, threads, shard, time_budget: None }
+        RenderPlan {
+            beams: 22_700,
+            chunk_beams: 1000,
+            seed: 7,
+            threads,
+            shard,
+            time_budget: None,
+            error_estimate: false,
+            target_error: None,
+        }
     }
 
     fn run(integrator: &dyn Integrator, plan: &RenderPlan) -> RenderOutput {

@@ -24,6 +24,7 @@
 mod bdpt;
 mod camera;
 mod effects;
+mod estimate;
 mod film;
 mod integrator;
 mod light_tracer;
@@ -38,6 +39,7 @@ pub use camera::{
     CameraError, CameraRay, CameraRepr, CameraSample, FovAxis, PinholeCamera, Projection,
 };
 pub use effects::{BUNDLE, Effects, EffectsMode, IntegratorChoice, SceneFeatures};
+pub use estimate::{ErrorEstimate, MIN_BATCHES, Moments};
 pub use film::{ExactSum, Film, FilmError, FilmWriter, MAX_PIXELS, Splat};
 pub use integrator::{Integrator, LightTracer};
 pub use light_tracer::{
@@ -47,7 +49,8 @@ pub use light_tracer::{
 pub use object_light::{ObjectEmission, ObjectLight};
 pub use path_tracer::{PathTracer, PathTracerSettings};
 pub use render::{
-    DEFAULT_CHUNK_BEAMS, FALLBACK_MEMORY_LIMIT, MemoryLimit, RenderOutput, RenderPlan, render,
+    DEFAULT_CHUNK_BEAMS, ESTIMATE_INTERVAL, FALLBACK_MEMORY_LIMIT, MemoryLimit, Progress,
+    RenderOutput, RenderPlan, render, render_observed,
 };
 pub use sampler::{ChunkSampler, SamplerKind};
 pub use wavelengths::{CAMERA_LAMBDA_MAX, CAMERA_LAMBDA_MIN, CameraWavelengths, HERO};

@@ -1,12 +1,13 @@
 //! Running an [`Integrator`] over work chunks on several threads (and, with shards, machines).
 
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
 
-use crate::{Film, FilmError, FilmWriter, Integrator, TraceStats};
+use crate::estimate::ChunkTally;
+use crate::{ErrorEstimate, Film, FilmError, FilmWriter, Integrator, Moments, TraceStats};
 
 /// Beams per work chunk by default: small enough to balance threads, large enough that the
 /// per-chunk cost (a generator, a film merge) is negligible.
@@ -28,6 +29,14 @@ pub struct RenderPlan {
     /// Time budget (s): after it, no new chunk is claimed and the chunks being traced stop
     /// within a few microseconds of work (between beams; at least one beam is always traced).
     pub time_budget: Option<f64>,
+    /// Keep the per-chunk moments of the error estimate ([`Moments`]; 72 bytes per pixel and
+    /// 29 per pixel and thread).
+    #[serde(default)]
+    pub error_estimate: bool,
+    /// Stop once the estimated relative RMSE is at most this (needs [`crate::MIN_BATCHES`]
+    /// chunks; implies `error_estimate`). Chunks being traced then finish.
+    #[serde(default)]
+    pub target_error: Option<f64>,
 }
 
 /// Memory a render may use when the available memory cannot be read (no `/proc/meminfo`):
@@ -125,8 +134,32 @@ impl RenderPlan {
     /// [`FilmWriter`] buffer per working thread. It does not grow with the thread count beyond
     /// the small buffers.
     pub fn memory_bytes(&self, width: u32, height: u32) -> u64 {
+        let threads = self.worker_threads() as u64;
+        let estimate = if self.keeps_estimate() {
+            let pixels = u64::from(width) * u64::from(height);
+            Moments::bytes_for(width, height).saturating_add(
+                threads.saturating_mul(pixels.saturating_mul(ChunkTally::BYTES_PER_PIXEL)),
+            )
+        } else {
+            0
+        };
         Film::bytes_for(width, height)
-            .saturating_add((self.worker_threads() as u64).saturating_mul(FilmWriter::BYTES))
+            .saturating_add(threads.saturating_mul(FilmWriter::BYTES))
+            .saturating_add(estimate)
+    }
+
+    /// The target error this shard stops at: the image's target times `sqrt(N)` for one of `N`
+    /// shards (N shards of equal work, each with error `e`, merge into an image with error
+    /// `e / sqrt(N)`).
+    pub fn shard_target_error(&self) -> Option<f64> {
+        let n = self.shard.map_or(1, |(_, n)| n.max(1));
+        self.target_error.map(|t| t * (n as f64).sqrt())
+    }
+
+    /// `true` if the render keeps the error estimate's moments (asked for, or needed by a
+    /// target).
+    pub fn keeps_estimate(&self) -> bool {
+        self.error_estimate || self.target_error.is_some()
     }
 
     /// Checks that a `width x height` render fits in `limit`; returns the bytes it needs.
@@ -149,8 +182,13 @@ impl RenderPlan {
             height,
             needed,
             breakdown: format!(
-                "a film of {} at 48 bytes per pixel and {threads} thread buffer{} of {}",
+                "a film of {} at 48 bytes per pixel{} and {threads} thread buffer{} of {}",
                 spectrace_geometry::human_bytes(Film::bytes_for(width, height)),
+                if self.keeps_estimate() {
+                    ", the error estimate's moments at 72 bytes per pixel and 29 per pixel and thread"
+                } else {
+                    ""
+                },
                 if threads == 1 { "" } else { "s" },
                 spectrace_geometry::human_bytes(FilmWriter::BYTES)
             ),
@@ -176,15 +214,32 @@ pub struct RenderOutput {
     pub beams: u64,
     /// Wall time (s).
     pub seconds: f64,
+    /// The per-chunk moments of the error estimate, if the plan kept them (chunks cut short by
+    /// a time budget are left out: see [`FilmWriter::discard_chunk`]).
+    #[serde(default)]
+    pub moments: Option<Moments>,
 }
 
 impl RenderOutput {
+    /// The estimated accuracy of the image (`None` if the plan kept no moments).
+    pub fn estimate(&self) -> Option<ErrorEstimate> {
+        self.moments.as_ref().map(Moments::estimate)
+    }
+
     /// Adds another shard's output (same film size); chunks must not overlap.
     ///
     /// # Errors
     /// [`FilmError::SizeMismatch`] when the films differ in size.
     pub fn merge(&mut self, other: &RenderOutput) -> Result<(), FilmError> {
         self.film.merge(&other.film)?;
+        self.moments = match (self.moments.take(), &other.moments) {
+            (Some(mut a), Some(b)) => {
+                a.merge(b)?;
+                Some(a)
+            }
+            // One side without moments: the merged image has no estimate.
+            _ => None,
+        };
         self.stats.merge(&other.stats);
         self.chunks.extend(&other.chunks);
         self.chunks.sort_unstable();
@@ -194,47 +249,106 @@ impl RenderOutput {
     }
 }
 
+/// What a render reports as it goes ([`render_observed`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Progress {
+    /// Work items done (beams, for the light tracer).
+    pub items: u64,
+    /// Wall time since the render started (s).
+    pub seconds: f64,
+    /// The error estimate, when one was just computed (at most every
+    /// [`ESTIMATE_INTERVAL`] seconds, and rarely enough to cost under 5% of the render).
+    pub estimate: Option<ErrorEstimate>,
+}
+
+/// Shortest time between two live error estimates (s).
+pub const ESTIMATE_INTERVAL: f64 = 0.05;
+
 /// Renders the plan's chunks with `integrator` on `plan.threads` threads into one shared film;
 /// `progress(items)` is called after every chunk (from worker threads) with the work items
-/// (beams, for the light tracer) done so far.
+/// (beams, for the light tracer) done so far. See [`render_observed`].
+///
+/// # Errors
+/// As [`render_observed`].
+pub fn render(
+    integrator: &dyn Integrator,
+    plan: &RenderPlan,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<RenderOutput, FilmError> {
+    render_observed(integrator, plan, &|p: &Progress| progress(p.items))
+}
+
+/// When the next live estimate is due, and what the last one cost.
+struct EstimateClock {
+    next: Instant,
+}
+
+/// Renders the plan's chunks with `integrator` on `plan.threads` threads into one shared film;
+/// `progress` is called after every chunk (from worker threads) with the work items done so far
+/// and, now and then, a fresh error estimate.
 ///
 /// The loop does not know which estimator runs: it claims chunks, hands each to
 /// [`Integrator::render_chunk`] with the thread's [`FilmWriter`], and counts the items done. The
 /// output's film holds the exact, unscaled sums; [`Integrator::image_scale`] of
 /// [`RenderOutput::beams`] normalises them.
 ///
-/// Memory: one film for the whole render plus a small [`FilmWriter`] buffer per thread
-/// ([`RenderPlan::memory_bytes`]), checked against [`MemoryLimit::system`] before anything is
-/// allocated. The film is exact, so the image is bit-identical for any thread count.
+/// Memory: one film for the whole render plus a small [`FilmWriter`] buffer per thread, and with
+/// the error estimate the [`Moments`] and a chunk tally per thread ([`RenderPlan::memory_bytes`]),
+/// checked against [`MemoryLimit::system`] before anything is allocated. The film is exact, so
+/// the image is bit-identical for any thread count (the estimate, a floating-point sum, to
+/// rounding).
 ///
 /// With a time budget, threads stop claiming chunks once it has passed (the first chunk is
 /// always claimed) and the chunks in progress stop between items within a few microseconds of
-/// work; the output counts exactly the items done.
+/// work; the output counts exactly the items done. With a target error, threads stop claiming
+/// chunks once an estimate from at least [`crate::MIN_BATCHES`] chunks reaches it; the chunks in
+/// progress finish (a little more accuracy, never less).
 ///
 /// # Errors
 /// [`FilmError::InvalidSize`] for a camera whose resolution is not a valid film;
 /// [`FilmError::TooLarge`] when the render would need more memory than it may use.
-pub fn render(
+pub fn render_observed(
     integrator: &dyn Integrator,
     plan: &RenderPlan,
-    progress: &(dyn Fn(u64) + Sync),
+    progress: &(dyn Fn(&Progress) + Sync),
 ) -> Result<RenderOutput, FilmError> {
     let started = Instant::now();
     let (w, h) = integrator.resolution();
     plan.check_memory(w, h, &MemoryLimit::system())?;
     let film = Mutex::new(Film::new(w, h)?);
+    let moments = if plan.keeps_estimate() { Some(Mutex::new(Moments::new(w, h)?)) } else { None };
     let next = AtomicU64::new(0);
     let done = AtomicU64::new(0);
+    let target_reached = AtomicBool::new(false);
+    let clock = Mutex::new(EstimateClock { next: started });
     // A budget too large to represent is no budget at all.
     let deadline = plan
         .time_budget
         .and_then(|s| Duration::try_from_secs_f64(s.max(0.0)).ok())
         .and_then(|d| started.checked_add(d));
+    // The live estimate, if one is due: computed by one thread at a time, and spaced so that
+    // it costs at most 1/20 of the time between two.
+    let live_estimate = || -> Option<ErrorEstimate> {
+        let moments = moments.as_ref()?;
+        let mut clock = clock.try_lock().ok()?;
+        let now = Instant::now();
+        if now < clock.next {
+            return None;
+        }
+        let e = moments.lock().unwrap_or_else(PoisonError::into_inner).estimate();
+        let cost = now.elapsed().as_secs_f64();
+        clock.next = Instant::now()
+            + Duration::from_secs_f64((20.0 * cost).clamp(ESTIMATE_INTERVAL, 60.0));
+        Some(e)
+    };
     let results: Mutex<Vec<(TraceStats, Vec<u64>)>> = Mutex::new(Vec::new());
     std::thread::scope(|scope| {
         for _ in 0..plan.worker_threads() {
             scope.spawn(|| {
-                let mut writer = FilmWriter::new(&film);
+                let mut writer = match &moments {
+                    Some(m) => FilmWriter::with_moments(&film, m),
+                    None => FilmWriter::new(&film),
+                };
                 let mut stats = TraceStats::default();
                 let mut mine = Vec::new();
                 loop {
@@ -244,14 +358,33 @@ pub fn render(
                     {
                         break;
                     }
+                    if target_reached.load(Ordering::Relaxed) {
+                        break;
+                    }
                     let i = next.fetch_add(1, Ordering::Relaxed);
                     let Some(c) = plan.shard_chunk(i) else { break };
                     let n = plan.beams_in_chunk(c);
                     let s = integrator.render_chunk(plan.seed, c, n, deadline, &mut writer);
-                    writer.flush();
+                    if s.beams < n {
+                        writer.discard_chunk();
+                    } else {
+                        writer.end_chunk(s.beams);
+                    }
                     stats.merge(&s);
                     mine.push(c);
-                    progress(done.fetch_add(s.beams, Ordering::Relaxed) + s.beams);
+                    let items = done.fetch_add(s.beams, Ordering::Relaxed) + s.beams;
+                    let estimate = live_estimate();
+                    if let (Some(e), Some(target)) = (estimate, plan.shard_target_error())
+                        && e.is_trusted()
+                        && e.relative_rmse.is_some_and(|r| r <= target)
+                    {
+                        target_reached.store(true, Ordering::Relaxed);
+                    }
+                    progress(&Progress {
+                        items,
+                        seconds: started.elapsed().as_secs_f64(),
+                        estimate,
+                    });
                     if s.beams < n {
                         // Cut short by the deadline.
                         break;
@@ -265,6 +398,7 @@ pub fn render(
         }
     });
     let film = film.into_inner().unwrap_or_else(PoisonError::into_inner);
+    let moments = moments.map(|m| m.into_inner().unwrap_or_else(PoisonError::into_inner));
     let mut stats = TraceStats::default();
     let mut rendered = Vec::new();
     for (s, c) in results.into_inner().unwrap_or_default() {
@@ -280,6 +414,7 @@ pub fn render(
         stats,
         chunks: rendered,
         seconds: started.elapsed().as_secs_f64(),
+        moments,
     })
 }
 
@@ -288,7 +423,16 @@ mod tests {
     use super::*;
 
     fn plan(beams: u64, chunk_beams: u64, shard: Option<(u64, u64)>) -> RenderPlan {
-        RenderPlan { beams, chunk_beams, seed: 1, threads: 1, shard, time_budget: None }
+        RenderPlan {
+            beams,
+            chunk_beams,
+            seed: 1,
+            threads: 1,
+            shard,
+            time_budget: None,
+            error_estimate: false,
+            target_error: None,
+        }
     }
 
     #[test]

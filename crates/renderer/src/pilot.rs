@@ -1,0 +1,305 @@
+//! `spectrace estimate`: how long a scene takes to reach a target error with each estimator,
+//! predicted from a short pilot render of each, before rendering.
+//!
+//! For every estimator (light, path, bdpt) the pilot renders in two rounds, keeping the error
+//! estimate ([`spectrace_tracer::Moments`]): one chunk per thread, which times a round, then as
+//! many more rounds as fit in the pilot time, on other random streams (a camera estimator's
+//! chunk is one sample per pixel, so a slow one may get only the first round). The chunks are
+//! independent, so the error falls as `1 / sqrt(items)`: reaching `E` from an error `e` after
+//! `N` items needs `N (e / E)^2` items, and at the second round's speed (free of start-up costs)
+//! the extra ones take `(N (e / E)^2 - N_1) / rate` seconds after the first round's `t_1`. The
+//! slopes of log error against log time and against log work are fitted to the second round's
+//! live estimates; the time slope is reported beside the expected -1/2 (start-up costs make it
+//! steeper early on), and the work slope replaces -1/2 in the prediction only when it differs by
+//! more than three standard errors. The stated uncertainty is the estimate's own (from its
+//! degrees of freedom), doubled because time goes as the error squared; the machine's load is
+//! not in it.
+
+use std::sync::Mutex;
+
+use serde::{Deserialize, Serialize};
+use spectrace_lights::LightSource;
+use spectrace_tracer::{IntegratorChoice, MIN_BATCHES, Progress, RenderPlan, render_observed};
+
+use crate::{
+    RenderError, RenderOptions, Scene, choose_integrator, decide_effects, duration,
+    integrator_warnings, plan_with, with_integrator,
+};
+
+/// Fewest chunks a live estimate of the pilot needs to enter the slope fit.
+pub const MIN_PILOT_CHUNKS: u64 = 4;
+
+/// Pilot time per estimator by default (s).
+pub const DEFAULT_PILOT_SECONDS: f64 = 1.5;
+
+/// What `spectrace estimate` is asked.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EstimateOptions {
+    /// The target relative RMSE.
+    pub target_error: f64,
+    /// Pilot time per estimator (s).
+    pub pilot_seconds: f64,
+    /// Worker threads (0: one per core).
+    pub threads: usize,
+    /// Seed of the pilot renders.
+    pub seed: u64,
+    /// The estimators to try (default: light, path and bdpt).
+    pub integrators: Vec<IntegratorChoice>,
+}
+
+impl Default for EstimateOptions {
+    fn default() -> Self {
+        Self {
+            target_error: 0.05,
+            pilot_seconds: DEFAULT_PILOT_SECONDS,
+            threads: 0,
+            seed: 0x5EED_0001,
+            integrators: vec![IntegratorChoice::Light, IntegratorChoice::Path, IntegratorChoice::Bdpt],
+        }
+    }
+}
+
+/// One estimator's pilot and prediction.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Prediction {
+    /// The estimator (`light`, `path`, `bdpt`).
+    pub integrator: String,
+    /// Work items the pilot rendered (beams, or camera samples).
+    pub pilot_items: u64,
+    /// Whole chunks the pilot rendered.
+    pub pilot_chunks: u64,
+    /// The pilot's render time (s).
+    pub pilot_seconds: f64,
+    /// The pilot's estimated relative error (`None`: nothing reached the camera).
+    pub pilot_error: Option<f64>,
+    /// Slope of log error against log time fitted to the pilot's live estimates (its second
+    /// round), with its standard error (`None` with fewer than three estimates).
+    pub measured_slope: Option<(f64, f64)>,
+    /// The slope of error against work the prediction used: -1/2 unless the one measured in the
+    /// pilot differs by more than three standard errors.
+    pub slope_used: f64,
+    /// Work items predicted to reach the target.
+    pub predicted_items: Option<f64>,
+    /// Render time predicted to reach the target (s).
+    pub predicted_seconds: Option<f64>,
+    /// One-sigma relative uncertainty of the predicted time.
+    pub relative_uncertainty: f64,
+    /// Why this estimator's image differs from the scene's true image (light it cannot reach),
+    /// empty when it renders everything.
+    pub misses: Vec<String>,
+}
+
+/// `spectrace estimate`'s answer.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EstimateReport {
+    /// The scene file.
+    pub scene: String,
+    /// The target relative RMSE.
+    pub target_error: f64,
+    /// One prediction per estimator tried.
+    pub predictions: Vec<Prediction>,
+    /// The fastest estimator that renders everything (or, if none does, the fastest).
+    pub recommended: Option<String>,
+    /// What `auto` (the effects analysis) picks, and why.
+    pub auto_picks: String,
+    /// The reason `auto` gives.
+    pub auto_reason: String,
+}
+
+/// Runs the pilots and predicts the time to `options.target_error` for each estimator.
+///
+/// # Errors
+/// [`RenderError::Options`] for an invalid target or pilot time, or a film that cannot be
+/// made.
+pub fn estimate(scene: &Scene, options: &EstimateOptions) -> Result<EstimateReport, RenderError> {
+    crate::check_target_error(options.target_error)
+        .map_err(|m| RenderError::Options(format!("--target-error {m}")))?;
+    if !(options.pilot_seconds > 0.0 && options.pilot_seconds <= 600.0) {
+        return Err(RenderError::Options(format!(
+            "--pilot-seconds {}: must be more than 0 and at most 600",
+            options.pilot_seconds
+        )));
+    }
+    let mut predictions = Vec::new();
+    for &choice in &options.integrators {
+        predictions.push(pilot(scene, options, choice)?);
+    }
+    let complete = |p: &&Prediction| p.misses.is_empty();
+    let fastest = |ps: Vec<&Prediction>| {
+        ps.into_iter()
+            .filter(|p| p.predicted_seconds.is_some())
+            .min_by(|a, b| a.predicted_seconds.partial_cmp(&b.predicted_seconds).unwrap_or(std::cmp::Ordering::Equal))
+            .map(|p| p.integrator.clone())
+    };
+    let recommended = fastest(predictions.iter().filter(complete).collect())
+        .or_else(|| fastest(predictions.iter().collect()));
+    let (auto, reason) = choose_integrator(scene, None);
+    Ok(EstimateReport {
+        scene: scene.path.display().to_string(),
+        target_error: options.target_error,
+        predictions,
+        recommended,
+        auto_picks: auto.name().to_owned(),
+        auto_reason: reason,
+    })
+}
+
+/// One estimator's pilot.
+fn pilot(
+    scene: &Scene,
+    options: &EstimateOptions,
+    choice: IntegratorChoice,
+) -> Result<Prediction, RenderError> {
+    let effects = decide_effects(scene, None);
+    let base = RenderOptions {
+        threads: Some(options.threads),
+        seed: Some(options.seed),
+        integrator: Some(choice),
+        ..RenderOptions::default()
+    };
+    // Round 1: one chunk per thread, all at once, times a chunk.
+    let first = RenderPlan {
+        error_estimate: true,
+        target_error: None,
+        time_budget: None,
+        ..plan_with(scene, &RenderOptions { beams: Some(1), ..base.clone() }, choice)?
+    };
+    let threads = first.threads.max(1) as u64;
+    let first = RenderPlan { beams: first.chunk_beams.saturating_mul(threads), ..first };
+    let run = |plan: &RenderPlan, observe: &(dyn Fn(&Progress) + Sync)| {
+        let out = with_integrator(scene, choice, effects, |tracer| {
+            render_observed(tracer, plan, observe)
+        })
+        .map_err(|e| RenderError::Options(e.to_string()));
+        scene.lights.reset_count();
+        out
+    };
+    let mut output = run(&first, &|_| {})?;
+    let round = output.seconds.max(1e-6);
+    // Round 2: as many more rounds as fit in the pilot time, on other random streams. Its live
+    // estimates give the measured slope, its speed the render rate (no start-up costs).
+    let rounds = ((options.pilot_seconds - round) / round).floor().max(0.0) as u64;
+    let live: Mutex<Vec<(f64, u64, f64)>> = Mutex::new(Vec::new());
+    let mut rate = output.beams as f64 / round;
+    if rounds > 0 {
+        let second = RenderPlan {
+            beams: first.beams.saturating_mul(rounds),
+            seed: first.seed.wrapping_add(0x9E37_79B9),
+            ..first
+        };
+        let observe = |p: &Progress| {
+            if let Some(e) = p.estimate
+                && let Some(r) = e.relative_rmse
+                && e.batches >= MIN_PILOT_CHUNKS
+                && let Ok(mut v) = live.lock()
+            {
+                v.push((p.seconds, e.items, r));
+            }
+        };
+        let more = run(&second, &observe)?;
+        rate = more.beams as f64 / more.seconds.max(1e-9);
+        output.merge(&more).map_err(|e| RenderError::Options(e.to_string()))?;
+        output.seconds = round + more.seconds;
+    }
+    let estimate = output.estimate().unwrap_or(spectrace_tracer::ErrorEstimate {
+        relative_rmse: None,
+        batches: 0,
+        items: 0,
+        degrees_of_freedom: 0.0,
+    });
+    let live = live.into_inner().unwrap_or_default();
+    let slope_vs_time = fit_slope(&live.iter().map(|&(t, _, e)| (t, e)).collect::<Vec<_>>());
+    let slope_vs_items =
+        fit_slope(&live.iter().map(|&(_, n, e)| (n as f64, e)).collect::<Vec<_>>());
+    // Independent chunks make the error fall as items^-1/2; a measured slope replaces it only
+    // when it is clearly different (a sign of chunks that are not independent).
+    let slope_used = match slope_vs_items {
+        Some((s, se)) if s < 0.0 && (s + 0.5).abs() > 3.0 * se => s,
+        _ => -0.5,
+    };
+    let target = options.target_error;
+    // How many times the pilot's work reaching the target takes.
+    let factor =
+        estimate.relative_rmse.filter(|&e| e > 0.0).map(|e| (e / target).powf(-1.0 / slope_used));
+    // A render to a target runs at least MIN_BATCHES chunks before it trusts its estimate.
+    let fewest = (MIN_BATCHES * first.chunk_beams) as f64;
+    let predicted_items = factor.map(|f| (output.beams as f64 * f).max(fewest));
+    let predicted_seconds = predicted_items.map(|n| round + (n - first.beams as f64).max(0.0) / rate);
+    let relative_uncertainty = 2.0 * estimate.relative_uncertainty();
+    let seconds = output.seconds;
+    let measured_slope = slope_vs_time;
+    Ok(Prediction {
+        integrator: choice.name().to_owned(),
+        pilot_items: output.beams,
+        pilot_chunks: estimate.batches,
+        pilot_seconds: seconds,
+        pilot_error: estimate.relative_rmse,
+        measured_slope,
+        slope_used,
+        predicted_items,
+        predicted_seconds,
+        relative_uncertainty,
+        misses: integrator_warnings(scene, choice),
+    })
+}
+
+/// Least-squares slope of log error against log `x` (time or work), with its standard error,
+/// over the points `(x, error)` (`None` for fewer than three).
+fn fit_slope(points: &[(f64, f64)]) -> Option<(f64, f64)> {
+    let pts: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|(t, e)| *t > 0.0 && *e > 0.0)
+        .map(|(t, e)| (t.ln(), e.ln()))
+        .collect();
+    if pts.len() < 3 {
+        return None;
+    }
+    let n = pts.len() as f64;
+    let mx = pts.iter().map(|p| p.0).sum::<f64>() / n;
+    let my = pts.iter().map(|p| p.1).sum::<f64>() / n;
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    if !(sxx > 0.0) {
+        return None;
+    }
+    let slope = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>() / sxx;
+    let residual: f64 = pts.iter().map(|p| (p.1 - my - slope * (p.0 - mx)).powi(2)).sum();
+    let se = (residual / (n - 2.0) / sxx).sqrt();
+    Some((slope, se))
+}
+
+/// The report as a Markdown table with a recommendation.
+pub fn markdown(report: &EstimateReport) -> String {
+    let mut md = format!(
+        "{}: time to {:.2}% relative RMSE, predicted from a pilot of each estimator\n\n\
+         | estimator | pilot | pilot error | slope (measured, used) | predicted time | ± (1 sigma) | misses |\n\
+         |---|---|---|---|---|---|---|\n",
+        report.scene,
+        report.target_error * 100.0
+    );
+    for p in &report.predictions {
+        let slope = match p.measured_slope {
+            Some((s, se)) => format!("{s:.2} ± {se:.2}, {:.2}", p.slope_used),
+            None => format!("-, {:.2}", p.slope_used),
+        };
+        md.push_str(&format!(
+            "| {} | {} items, {} chunks, {} | {} | {} | {} | {:.0}% | {} |\n",
+            p.integrator,
+            p.pilot_items,
+            p.pilot_chunks,
+            duration(p.pilot_seconds),
+            p.pilot_error.map_or("-".to_owned(), |e| format!("{:.2}%", e * 100.0)),
+            slope,
+            p.predicted_seconds.map_or("no light seen".to_owned(), duration),
+            p.relative_uncertainty * 100.0,
+            if p.misses.is_empty() { "nothing".to_owned() } else { p.misses.join("; ") }
+        ));
+    }
+    match &report.recommended {
+        Some(r) => md.push_str(&format!(
+            "\nrecommended: {r}; auto picks {} ({})\n",
+            report.auto_picks, report.auto_reason
+        )),
+        None => md.push_str("\nno estimator saw light in its pilot\n"),
+    }
+    md
+}

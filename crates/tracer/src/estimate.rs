@@ -1,0 +1,481 @@
+//! How accurate an image is, measured while it renders: the spread between independent chunks.
+//!
+//! Every chunk of a render ([`crate::RenderPlan`]) draws its random numbers from its own stream,
+//! so the chunk images `I_c = k S_c / n_c` (`S_c` the chunk's film sums, `n_c` its work items,
+//! `k` the estimator's normalisation) are independent, unbiased estimates of the same image, and
+//! the image itself is their item-weighted mean `I = k S / N`. [`Moments`] keeps, per pixel, the
+//! sums `S = Σ S_c` and the second moments `Q = Σ S_c S_cᵀ / n_c` (X, Y, Z and their cross terms)
+//! of the chunks finished so far; from them the variance of every pixel of `I` is
+//!
+//! ```text
+//! Var(I) = k² (Q - S Sᵀ / N) / ((C - 1) N) = s² (N Q - S Sᵀ) / (C - 1),   s = k / N,
+//! ```
+//!
+//! (`C` chunks; exact for equal chunk sizes, the usual weighted estimate otherwise). The chunks
+//! are the batches of a batch-means estimate: [`MIN_BATCHES`] of them are needed before a
+//! render may stop on a target. The image's relative RMSE, the measure of the accuracy report
+//! (`sqrt(Σ|I - T|² / Σ|T|²)` over all pixels and X, Y, Z against the converged image `T`), is
+//! estimated by `sqrt(Σ Var / (Σ I² - Σ Var))`: `Σ I² - Σ Var` is an unbiased estimate of
+//! `Σ T²`. The normalisation `k` cancels, so the estimate needs no knowledge of the estimator.
+//!
+//! What it cannot see: bias. Light an estimator cannot reach (a path tracer and a laser) is
+//! missing from every chunk alike. With the Sobol sampler and a camera integrator, the passes of
+//! a pixel are points of one sequence, not independent, and the estimate is the independent
+//! sampler's error: an upper bound on the true one.
+
+use std::sync::{Mutex, PoisonError};
+
+use serde::{Deserialize, Serialize};
+use spectrace_spectrum::Xyz;
+
+use crate::FilmError;
+
+/// Chunks (batches) a render needs before its error estimate is trusted to stop it.
+pub const MIN_BATCHES: u64 = 16;
+
+/// Bytes [`Moments`] keeps per pixel: nine `f64`.
+const MOMENT_BYTES: u64 = 9 * 8;
+
+/// Per-pixel first and second moments of the chunk sums of a render (see the module essay).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Moments {
+    width: u32,
+    height: u32,
+    /// Per pixel: `[Sx, Sy, Sz, Qxx, Qyy, Qzz, Qxy, Qxz, Qyz]`.
+    sums: Vec<[f64; 9]>,
+    /// Chunks folded in.
+    chunks: u64,
+    /// Work items of those chunks.
+    items: u64,
+}
+
+/// The estimated accuracy of an image.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ErrorEstimate {
+    /// Estimated relative RMSE against the converged image (over all pixels and X, Y, Z);
+    /// `None` with fewer than two chunks or when the noise is as large as the signal.
+    pub relative_rmse: Option<f64>,
+    /// Chunks (independent batches) the estimate comes from.
+    pub batches: u64,
+    /// Work items (beams or camera samples) of those chunks.
+    pub items: u64,
+    /// Effective degrees of freedom of the variance estimate (Welch-Satterthwaite over the
+    /// pixels and channels); the estimate's own relative uncertainty is about
+    /// `1 / sqrt(2 dof)`.
+    pub degrees_of_freedom: f64,
+}
+
+impl ErrorEstimate {
+    /// The relative standard deviation of [`ErrorEstimate::relative_rmse`] itself (one sigma):
+    /// `1 / sqrt(2 dof)`; infinite without degrees of freedom.
+    pub fn relative_uncertainty(&self) -> f64 {
+        if self.degrees_of_freedom > 0.0 {
+            (2.0 * self.degrees_of_freedom).sqrt().recip()
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// `true` once the estimate comes from at least [`MIN_BATCHES`] chunks.
+    pub fn is_trusted(&self) -> bool {
+        self.batches >= MIN_BATCHES && self.relative_rmse.is_some()
+    }
+
+    /// Work items needed to reach relative error `target`, with error falling as
+    /// `1 / sqrt(items)` (exact for independent chunks); `None` without an estimate.
+    pub fn items_for(&self, target: f64) -> Option<f64> {
+        let e = self.relative_rmse?;
+        (target > 0.0).then(|| self.items as f64 * (e / target).powi(2))
+    }
+}
+
+impl Moments {
+    /// Empty moments for a `width x height` film.
+    ///
+    /// # Errors
+    /// [`FilmError::InvalidSize`] as for [`crate::Film::new`].
+    pub fn new(width: u32, height: u32) -> Result<Self, FilmError> {
+        let n = u64::from(width) * u64::from(height);
+        if width == 0 || height == 0 || n > crate::MAX_PIXELS {
+            return Err(FilmError::InvalidSize(width, height));
+        }
+        Ok(Self { width, height, sums: vec![[0.0; 9]; n as usize], chunks: 0, items: 0 })
+    }
+
+    /// Bytes the moments of a `width x height` film occupy (72 per pixel).
+    pub fn bytes_for(width: u32, height: u32) -> u64 {
+        (u64::from(width) * u64::from(height))
+            .saturating_mul(MOMENT_BYTES)
+            .saturating_add(std::mem::size_of::<Moments>() as u64)
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Chunks folded in.
+    pub fn chunks(&self) -> u64 {
+        self.chunks
+    }
+
+    /// Work items of the chunks folded in.
+    pub fn items(&self) -> u64 {
+        self.items
+    }
+
+    /// Folds in one finished chunk of `items` work items whose film sums are `pixels`
+    /// (`(index, [X, Y, Z])`, every pixel at most once; pixels not listed received nothing).
+    pub fn add_chunk(&mut self, pixels: impl IntoIterator<Item = (usize, [f64; 3])>, items: u64) {
+        self.chunks += 1;
+        self.items = self.items.saturating_add(items);
+        if items == 0 {
+            return;
+        }
+        let inv = 1.0 / items as f64;
+        for (index, [x, y, z]) in pixels {
+            let Some(m) = self.sums.get_mut(index) else { continue };
+            m[0] += x;
+            m[1] += y;
+            m[2] += z;
+            m[3] += x * x * inv;
+            m[4] += y * y * inv;
+            m[5] += z * z * inv;
+            m[6] += x * y * inv;
+            m[7] += x * z * inv;
+            m[8] += y * z * inv;
+        }
+    }
+
+    /// Adds another render's moments (same size; their chunks must be other chunks of the
+    /// same image, e.g. another shard).
+    ///
+    /// # Errors
+    /// [`FilmError::SizeMismatch`] when the sizes differ.
+    pub fn merge(&mut self, other: &Moments) -> Result<(), FilmError> {
+        if (self.width, self.height) != (other.width, other.height) {
+            return Err(FilmError::SizeMismatch(
+                self.width,
+                self.height,
+                other.width,
+                other.height,
+            ));
+        }
+        for (a, b) in self.sums.iter_mut().zip(&other.sums) {
+            for (x, y) in a.iter_mut().zip(b) {
+                *x += y;
+            }
+        }
+        self.chunks += other.chunks;
+        self.items = self.items.saturating_add(other.items);
+        Ok(())
+    }
+
+    /// Checks moments read from a file: one entry per pixel, every value finite, sums of
+    /// light never negative.
+    ///
+    /// # Errors
+    /// What is wrong, in words.
+    pub fn validate(&self) -> Result<(), String> {
+        let pixels = u64::from(self.width) * u64::from(self.height);
+        if self.sums.len() as u64 != pixels {
+            return Err(format!(
+                "holds {} pixels, but a {}x{} image has {pixels}",
+                self.sums.len(),
+                self.width,
+                self.height
+            ));
+        }
+        if let Some(i) = self.sums.iter().position(|m| {
+            !m.iter().all(|v| v.is_finite()) || !(m[0] >= 0.0 && m[1] >= 0.0 && m[2] >= 0.0)
+        }) {
+            return Err(format!("pixel {i}: a value is not finite, or a sum of light is negative"));
+        }
+        Ok(())
+    }
+
+    /// The covariance of X, Y, Z of pixel `m` times `(C - 1) / s²`: `N Q - S Sᵀ` as
+    /// `[xx, yy, zz, xy, xz, yz]`, the diagonal clamped at 0 (rounding can make a noiseless
+    /// pixel's slightly negative).
+    fn scaled_covariance(&self, m: &[f64; 9]) -> [f64; 6] {
+        let n = self.items as f64;
+        let [sx, sy, sz] = [m[0], m[1], m[2]];
+        [
+            (n * m[3] - sx * sx).max(0.0),
+            (n * m[4] - sy * sy).max(0.0),
+            (n * m[5] - sz * sz).max(0.0),
+            n * m[6] - sx * sy,
+            n * m[7] - sx * sz,
+            n * m[8] - sy * sz,
+        ]
+    }
+
+    /// The estimated relative RMSE of the image these chunks make (see the module essay).
+    pub fn estimate(&self) -> ErrorEstimate {
+        let mut estimate = ErrorEstimate {
+            relative_rmse: None,
+            batches: self.chunks,
+            items: self.items,
+            degrees_of_freedom: 0.0,
+        };
+        if self.chunks < 2 || self.items == 0 {
+            return estimate;
+        }
+        // Everything in units of s² (s = k / N): the ratio does not depend on it. Variance per
+        // pixel and channel: cov / (C - 1); signal: S² (the image squared over s²).
+        let dof = (self.chunks - 1) as f64;
+        let (mut variance, mut variance_sq, mut signal) = (0.0, 0.0, 0.0);
+        for m in &self.sums {
+            let c = self.scaled_covariance(m);
+            for v in &c[..3] {
+                let v = v / dof;
+                variance += v;
+                variance_sq += v * v;
+            }
+            signal += m[0] * m[0] + m[1] * m[1] + m[2] * m[2];
+        }
+        let truth = signal - variance;
+        if variance_sq > 0.0 {
+            estimate.degrees_of_freedom = dof * variance * variance / variance_sq;
+        }
+        if truth > 0.0 && variance.is_finite() {
+            estimate.relative_rmse = Some((variance / truth).sqrt());
+        }
+        estimate
+    }
+
+    /// The standard error of every pixel of the image `s S` (`s` = the image's scale per film
+    /// unit), in linear sRGB like the image: `sqrt(mᵀ Cov m)` for each row `m` of the XYZ to
+    /// linear sRGB matrix. All zero with fewer than two chunks.
+    pub fn standard_error_rgb(&self, scale: f64) -> Vec<[f64; 3]> {
+        if self.chunks < 2 {
+            return vec![[0.0; 3]; self.sums.len()];
+        }
+        let rows = srgb_rows();
+        let factor = scale * scale / (self.chunks - 1) as f64;
+        self.sums
+            .iter()
+            .map(|m| {
+                let [xx, yy, zz, xy, xz, yz] = self.scaled_covariance(m);
+                rows.map(|[a, b, c]| {
+                    let v = a * a * xx
+                        + b * b * yy
+                        + c * c * zz
+                        + 2.0 * (a * b * xy + a * c * xz + b * c * yz);
+                    (v.max(0.0) * factor).sqrt()
+                })
+            })
+            .collect()
+    }
+}
+
+/// The rows of the XYZ to linear sRGB matrix.
+fn srgb_rows() -> [[f64; 3]; 3] {
+    let cols = [Xyz::new(1.0, 0.0, 0.0), Xyz::new(0.0, 1.0, 0.0), Xyz::new(0.0, 0.0, 1.0)]
+        .map(Xyz::to_linear_srgb);
+    [0, 1, 2].map(|r| [cols[0][r], cols[1][r], cols[2][r]])
+}
+
+/// A thread's sums of the chunk it is rendering, folded into shared [`Moments`] when the chunk
+/// ends ([`crate::FilmWriter::end_chunk`]). Dense (24 bytes per pixel, allocated at the first
+/// contribution) with a list of the pixels touched, so a chunk that lights few pixels costs
+/// little to fold.
+#[derive(Debug)]
+pub(crate) struct ChunkTally<'a> {
+    moments: &'a Mutex<Moments>,
+    pixels: usize,
+    sums: Vec<[f64; 3]>,
+    /// Whether each pixel is in `touched`.
+    listed: Vec<bool>,
+    touched: Vec<u32>,
+}
+
+impl<'a> ChunkTally<'a> {
+    /// Bytes a tally takes per pixel at most: the sums and the touched list.
+    pub(crate) const BYTES_PER_PIXEL: u64 = 24 + 1 + 4;
+
+    /// A tally folding into `moments`.
+    pub(crate) fn new(moments: &'a Mutex<Moments>) -> Self {
+        let pixels = moments.lock().unwrap_or_else(PoisonError::into_inner).sums.len();
+        Self { moments, pixels, sums: Vec::new(), listed: Vec::new(), touched: Vec::new() }
+    }
+
+    /// Adds a contribution to pixel `index` of the current chunk.
+    #[inline]
+    pub(crate) fn add(&mut self, index: usize, xyz: [f64; 3]) {
+        if self.sums.is_empty() {
+            self.sums = vec![[0.0; 3]; self.pixels];
+            self.listed = vec![false; self.pixels];
+        }
+        let (Some(s), Some(listed)) = (self.sums.get_mut(index), self.listed.get_mut(index))
+        else {
+            return;
+        };
+        if !*listed {
+            *listed = true;
+            self.touched.push(index as u32);
+        }
+        for (a, b) in s.iter_mut().zip(xyz) {
+            *a += b;
+        }
+    }
+
+    /// Folds the current chunk (`items` work items) into the moments and starts a new one.
+    pub(crate) fn end_chunk(&mut self, items: u64) {
+        let mut moments = self.moments.lock().unwrap_or_else(PoisonError::into_inner);
+        let sums = &self.sums;
+        moments.add_chunk(self.touched.iter().map(|&i| (i as usize, sums[i as usize])), items);
+        drop(moments);
+        self.discard();
+    }
+
+    /// Forgets the current chunk and starts a new one.
+    pub(crate) fn discard(&mut self) {
+        for &i in &self.touched {
+            self.sums[i as usize] = [0.0; 3];
+            self.listed[i as usize] = false;
+        }
+        self.touched.clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+
+    /// A synthetic render: `pixels` pixels whose chunk sums are the sum of `items` draws of
+    /// `value * (1 + noise * u)`, u uniform in [-1, 1].
+    fn synthetic(chunks: u64, items: u64, seed: u64) -> (Moments, Vec<[f64; 3]>) {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+        let (w, h) = (16, 8);
+        let mut m = Moments::new(w, h).unwrap();
+        let mut total = vec![[0.0; 3]; (w * h) as usize];
+        for _ in 0..chunks {
+            let mut chunk = vec![[0.0; 3]; (w * h) as usize];
+            for _ in 0..items {
+                let p = rng.random_range(0..(w * h) as usize);
+                let u: f64 = rng.random_range(-1.0..1.0);
+                let v = 1.0 + (p % 7) as f64 * 0.1;
+                chunk[p][0] += v * (1.0 + 0.5 * u);
+                chunk[p][1] += v;
+                chunk[p][2] += 0.5 * v * (1.0 - 0.5 * u);
+            }
+            for (t, c) in total.iter_mut().zip(&chunk) {
+                for k in 0..3 {
+                    t[k] += c[k];
+                }
+            }
+            m.add_chunk(chunk.into_iter().enumerate(), items);
+        }
+        (m, total)
+    }
+
+    #[test]
+    fn estimate_matches_the_spread_of_independent_renders() {
+        // The true relative RMSE of a render, measured from 40 independent renders against
+        // their mean (the converged image), against the estimate of each render alone. With
+        // 32 chunks per render the estimate's own noise is a few percent; 15% bounds it.
+        let (renders, chunks, items) = (40u64, 32, 2000);
+        let runs: Vec<(Moments, Vec<[f64; 3]>)> =
+            (0..renders).map(|r| synthetic(chunks, items, 100 + r)).collect();
+        let n = (chunks * items) as f64;
+        let mut mean = vec![[0.0; 3]; runs[0].1.len()];
+        for (_, img) in &runs {
+            for (a, b) in mean.iter_mut().zip(img) {
+                for k in 0..3 {
+                    a[k] += b[k] / n / renders as f64;
+                }
+            }
+        }
+        let (mut diff, mut norm) = (0.0, 0.0);
+        for (_, img) in &runs {
+            for (a, t) in img.iter().zip(&mean) {
+                for k in 0..3 {
+                    diff += (a[k] / n - t[k]).powi(2);
+                    norm += t[k] * t[k];
+                }
+            }
+        }
+        let truth = (diff / norm).sqrt();
+        let estimated: f64 =
+            runs.iter().map(|(m, _)| m.estimate().relative_rmse.unwrap()).sum::<f64>()
+                / renders as f64;
+        assert!((estimated / truth - 1.0).abs() < 0.15, "estimate {estimated}, truth {truth}");
+        let e = runs[0].0.estimate();
+        assert!(e.is_trusted() && e.batches == chunks && e.items == chunks * items);
+        assert!(e.degrees_of_freedom > 100.0, "{}", e.degrees_of_freedom);
+    }
+
+    #[test]
+    fn noiseless_images_estimate_zero_and_one_chunk_estimates_nothing() {
+        let mut m = Moments::new(2, 1).unwrap();
+        m.add_chunk([(0, [2.0, 2.0, 2.0])], 4);
+        assert_eq!(m.estimate().relative_rmse, None);
+        assert_eq!(m.standard_error_rgb(1.0), vec![[0.0; 3]; 2]);
+        m.add_chunk([(0, [2.0, 2.0, 2.0])], 4);
+        assert_eq!(m.estimate().relative_rmse, Some(0.0));
+        // A black image has no relative error.
+        let mut black = Moments::new(2, 1).unwrap();
+        black.add_chunk([], 4);
+        black.add_chunk([], 4);
+        assert_eq!(black.estimate().relative_rmse, None);
+    }
+
+    #[test]
+    fn merged_moments_estimate_what_one_render_of_all_chunks_does() {
+        let (a, _) = synthetic(10, 500, 1);
+        let (b, _) = synthetic(12, 500, 2);
+        let mut merged = a.clone();
+        merged.merge(&b).unwrap();
+        assert_eq!((merged.chunks(), merged.items()), (22, 11_000));
+        let e = merged.estimate().relative_rmse.unwrap();
+        let ea = a.estimate().relative_rmse.unwrap();
+        // More chunks of the same kind: the error falls by about sqrt(22 / 10).
+        assert!((ea / e / (22.0f64 / 10.0).sqrt() - 1.0).abs() < 0.25, "{ea} {e}");
+        assert!(merged.merge(&Moments::new(3, 3).unwrap()).is_err());
+    }
+
+    #[test]
+    fn the_rgb_error_of_a_luminance_only_noise_follows_the_matrix() {
+        // Noise in Y alone (X and Z constant): the sRGB errors are |row_Y| times Y's error.
+        let mut m = Moments::new(1, 1).unwrap();
+        for (c, y) in [1.0, 3.0, 1.0, 3.0].into_iter().enumerate() {
+            let _ = c;
+            m.add_chunk([(0, [1.0, y, 1.0])], 1);
+        }
+        // Y's chunk values 1, 3, 1, 3: sample variance 4/3; the image (scale 1/4 per item
+        // over 4 items) has standard error sqrt(4/3 / 4) = 0.577 in Y.
+        let se = m.standard_error_rgb(0.25)[0];
+        let rows = srgb_rows();
+        for r in 0..3 {
+            let expected = rows[r][1].abs() * (4.0f64 / 3.0 / 4.0).sqrt();
+            assert!((se[r] - expected).abs() < 1e-12, "{r}: {} vs {expected}", se[r]);
+        }
+    }
+
+    #[test]
+    fn a_tally_lists_each_pixel_once_even_when_its_sum_returns_to_zero() {
+        let moments = Mutex::new(Moments::new(4, 1).unwrap());
+        let mut t = ChunkTally::new(&moments);
+        t.add(1, [1.0, 0.0, 0.0]);
+        t.add(1, [-1.0, 0.0, 0.0]);
+        t.add(1, [2.0, 0.0, 0.0]);
+        t.add(3, [0.0, 0.0, 0.0]);
+        t.end_chunk(2);
+        t.add(1, [4.0, 0.0, 0.0]);
+        t.end_chunk(2);
+        let m = moments.into_inner().unwrap();
+        assert_eq!(m.sums[1][0], 6.0);
+        // Second moments: 2^2 / 2 + 4^2 / 2.
+        assert_eq!(m.sums[1][3], 10.0);
+        // A pixel that received only zeros adds zeros.
+        assert_eq!(m.sums[3], [0.0; 9]);
+        assert_eq!((m.chunks(), m.items()), (2, 4));
+    }
+}
