@@ -8,6 +8,8 @@
 //! - `cargo xtask ci`: runs the same checks as `.ci/run` (tests, rustfmt, clippy).
 //! - `cargo xtask render [SCENE] [options]`: builds the renderer in release mode and renders a
 //!   scene (default `scenes/showcase.json`); options go to `spectrace render`.
+//! - `cargo xtask estimate SCENE --target-error E [options]`: predicts the render time to E for
+//!   each estimator from short pilots (`spectrace estimate`).
 //! - `cargo xtask accuracy [SCENES]`: the error-against-time report, `docs/accuracy.md`.
 //! - `cargo xtask fuzz [--cases N] [--seed S]`: a longer run of the scene and part-file fuzzer
 //!   (`tests/tests/fuzz.rs`) in release mode.
@@ -88,6 +90,7 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         "render" => render(&args[1..]),
+        "estimate" => estimate(&args[1..]),
         "accuracy" => accuracy(&args[1..]),
         "fuzz" => fuzz(&args[1..]),
         "peer" => peer::run(&args[1..]),
@@ -108,6 +111,14 @@ fn workspace_root() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
         .map_or_else(|| ".".into(), |p| p.to_path_buf())
+}
+
+/// `cargo xtask estimate SCENE --target-error E [options]`: builds the renderer in release mode
+/// and predicts the time to E per estimator from short pilots (`spectrace estimate`).
+fn estimate(args: &[String]) -> ExitCode {
+    let mut command: Vec<String> = vec!["estimate".into()];
+    command.extend(args.iter().cloned());
+    run_spectrace(&command)
 }
 
 /// `cargo xtask render [SCENE] [options]`: builds the renderer in release mode and renders the
@@ -230,8 +241,10 @@ fn print_help() {
         "usage: cargo xtask [COMMAND]\n\n\
          commands:\n  \
          status   what Spectrace contains so far (default)\n  \
-         render [SCENE] [--integrator auto|light|path|bdpt] [--beams N | --spp N | --time SECS]\n                  [--out DIR] [--threads N] [--seed S] [--shard K/N]\n           \
+         render [SCENE] [--integrator auto|light|path|bdpt] [--beams N | --spp N | --time SECS]\n                  [--target-error E] [--out DIR] [--threads N] [--seed S] [--shard K/N]\n           \
                   build in release and render SCENE (default scenes/showcase.json)\n  \
+         estimate SCENE --target-error E [--pilot-seconds S] [--integrators light,path,bdpt]\n           \
+                  predict the render time to E for each estimator from short pilots\n  \
          accuracy [SCENES]  error against time for every accuracy knob (docs/accuracy.md)\n  \
          fuzz [--cases N] [--seed S]  fuzz the scene and part-file loaders (release)\n  \
          peer [--scenes A,B] [--max-seconds S] [--reference-scale F] [--no-docs]\n           \
@@ -252,7 +265,8 @@ fn status() -> ExitCode {
     }
     println!(
         "\nRender the showcase scene:  cargo xtask render\n\
-         Render any scene:           cargo xtask render scenes/NAME.json [--integrator auto|light|path|bdpt] [--beams N | --spp N | --time SECS] [--out DIR] [--threads N] [--seed S]\n\
+         Render any scene:           cargo xtask render scenes/NAME.json [--integrator auto|light|path|bdpt] [--beams N | --spp N | --time SECS | --target-error E] [--out DIR] [--threads N] [--seed S]\n\
+         Predict the time to 5%:     cargo xtask estimate scenes/NAME.json --target-error 0.05\n\
          Accuracy against time:      cargo xtask accuracy [SCENES]\n\
          Race against Mitsuba 3:     cargo xtask peer (python3, pip, libLLVM >= 16; docs/peer.md)\n\
          Run every test:             cargo test --workspace\n\

@@ -461,6 +461,9 @@ where
                 report.rejected_contributions,
                 report.outputs.join(", ")
             );
+            if let Some(e) = &report.error_estimate {
+                println!("{}", e.summary());
+            }
             ExitCode::SUCCESS
         }
         Err(e) => {

@@ -39,8 +39,8 @@ pub use files::{
 pub use output::{EncodedImage, OUTPUT_BYTES_PER_PIXEL, encode_image, write_exr, write_png};
 pub use part::{PARTIAL_VERSION, PartialFilm};
 pub use scene::{
-    DEFAULT_SPP, check_target_error, EffectsSettings, LoadOptions, Object, OutputSettings, Scene, SceneError,
-    SceneFile, Settings,
+    DEFAULT_SPP, EffectsSettings, LoadOptions, Object, OutputSettings, Scene, SceneError,
+    SceneFile, Settings, check_target_error,
 };
 
 /// Command-line overrides of a scene's settings.
@@ -209,7 +209,10 @@ impl AccuracyEstimate {
     /// One line for the terminal: `error 3.2% ±0.1% (64 batches); 2%: ~41 s`.
     pub fn summary(&self) -> String {
         let Some(e) = self.relative_rmse else {
-            return format!("error: no estimate ({} batches, need 2 and a lit image)", self.batches);
+            return format!(
+                "error: no estimate ({} batches, need 2 and a lit image)",
+                self.batches
+            );
         };
         let mut line = format!(
             "estimated error {:.2}% ±{:.2}% ({} batches{})",
@@ -763,8 +766,8 @@ fn render_with(
             bar.set_message(progress_message(e, target, p.seconds));
         }
     };
-    let output = render_observed(tracer, &plan, &update)
-        .map_err(|e| RenderError::Options(e.to_string()))?;
+    let output =
+        render_observed(tracer, &plan, &update).map_err(|e| RenderError::Options(e.to_string()))?;
     let pixels = u64::from(scene.camera.width()) * u64::from(scene.camera.height());
     let numerator = normalisation(choice, scene.lights.power(), pixels);
     bar.finish_and_clear();
@@ -908,7 +911,11 @@ fn progress_bar(plan: &RenderPlan, visible: bool) -> indicatif::ProgressBar {
 
 /// The progress bar's message for a live estimate: the error and, with a target, the time
 /// still needed (error falling as `1 / sqrt(time)`).
-fn progress_message(e: &spectrace_tracer::ErrorEstimate, target: Option<f64>, seconds: f64) -> String {
+fn progress_message(
+    e: &spectrace_tracer::ErrorEstimate,
+    target: Option<f64>,
+    seconds: f64,
+) -> String {
     let Some(r) = e.relative_rmse else {
         return format!("error: waiting for batches ({})", e.batches);
     };

@@ -45,6 +45,9 @@ pub struct EstimateOptions {
     pub seed: u64,
     /// The estimators to try (default: light, path and bdpt).
     pub integrators: Vec<IntegratorChoice>,
+    /// Rounds after the first, instead of as many as fit in the pilot time: a pilot whose
+    /// work does not depend on the machine's speed (for tests).
+    pub fixed_rounds: Option<u64>,
 }
 
 impl Default for EstimateOptions {
@@ -54,7 +57,12 @@ impl Default for EstimateOptions {
             pilot_seconds: DEFAULT_PILOT_SECONDS,
             threads: 0,
             seed: 0x5EED_0001,
-            integrators: vec![IntegratorChoice::Light, IntegratorChoice::Path, IntegratorChoice::Bdpt],
+            integrators: vec![
+                IntegratorChoice::Light,
+                IntegratorChoice::Path,
+                IntegratorChoice::Bdpt,
+            ],
+            fixed_rounds: None,
         }
     }
 }
@@ -128,7 +136,11 @@ pub fn estimate(scene: &Scene, options: &EstimateOptions) -> Result<EstimateRepo
     let fastest = |ps: Vec<&Prediction>| {
         ps.into_iter()
             .filter(|p| p.predicted_seconds.is_some())
-            .min_by(|a, b| a.predicted_seconds.partial_cmp(&b.predicted_seconds).unwrap_or(std::cmp::Ordering::Equal))
+            .min_by(|a, b| {
+                a.predicted_seconds
+                    .partial_cmp(&b.predicted_seconds)
+                    .unwrap_or(std::cmp::Ordering::Equal)
+            })
             .map(|p| p.integrator.clone())
     };
     let recommended = fastest(predictions.iter().filter(complete).collect())
@@ -178,7 +190,9 @@ fn pilot(
     let round = output.seconds.max(1e-6);
     // Round 2: as many more rounds as fit in the pilot time, on other random streams. Its live
     // estimates give the measured slope, its speed the render rate (no start-up costs).
-    let rounds = ((options.pilot_seconds - round) / round).floor().max(0.0) as u64;
+    let rounds = options.fixed_rounds.unwrap_or_else(|| {
+        ((options.pilot_seconds - round) / round).floor().clamp(0.0, 1e6) as u64
+    });
     let live: Mutex<Vec<(f64, u64, f64)>> = Mutex::new(Vec::new());
     let mut rate = output.beams as f64 / round;
     if rounds > 0 {
@@ -224,7 +238,8 @@ fn pilot(
     // A render to a target runs at least MIN_BATCHES chunks before it trusts its estimate.
     let fewest = (MIN_BATCHES * first.chunk_beams) as f64;
     let predicted_items = factor.map(|f| (output.beams as f64 * f).max(fewest));
-    let predicted_seconds = predicted_items.map(|n| round + (n - first.beams as f64).max(0.0) / rate);
+    let predicted_seconds =
+        predicted_items.map(|n| round + (n - first.beams as f64).max(0.0) / rate);
     let relative_uncertainty = 2.0 * estimate.relative_uncertainty();
     let seconds = output.seconds;
     let measured_slope = slope_vs_time;

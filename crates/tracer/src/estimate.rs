@@ -192,7 +192,7 @@ impl Moments {
             ));
         }
         if let Some(i) = self.sums.iter().position(|m| {
-            !m.iter().all(|v| v.is_finite()) || !(m[0] >= 0.0 && m[1] >= 0.0 && m[2] >= 0.0)
+            !(m.iter().all(|v| v.is_finite()) && m[0] >= 0.0 && m[1] >= 0.0 && m[2] >= 0.0)
         }) {
             return Err(format!("pixel {i}: a value is not finite, or a sum of light is negative"));
         }
@@ -312,8 +312,7 @@ impl<'a> ChunkTally<'a> {
             self.sums = vec![[0.0; 3]; self.pixels];
             self.listed = vec![false; self.pixels];
         }
-        let (Some(s), Some(listed)) = (self.sums.get_mut(index), self.listed.get_mut(index))
-        else {
+        let (Some(s), Some(listed)) = (self.sums.get_mut(index), self.listed.get_mut(index)) else {
             return;
         };
         if !*listed {

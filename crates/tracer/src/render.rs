@@ -337,8 +337,8 @@ pub fn render_observed(
         }
         let e = moments.lock().unwrap_or_else(PoisonError::into_inner).estimate();
         let cost = now.elapsed().as_secs_f64();
-        clock.next = Instant::now()
-            + Duration::from_secs_f64((20.0 * cost).clamp(ESTIMATE_INTERVAL, 60.0));
+        clock.next =
+            Instant::now() + Duration::from_secs_f64((20.0 * cost).clamp(ESTIMATE_INTERVAL, 60.0));
         Some(e)
     };
     let results: Mutex<Vec<(TraceStats, Vec<u64>)>> = Mutex::new(Vec::new());
