@@ -645,39 +645,60 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
     let plan = plan_with(scene, options, choice)?;
     let name = scene.output_name();
     planned_outputs(&options.out_dir, &name, &scene.output, plan.shard, &scene.inputs)?;
-    let (plan, _) = fit_estimate(scene, plan);
+    let (plan, estimate_warning) = fit_estimate(scene, plan)?;
     let effects = decide_effects(scene, options.effects);
     if options.verbose {
         eprintln!("{}", effects.summary());
         eprintln!("integrator: {reason}");
     }
     with_integrator(scene, choice, effects, |tracer| {
-        render_with(scene, options, choice, &reason, effects, plan, &name, tracer)
+        let setup = Setup { choice, reason: &reason, effects, plan, name: &name };
+        render_with(scene, options, &setup, estimate_warning.into_iter().collect(), tracer)
     })
 }
 
 /// The plan without the error estimate when its moments would not fit in memory but the
-/// render would (a very large image), with a warning saying so; the plan unchanged otherwise.
-/// With a target error the estimate is needed: the plan is kept and the render refused.
-fn fit_estimate(scene: &Scene, plan: RenderPlan) -> (RenderPlan, Option<String>) {
-    if plan.target_error.is_some() || !plan.keeps_estimate() {
-        return (plan, None);
+/// render would, or would make a shard's part file larger than a part may be (a very large
+/// image), with a warning saying so; the plan unchanged otherwise.
+///
+/// # Errors
+/// [`RenderError::Options`] when a target error needs the estimate that does not fit.
+fn fit_estimate(
+    scene: &Scene,
+    plan: RenderPlan,
+) -> Result<(RenderPlan, Option<String>), RenderError> {
+    if !plan.keeps_estimate() {
+        return Ok((plan, None));
     }
     let (w, h) = (scene.camera.width(), scene.camera.height());
     let limit = MemoryLimit::system();
     let without = RenderPlan { error_estimate: false, ..plan };
-    if plan.check_memory(w, h, &limit).is_err() && without.check_memory(w, h, &limit).is_ok() {
-        let warning = format!(
-            "no error estimate: its moments for a {w}x{h} image ({} more) do not fit in the \
-             memory a render may use ({})",
-            spectrace_geometry::human_bytes(
-                plan.memory_bytes(w, h).saturating_sub(without.memory_bytes(w, h))
-            ),
+    let estimate_bytes = plan.memory_bytes(w, h).saturating_sub(without.memory_bytes(w, h));
+    // A part file holds the film (up to 48 bytes per pixel) and the moments (72).
+    let part_bytes = (u64::from(w) * u64::from(h)).saturating_mul(48 + 72);
+    let why = if plan.shard.is_some() && part_bytes > MAX_PART_BYTES {
+        format!(
+            "a part file of a {w}x{h} image with its moments would exceed the {} part-file limit",
+            spectrace_geometry::human_bytes(MAX_PART_BYTES)
+        )
+    } else if plan.check_memory(w, h, &limit).is_err() && without.check_memory(w, h, &limit).is_ok()
+    {
+        format!(
+            "its moments for a {w}x{h} image ({} more) do not fit in the memory a render may \
+             use ({})",
+            spectrace_geometry::human_bytes(estimate_bytes),
             limit.source
-        );
-        return (without, Some(warning));
+        )
+    } else {
+        return Ok((plan, None));
+    };
+    // A target needs the estimate.
+    if plan.target_error.is_some() {
+        return Err(RenderError::Options(format!(
+            "--target-error / settings.target_error needs the error estimate, but {why}"
+        )));
     }
-    (plan, None)
+    Ok((without, Some(format!("no error estimate: {why}"))))
 }
 
 /// Runs `f` with the estimator `choice` for `scene`, following `effects`.
@@ -730,23 +751,27 @@ pub fn render_in_memory(
     Ok(InMemoryRender { output, image, integrator: choice })
 }
 
-/// The rest of [`render_scene`], once the estimator is built.
-#[allow(clippy::too_many_arguments)]
+/// What [`render_scene`] decided before building the estimator.
+struct Setup<'a> {
+    choice: IntegratorChoice,
+    reason: &'a str,
+    effects: Effects,
+    plan: RenderPlan,
+    name: &'a str,
+}
+
+/// The rest of [`render_scene`], once the estimator is built; `warnings` are the ones found so
+/// far.
 fn render_with(
     scene: &Scene,
     options: &RenderOptions,
-    choice: IntegratorChoice,
-    reason: &str,
-    effects: Effects,
-    plan: RenderPlan,
-    name: &str,
+    setup: &Setup<'_>,
+    mut warnings: Vec<String>,
     tracer: &dyn Integrator,
 ) -> Result<RenderReport, RenderError> {
+    let Setup { choice, reason, effects, plan, name } = *setup;
     let name = name.to_owned();
-    let mut warnings = integrator_warnings(scene, choice);
-    if let (_, Some(w)) = fit_estimate(scene, plan) {
-        warnings.push(w);
-    }
+    warnings.extend(integrator_warnings(scene, choice));
     // The light tracer's probe checks that light can reach the camera (for camera integrators a
     // black image is reported after the render).
     let probed = probe_with(scene, &plan, tracer)?;

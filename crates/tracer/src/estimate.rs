@@ -47,6 +47,11 @@ pub struct Moments {
     chunks: u64,
     /// Work items of those chunks.
     items: u64,
+    /// Running totals over the pixels, kept as chunks are folded in, for an estimate in O(1)
+    /// ([`Moments::quick_estimate`]): `Σ (Qxx + Qyy + Qzz)` and `Σ (Sx² + Sy² + Sz²)`.
+    /// Derived data: not stored in part files, recomputed after a merge.
+    #[serde(skip)]
+    totals: [f64; 2],
 }
 
 /// The estimated accuracy of an image.
@@ -99,7 +104,14 @@ impl Moments {
         if width == 0 || height == 0 || n > crate::MAX_PIXELS {
             return Err(FilmError::InvalidSize(width, height));
         }
-        Ok(Self { width, height, sums: vec![[0.0; 9]; n as usize], chunks: 0, items: 0 })
+        Ok(Self {
+            width,
+            height,
+            sums: vec![[0.0; 9]; n as usize],
+            chunks: 0,
+            items: 0,
+            totals: [0.0; 2],
+        })
     }
 
     /// Bytes the moments of a `width x height` film occupy (72 per pixel).
@@ -138,8 +150,12 @@ impl Moments {
             return;
         }
         let inv = 1.0 / items as f64;
+        let [mut q, mut s2] = self.totals;
         for (index, [x, y, z]) in pixels {
             let Some(m) = self.sums.get_mut(index) else { continue };
+            // (S + s)^2 - S^2 = s (2 S + s), per channel.
+            s2 += x * (2.0 * m[0] + x) + y * (2.0 * m[1] + y) + z * (2.0 * m[2] + z);
+            q += (x * x + y * y + z * z) * inv;
             m[0] += x;
             m[1] += y;
             m[2] += z;
@@ -150,6 +166,40 @@ impl Moments {
             m[7] += x * z * inv;
             m[8] += y * z * inv;
         }
+        self.totals = [q, s2];
+    }
+
+    /// The estimated relative error from the running totals, in O(1) (the live estimate while
+    /// rendering; [`Moments::estimate`] is the exact sum over the pixels, with the degrees of
+    /// freedom). Equal to it up to rounding, except that it does not clamp a pixel's variance
+    /// at zero; `degrees_of_freedom` is left at 0.
+    pub fn quick_estimate(&self) -> ErrorEstimate {
+        let mut estimate = ErrorEstimate {
+            relative_rmse: None,
+            batches: self.chunks,
+            items: self.items,
+            degrees_of_freedom: 0.0,
+        };
+        if self.chunks < 2 || self.items == 0 {
+            return estimate;
+        }
+        let [q, s2] = self.totals;
+        let variance = ((self.items as f64 * q - s2) / (self.chunks - 1) as f64).max(0.0);
+        let truth = s2 - variance;
+        if truth > 0.0 && variance.is_finite() {
+            estimate.relative_rmse = Some((variance / truth).sqrt());
+        }
+        estimate
+    }
+
+    /// Recomputes the running totals from the per-pixel moments.
+    fn recompute_totals(&mut self) {
+        let (mut q, mut s2) = (0.0, 0.0);
+        for m in &self.sums {
+            q += m[3] + m[4] + m[5];
+            s2 += m[0] * m[0] + m[1] * m[1] + m[2] * m[2];
+        }
+        self.totals = [q, s2];
     }
 
     /// Adds another render's moments (same size; their chunks must be other chunks of the
@@ -173,6 +223,7 @@ impl Moments {
         }
         self.chunks += other.chunks;
         self.items = self.items.saturating_add(other.items);
+        self.recompute_totals();
         Ok(())
     }
 
@@ -408,6 +459,9 @@ mod tests {
         assert!((estimated / truth - 1.0).abs() < 0.15, "estimate {estimated}, truth {truth}");
         let e = runs[0].0.estimate();
         assert!(e.is_trusted() && e.batches == chunks && e.items == chunks * items);
+        // The running totals give the same estimate to rounding.
+        let quick = runs[0].0.quick_estimate().relative_rmse.unwrap();
+        assert!((quick / e.relative_rmse.unwrap() - 1.0).abs() < 1e-9, "{quick} vs {e:?}");
         assert!(e.degrees_of_freedom > 100.0, "{}", e.degrees_of_freedom);
     }
 
@@ -434,6 +488,8 @@ mod tests {
         merged.merge(&b).unwrap();
         assert_eq!((merged.chunks(), merged.items()), (22, 11_000));
         let e = merged.estimate().relative_rmse.unwrap();
+        let quick = merged.quick_estimate().relative_rmse.unwrap();
+        assert!((quick / e - 1.0).abs() < 1e-9, "{quick} vs {e}");
         let ea = a.estimate().relative_rmse.unwrap();
         // More chunks of the same kind: the error falls by about sqrt(22 / 10).
         assert!((ea / e / (22.0f64 / 10.0).sqrt() - 1.0).abs() < 0.25, "{ea} {e}");

@@ -49,8 +49,8 @@ pub use light_tracer::{
 pub use object_light::{ObjectEmission, ObjectLight};
 pub use path_tracer::{PathTracer, PathTracerSettings};
 pub use render::{
-    DEFAULT_CHUNK_BEAMS, ESTIMATE_INTERVAL, FALLBACK_MEMORY_LIMIT, MemoryLimit, Progress,
-    RenderOutput, RenderPlan, render, render_observed,
+    DEFAULT_CHUNK_BEAMS, FALLBACK_MEMORY_LIMIT, MemoryLimit, Progress, RenderOutput, RenderPlan,
+    render, render_observed,
 };
 pub use sampler::{ChunkSampler, SamplerKind};
 pub use wavelengths::{CAMERA_LAMBDA_MAX, CAMERA_LAMBDA_MIN, CameraWavelengths, HERO};

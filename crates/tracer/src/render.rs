@@ -256,13 +256,10 @@ pub struct Progress {
     pub items: u64,
     /// Wall time since the render started (s).
     pub seconds: f64,
-    /// The error estimate, when one was just computed (at most every
-    /// [`ESTIMATE_INTERVAL`] seconds, and rarely enough to cost under 5% of the render).
+    /// The error estimate after this chunk ([`Moments::quick_estimate`], from the running
+    /// totals), if the render keeps one.
     pub estimate: Option<ErrorEstimate>,
 }
-
-/// Shortest time between two live error estimates (s).
-pub const ESTIMATE_INTERVAL: f64 = 0.05;
 
 /// Renders the plan's chunks with `integrator` on `plan.threads` threads into one shared film;
 /// `progress(items)` is called after every chunk (from worker threads) with the work items
@@ -278,14 +275,9 @@ pub fn render(
     render_observed(integrator, plan, &|p: &Progress| progress(p.items))
 }
 
-/// When the next live estimate is due, and what the last one cost.
-struct EstimateClock {
-    next: Instant,
-}
-
 /// Renders the plan's chunks with `integrator` on `plan.threads` threads into one shared film;
 /// `progress` is called after every chunk (from worker threads) with the work items done so far
-/// and, now and then, a fresh error estimate.
+/// and, if the plan keeps the error estimate, the estimate so far.
 ///
 /// The loop does not know which estimator runs: it claims chunks, hands each to
 /// [`Integrator::render_chunk`] with the thread's [`FilmWriter`], and counts the items done. The
@@ -320,26 +312,15 @@ pub fn render_observed(
     let next = AtomicU64::new(0);
     let done = AtomicU64::new(0);
     let target_reached = AtomicBool::new(false);
-    let clock = Mutex::new(EstimateClock { next: started });
     // A budget too large to represent is no budget at all.
     let deadline = plan
         .time_budget
         .and_then(|s| Duration::try_from_secs_f64(s.max(0.0)).ok())
         .and_then(|d| started.checked_add(d));
-    // The live estimate, if one is due: computed by one thread at a time, and spaced so that
-    // it costs at most 1/20 of the time between two.
+    // The live estimate from the running totals, in O(1), after every chunk.
     let live_estimate = || -> Option<ErrorEstimate> {
-        let moments = moments.as_ref()?;
-        let mut clock = clock.try_lock().ok()?;
-        let now = Instant::now();
-        if now < clock.next {
-            return None;
-        }
-        let e = moments.lock().unwrap_or_else(PoisonError::into_inner).estimate();
-        let cost = now.elapsed().as_secs_f64();
-        clock.next =
-            Instant::now() + Duration::from_secs_f64((20.0 * cost).clamp(ESTIMATE_INTERVAL, 60.0));
-        Some(e)
+        let m = moments.as_ref()?.lock().unwrap_or_else(PoisonError::into_inner);
+        Some(m.quick_estimate())
     };
     let results: Mutex<Vec<(TraceStats, Vec<u64>)>> = Mutex::new(Vec::new());
     std::thread::scope(|scope| {
