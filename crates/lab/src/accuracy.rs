@@ -29,8 +29,16 @@
 //! and `accuracy.svg` (log-log plot of error against time, one panel per scene, one line per
 //! configuration, with a dashed line of slope -1/2), both in [`AccuracyOptions::out_dir`].
 //!
+//! Every configuration is the scene file loaded as the renderer's typed [`Scene`] with its knobs
+//! set on typed fields ([`apply`]): `settings.sampler`, the effects mode and the estimator
+//! directly, a light's wavelength sampling through
+//! [`spectrace_lights::LightSource::set_wavelength_sampling`] and its SPD through [`spectrace_lights::LightSource::map_spd`] with
+//! [`SpectralPowerDistribution::piecewise_constant`] (hooks whose defaults say "not supported",
+//! so third-party lights and spectra keep compiling; such lights are left as written and counted
+//! in the report). No scene JSON is edited.
+//!
 //! To keep the default run short, [`AccuracyOptions::max_width`] scales the camera resolution down
-//! (editing the scene JSON's `camera.width`/`camera.height` before it is parsed, keeping the aspect
+//! (a new camera from the same [`CameraRepr`] with a smaller `width`/`height`, keeping the aspect
 //! ratio); the field of view is unchanged, so the image shows the same view with fewer pixels.
 
 use std::fmt::Write as _;
@@ -38,12 +46,10 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
-use serde_json::{Map, Value};
-use spectrace_lights::LightSource;
-use spectrace_spectrum::{CieIlluminant, SpectralPowerDistribution, Xyz};
-use spectrace_tracer::{EffectsMode, IntegratorChoice, render};
-
-use crate::{RenderOptions, Scene, choose_integrator, decide_effects, plan_with, with_integrator};
+use spectrace_lights::WavelengthSampling;
+use spectrace_renderer::{Scene, choose_integrator, decide_effects, render_xyz};
+use spectrace_spectrum::{SpectralPowerDistribution, Xyz};
+use spectrace_tracer::{CameraRepr, EffectsMode, IntegratorChoice, PinholeCamera, SamplerKind};
 
 /// Settings of an accuracy run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -243,7 +249,25 @@ impl Configuration {
         }
     }
 
-    fn effects_mode(self) -> EffectsMode {
+    /// The sampler the configuration sets (`settings.sampler`).
+    pub fn sampler(self) -> SamplerKind {
+        match self {
+            Configuration::Sobol | Configuration::PathSobol => SamplerKind::Sobol,
+            _ => SamplerKind::Independent,
+        }
+    }
+
+    /// The wavelength sampling the configuration gives every light (`None`: as written).
+    pub fn wavelength_sampling(self) -> Option<WavelengthSampling> {
+        match self {
+            Configuration::EqualWavelengths => Some(WavelengthSampling::EqualWavelengths),
+            Configuration::ObserverWavelengths => Some(WavelengthSampling::Observer),
+            _ => None,
+        }
+    }
+
+    /// The effects mode the configuration renders with.
+    pub fn effects_mode(self) -> EffectsMode {
         match self {
             Configuration::EffectsOff => EffectsMode::Off,
             _ => EffectsMode::Auto,
@@ -437,16 +461,11 @@ fn run_scene(
 ) -> Result<SceneResult, String> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
-    let mut json: Value = serde_json::from_str(&text)
-        .map_err(|e| format!("{}: not valid JSON: {e}", path.display()))?;
-    if let Some(max_width) = options.max_width {
-        limit_resolution(&mut json, max_width);
-    }
     let name = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "scene".to_owned());
-    let baseline = parse(&json, path).map_err(|e| format!("accuracy: {e}"))?;
+    let baseline = load(&text, path, options.max_width).map_err(|e| format!("accuracy: {e}"))?;
     let (width, height) = (baseline.camera.width(), baseline.camera.height());
     let effects_summary = decide_effects(&baseline, Some(EffectsMode::Auto)).summary();
     let (auto_picks, auto_reason) = choose_integrator(&baseline, Some(IntegratorChoice::Auto));
@@ -509,18 +528,10 @@ fn run_scene(
 
     let mut prepared = Vec::new();
     for &configuration in &options.configurations {
-        if rewrite(configuration, &json).is_ok_and(|(changed, _)| changed.is_empty()) {
-            // The scene as written: no need to parse it again.
-            let scene = parse(&json, path);
-            prepared.push(Prepared { configuration, changed: String::new(), scene });
-            continue;
-        }
-        let (changed, scene) = match rewrite(configuration, &json) {
-            Ok((changed, rewritten)) => (
-                changed,
-                parse(&rewritten, path)
-                    .map_err(|e| format!("the rewritten scene is rejected: {e}")),
-            ),
+        let (changed, scene) = match load(&text, path, options.max_width)
+            .and_then(|mut scene| apply(configuration, &mut scene).map(|changed| (changed, scene)))
+        {
+            Ok((changed, scene)) => (changed, Ok(scene)),
             Err(reason) => (String::new(), Err(reason)),
         };
         if let Err(reason) = &scene {
@@ -591,9 +602,14 @@ fn run_scene(
     })
 }
 
-fn parse(json: &Value, path: &Path) -> Result<Scene, String> {
-    let text = serde_json::to_string(json).map_err(|e| e.to_string())?;
-    Scene::from_json(&text, path).map_err(|e| e.to_string())
+/// The scene of `text` (the file `path`) as the renderer's typed [`Scene`], its camera scaled
+/// down to at most `max_width` pixels wide.
+fn load(text: &str, path: &Path, max_width: Option<u32>) -> Result<Scene, String> {
+    let mut scene = Scene::from_json(text, path).map_err(|e| e.to_string())?;
+    if let Some(max_width) = max_width {
+        limit_resolution(&mut scene, max_width)?;
+    }
+    Ok(scene)
 }
 
 /// The estimator of a scene's reference image: one that is unbiased on it. The path tracer where
@@ -605,119 +621,6 @@ pub fn reference_integrator(scene: &Scene) -> IntegratorChoice {
         IntegratorChoice::Path => IntegratorChoice::Path,
         _ => IntegratorChoice::Bdpt,
     }
-}
-
-/// Renders `paths` paths with `integrator` (for a camera integrator, `ceil(paths / pixels)`
-/// samples per pixel) and returns the XYZ image, the wall time of the render alone and the paths
-/// traced.
-fn render_xyz(
-    scene: &Scene,
-    integrator: IntegratorChoice,
-    mode: EffectsMode,
-    paths: u64,
-    seed: u64,
-    threads: usize,
-) -> Result<(Vec<Xyz>, f64, u64), String> {
-    let options = RenderOptions {
-        beams: Some(paths),
-        seed: Some(seed),
-        threads: Some(threads),
-        effects: Some(mode),
-        ..RenderOptions::default()
-    };
-    let (choice, _) = choose_integrator(scene, Some(integrator));
-    let mut plan = plan_with(scene, &options, choice).map_err(|e| e.to_string())?;
-    if choice == IntegratorChoice::Light {
-        // At least ~16 chunks per render, so small sweep points use every thread too; the chunk
-        // size depends on the beams alone, so a cached reference stays valid whatever the thread
-        // count. (A camera integrator's chunk is a pass of one sample per pixel.)
-        plan.chunk_beams = (paths / 16).clamp(1, plan.chunk_beams.max(1024)).min(plan.chunk_beams);
-    }
-    let effects = decide_effects(scene, Some(mode));
-    scene.lights.reset_count();
-    let started = Instant::now();
-    // The image by the estimator's own `image_scale` (its documented film units; the same as
-    // the renderer's `normalisation`).
-    let (output, scale) = with_integrator(scene, choice, effects, |tracer| {
-        render(tracer, &plan, &|_| {}).map(|out| {
-            let scale = tracer.image_scale(out.beams);
-            (out, scale)
-        })
-    })
-    .map_err(|e| e.to_string())?;
-    let seconds = started.elapsed().as_secs_f64();
-    scene.lights.reset_count();
-    Ok((output.film.to_xyz(scale), seconds, output.beams))
-}
-
-/// One estimator's measurement in [`integrator_benchmark`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct IntegratorTiming {
-    /// The estimator asked for (`auto` included).
-    pub integrator: IntegratorChoice,
-    /// Paths traced (beams for the light tracer; `ceil(paths / pixels)` samples per pixel for
-    /// the camera integrators).
-    pub paths: u64,
-    /// Wall time of the render alone (s).
-    pub seconds: f64,
-}
-
-impl IntegratorTiming {
-    /// Paths per second.
-    pub fn paths_per_second(&self) -> f64 {
-        self.paths as f64 / self.seconds.max(1e-9)
-    }
-}
-
-/// One scene of `spectrace bench`: paths per second of every estimator with the same paths.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct IntegratorBenchmarkRow {
-    /// The scene file.
-    pub scene: String,
-    /// Image width.
-    pub width: u32,
-    /// Image height.
-    pub height: u32,
-    /// The estimator `auto` picks.
-    pub auto_picks: IntegratorChoice,
-    /// Why, in words.
-    pub auto_reason: String,
-    /// Light, path, bdpt and auto, in that order.
-    pub timings: Vec<IntegratorTiming>,
-}
-
-/// Renders `scene` with light, path, bdpt and auto, each with `paths` paths (N beams for the
-/// light tracer, `ceil(N / pixels)` samples per pixel for the camera integrators) and the same
-/// seed, and measures each (the integrator columns of `spectrace bench`).
-///
-/// # Errors
-/// A message naming the estimator for zero paths, too many threads or a failed render.
-pub fn integrator_benchmark(
-    scene: &Scene,
-    paths: u64,
-    threads: usize,
-) -> Result<IntegratorBenchmarkRow, String> {
-    let (auto_picks, auto_reason) = choose_integrator(scene, Some(IntegratorChoice::Auto));
-    let mut timings = Vec::new();
-    for integrator in [
-        IntegratorChoice::Light,
-        IntegratorChoice::Path,
-        IntegratorChoice::Bdpt,
-        IntegratorChoice::Auto,
-    ] {
-        let (_, seconds, traced) =
-            render_xyz(scene, integrator, EffectsMode::Auto, paths, 1, threads)
-                .map_err(|e| format!("{}: {}: {e}", scene.path.display(), integrator.name()))?;
-        timings.push(IntegratorTiming { integrator, paths: traced, seconds });
-    }
-    Ok(IntegratorBenchmarkRow {
-        scene: scene.path.display().to_string(),
-        width: scene.camera.width(),
-        height: scene.camera.height(),
-        auto_picks,
-        auto_reason,
-        timings,
-    })
 }
 
 /// Relative RMSE of an XYZ image against a reference:
@@ -779,222 +682,115 @@ fn sweep_seed(seed: u64, c: u64, k: u64) -> u64 {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Scene rewrites on the JSON.
+// The knobs, on the typed scene.
 
-/// Scales `camera.width`/`camera.height` so the width is at most `max_width`, keeping the aspect
-/// ratio. Returns whether it changed anything.
-fn limit_resolution(json: &mut Value, max_width: u32) -> bool {
-    let Some(camera) = json.get_mut("camera").and_then(Value::as_object_mut) else {
-        return false;
-    };
-    let (Some(w), Some(h)) =
-        (camera.get("width").and_then(Value::as_u64), camera.get("height").and_then(Value::as_u64))
-    else {
-        return false;
-    };
-    let max = u64::from(max_width.max(1));
-    if w <= max {
-        return false;
+/// Scales the camera down so the image is at most `max_width` pixels wide, keeping the aspect
+/// ratio (a new camera from the same [`CameraRepr`]). Returns whether it changed anything.
+fn limit_resolution(scene: &mut Scene, max_width: u32) -> Result<bool, String> {
+    let mut repr: CameraRepr = scene.camera.clone().into();
+    let max = max_width.max(1);
+    if repr.width <= max {
+        return Ok(false);
     }
-    let new_h = ((h as f64 * max as f64 / w as f64).round() as u64).max(1);
-    camera.insert("width".to_owned(), Value::from(max));
-    camera.insert("height".to_owned(), Value::from(new_h));
-    true
+    let height = (f64::from(repr.height) * f64::from(max) / f64::from(repr.width)).round();
+    repr.height = (height as u32).max(1);
+    repr.width = max;
+    scene.camera = PinholeCamera::new(repr).map_err(|e| format!("camera: {e}"))?;
+    Ok(true)
 }
 
-/// Calls `f` on every light object, recursing into `LightSet`s.
-fn for_each_light(json: &mut Value, f: &mut dyn FnMut(&mut Map<String, Value>)) {
-    fn visit(light: &mut Value, f: &mut dyn FnMut(&mut Map<String, Value>)) {
-        let Value::Object(map) = light else { return };
-        if map.get("type").and_then(Value::as_str) == Some("LightSet") {
-            if let Some(Value::Array(inner)) = map.get_mut("lights") {
-                for l in inner {
-                    visit(l, f);
-                }
+/// "`n` light(s)", with the lights left as written and why.
+fn lights_changed(changed: usize, lines: usize, unsupported: usize) -> String {
+    let mut text = format!("{changed} light(s)");
+    if lines > 0 {
+        text += &format!("; {lines} with delta lines left on importance");
+    }
+    if unsupported > 0 {
+        text += &format!("; {unsupported} of a type without the hook left as written");
+    }
+    text
+}
+
+/// Sets every light's wavelength sampling (lights whose SPD has delta lines keep importance:
+/// lines have no density to weight by). Returns (changed, skipped for lines, without the hook).
+fn set_wavelength_sampling(
+    scene: &mut Scene,
+    sampling: WavelengthSampling,
+) -> Result<(usize, usize, usize), String> {
+    let (mut changed, mut lines, mut unsupported) = (0, 0, 0);
+    let mut failure = None;
+    scene
+        .lights
+        .modify_lights(&mut |id, light| {
+            let spd = light.spd();
+            let has_lines = spd.is_delta() || (integral_of_density(&*spd) - 1.0).abs() > 1e-6;
+            if has_lines {
+                lines += 1;
+                return;
             }
-        } else {
-            f(map);
-        }
-    }
-    if let Some(Value::Array(lights)) = json.get_mut("lights") {
-        for l in lights {
-            visit(l, f);
-        }
-    }
+            match light.set_wavelength_sampling(sampling) {
+                Ok(()) => changed += 1,
+                Err(spectrace_lights::LightError::Unsupported { .. }) => unsupported += 1,
+                Err(e) => failure = Some(format!("lights[{}]: {e}", id.0)),
+            }
+        })
+        .map_err(|e| format!("lights: {e}"))?;
+    failure.map_or(Ok((changed, lines, unsupported)), Err)
 }
 
-/// Whether an SPD's JSON contains a delta line (`Monochromatic`, also inside a `Mixture`).
-fn spd_has_delta(spd: &Value) -> bool {
-    match spd.get("type").and_then(Value::as_str) {
-        Some("Monochromatic") => true,
-        Some("Mixture") => spd
-            .get("components")
-            .and_then(Value::as_array)
-            .is_some_and(|c| c.iter().any(|c| c.get("spd").is_some_and(spd_has_delta))),
-        _ => false,
-    }
+/// The integral of an SPD's density alone (its delta lines excluded): 1 without lines.
+fn integral_of_density(spd: &dyn SpectralPowerDistribution) -> f64 {
+    let (lo, hi) = spd.range();
+    spectrace_spectrum::integrate_panels(&|l| spd.value(l), lo, hi, &spd.breakpoints())
 }
 
-/// Sets `"wavelength_sampling": "equal_wavelengths"` on every light without delta lines.
-/// Returns (lights changed, lights skipped for delta lines).
-fn set_equal_wavelengths(json: &mut Value) -> (usize, usize) {
-    let (mut changed, mut skipped) = (0, 0);
-    for_each_light(json, &mut |light| {
-        if light.get("spd").is_some_and(spd_has_delta) {
-            skipped += 1;
-        } else if light.get("wavelength_sampling").and_then(Value::as_str)
-            != Some("equal_wavelengths")
+/// Replaces every light's tabulated SPD by its piecewise-constant counterpart. Returns (lights
+/// changed, lights without the hook).
+fn set_piecewise_constant(scene: &mut Scene) -> Result<(usize, usize), String> {
+    let (mut changed, mut unsupported) = (0, 0);
+    let mut failure = None;
+    scene
+        .lights
+        .modify_lights(&mut |id, light| match light
+            .map_spd(&|spd: &dyn SpectralPowerDistribution| spd.piecewise_constant())
         {
-            light.insert("wavelength_sampling".to_owned(), Value::from("equal_wavelengths"));
-            changed += 1;
-        }
-    });
-    (changed, skipped)
+            Ok(true) => changed += 1,
+            Ok(false) => {}
+            Err(spectrace_lights::LightError::Unsupported { .. }) => unsupported += 1,
+            Err(e) => failure = Some(format!("lights[{}]: {e}", id.0)),
+        })
+        .map_err(|e| format!("lights: {e}"))?;
+    failure.map_or(Ok((changed, unsupported)), Err)
 }
 
-/// Sets `wavelength_sampling: "observer"` on every light whose SPD has no delta lines: (lights
-/// changed, lights skipped for their lines).
-fn set_observer_wavelengths(json: &mut Value) -> (usize, usize) {
-    let (mut changed, mut skipped) = (0, 0);
-    for_each_light(json, &mut |light| {
-        if light.get("spd").is_some_and(spd_has_delta) {
-            skipped += 1;
-        } else if light.get("wavelength_sampling").and_then(Value::as_str) != Some("observer") {
-            light.insert("wavelength_sampling".to_owned(), Value::from("observer"));
-            changed += 1;
-        }
-    });
-    (changed, skipped)
-}
-
-/// A piecewise-constant `Binned` SPD with bins centred on `nm` and the given values.
-fn binned_from_nodes(nm: &[f64], values: &[f64]) -> Option<Value> {
-    let n = nm.len();
-    if n < 2 || values.len() != n {
-        return None;
+/// Sets the knobs of `configuration` on the typed scene (the estimator and the effects mode are
+/// chosen when rendering, see [`Configuration::integrator`]). Returns what changed (empty for
+/// the scene as written), or why the configuration does not apply to the scene.
+///
+/// # Errors
+/// Why the configuration does not apply (e.g. no light with a tabulated SPD).
+pub fn apply(configuration: Configuration, scene: &mut Scene) -> Result<String, String> {
+    if configuration.sampler() == SamplerKind::Sobol {
+        scene.settings.sampler = SamplerKind::Sobol;
+        return Ok("settings.sampler = sobol".to_owned());
     }
-    let mut edges = Vec::with_capacity(n + 1);
-    let first = nm[0] - 0.5 * (nm[1] - nm[0]);
-    edges.push(if first > 0.0 { first } else { nm[0] });
-    edges.extend(nm.windows(2).map(|w| 0.5 * (w[0] + w[1])));
-    edges.push(nm[n - 1] + 0.5 * (nm[n - 1] - nm[n - 2]));
-    let mut map = Map::new();
-    map.insert("type".to_owned(), Value::from("Binned"));
-    map.insert("edges_nm".to_owned(), Value::from(edges));
-    map.insert("values".to_owned(), Value::from(values.to_vec()));
-    Some(Value::Object(map))
-}
-
-fn numbers(v: Option<&Value>) -> Option<Vec<f64>> {
-    v?.as_array()?.iter().map(Value::as_f64).collect()
-}
-
-/// Rewrites tabulated SPDs (recursing into mixtures) into `Binned` ones; returns how many.
-fn binned_spd(spd: &mut Value) -> usize {
-    match spd.get("type").and_then(Value::as_str) {
-        Some("Tabulated") => {
-            let nm = numbers(spd.get("nm"));
-            let values = numbers(spd.get("values"));
-            match nm.zip(values).and_then(|(nm, values)| binned_from_nodes(&nm, &values)) {
-                Some(binned) => {
-                    *spd = binned;
-                    1
-                }
-                None => 0,
-            }
-        }
-        Some("CieIlluminant") => {
-            // The tabulated illuminants (D series, F series) are piecewise linear between their
-            // nodes; A (a formula) and E (constant) have no table and stay as they are.
-            let Some(name) = spd.get("name").and_then(Value::as_str) else { return 0 };
-            let Ok(illuminant) = CieIlluminant::new(name) else { return 0 };
-            let nodes = illuminant.breakpoints();
-            if nodes.len() < 3 {
-                return 0;
-            }
-            let values: Vec<f64> = nodes.iter().map(|&l| illuminant.value(l)).collect();
-            match binned_from_nodes(&nodes, &values) {
-                Some(binned) => {
-                    *spd = binned;
-                    1
-                }
-                None => 0,
-            }
-        }
-        Some("Mixture") => {
-            spd.get_mut("components").and_then(Value::as_array_mut).map_or(0, |components| {
-                components.iter_mut().filter_map(|c| c.get_mut("spd")).map(binned_spd).sum()
-            })
-        }
-        _ => 0,
+    if let Some(sampling) = configuration.wavelength_sampling() {
+        return match set_wavelength_sampling(scene, sampling)? {
+            (0, 0, 0) => Err(format!("every light already samples {}", sampling.name())),
+            (0, _, 0) => Err("every light's SPD contains delta lines (kept as lines)".to_owned()),
+            (0, _, _) => Err("no light offers the wavelength-sampling hook".to_owned()),
+            (changed, lines, unsupported) => Ok(lights_changed(changed, lines, unsupported)),
+        };
     }
-}
-
-/// Rewrites every tabulated SPD of the lights as `Binned`; returns (SPDs rewritten, lights
-/// touched).
-fn set_piecewise_constant(json: &mut Value) -> (usize, usize) {
-    let (mut spds, mut lights) = (0, 0);
-    for_each_light(json, &mut |light| {
-        if let Some(spd) = light.get_mut("spd") {
-            let n = binned_spd(spd);
-            spds += n;
-            lights += usize::from(n > 0);
-        }
-    });
-    (spds, lights)
-}
-
-/// The scene JSON of a configuration and what changed, or why it does not apply.
-fn rewrite(configuration: Configuration, json: &Value) -> Result<(String, Value), String> {
-    let mut out = json.clone();
-    match configuration {
-        Configuration::Baseline
-        | Configuration::EffectsOff
-        | Configuration::Path
-        | Configuration::Bdpt
-        | Configuration::Auto => Ok((String::new(), out)),
-        Configuration::ObserverWavelengths => match set_observer_wavelengths(&mut out) {
-            (0, 0) => Err("every light already samples observer-weighted wavelengths".to_owned()),
-            (0, _) => Err("every light's SPD contains delta lines (kept as lines)".to_owned()),
-            (changed, 0) => Ok((format!("{changed} light(s)"), out)),
-            (changed, skipped) => Ok((
-                format!("{changed} light(s); {skipped} with delta lines left on importance"),
-                out,
-            )),
-        },
-        Configuration::Sobol | Configuration::PathSobol => {
-            let Some(root) = out.as_object_mut() else {
-                return Err("the scene is not a JSON object".to_owned());
-            };
-            let settings = root.entry("settings").or_insert_with(|| Value::Object(Map::new()));
-            match settings.as_object_mut() {
-                Some(settings) => {
-                    settings.insert("sampler".to_owned(), Value::from("sobol"));
-                    Ok(("settings.sampler = sobol".to_owned(), out))
-                }
-                None => Err("settings is not a JSON object".to_owned()),
-            }
-        }
-        Configuration::EqualWavelengths => match set_equal_wavelengths(&mut out) {
-            (0, 0) => Err("every light already samples equal wavelengths".to_owned()),
-            (0, _) => {
-                Err("every light's SPD contains delta lines (no density to weight by)".to_owned())
-            }
-            (changed, 0) => Ok((format!("{changed} light(s)"), out)),
-            (changed, skipped) => Ok((
-                format!("{changed} light(s); {skipped} with delta lines left on importance"),
-                out,
-            )),
-        },
-        Configuration::PiecewiseConstantSpd => match set_piecewise_constant(&mut out) {
-            (0, _) => {
-                Err("no light has a Tabulated SPD or a tabulated CieIlluminant (nothing piecewise \
-                 linear to make piecewise constant)"
-                    .to_owned())
-            }
-            (spds, lights) => Ok((format!("{spds} SPD(s) in {lights} light(s)"), out)),
-        },
+    if configuration == Configuration::PiecewiseConstantSpd {
+        return match set_piecewise_constant(scene)? {
+            (0, _) => Err("no light has a Tabulated SPD or a tabulated CieIlluminant (nothing \
+                 piecewise linear to make piecewise constant)"
+                .to_owned()),
+            (changed, unsupported) => Ok(lights_changed(changed, 0, unsupported)),
+        };
     }
+    Ok(String::new())
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1259,7 +1055,7 @@ pub fn markdown(report: &AccuracyReport) -> String {
     let _ = writeln!(md, "# What accuracy costs in time\n");
     let _ = writeln!(
         md,
-        "Generated by `cargo xtask accuracy` (`spectrace_renderer::accuracy::run`) on {} thread(s) \
+        "Generated by `cargo xtask accuracy` (`spectrace_lab::accuracy::run`) on {} thread(s) \
          in {:.0} s; do not edit by hand. Reference: the scene as written (effects analysis \
          `auto`), rendered by an estimator that is unbiased on it (the path tracer where `auto` \
          picks it, BDPT everywhere else), at {} paths, seed {}, cached in `{}`. Sweep: {} to {} \
@@ -1698,76 +1494,89 @@ mod tests {
     }
 
     #[test]
-    fn rewrites_produce_parseable_scenes_with_the_fields_changed() {
-        let json: Value = serde_json::from_str(TINY).unwrap();
+    fn the_knobs_are_set_on_the_typed_scene() {
         let path = Path::new("tiny.json");
+        let scene = |text: &str| load(text, path, None).unwrap();
+        let light = |s: &Scene, i: usize| serde_json::to_value(&s.lights.lights()[i]).unwrap();
+        let spd = |s: &Scene, i: usize| {
+            serde_json::to_value(s.lights.lights()[i].spd().as_ref()).unwrap()
+        };
 
-        let (_, eq) = rewrite(Configuration::EqualWavelengths, &json).unwrap();
-        assert_eq!(eq["lights"][0]["wavelength_sampling"], "equal_wavelengths");
-        parse(&eq, path).unwrap();
+        let mut baseline = scene(TINY);
+        assert_eq!(apply(Configuration::Baseline, &mut baseline).unwrap(), "");
+        assert_eq!(light(&baseline, 0)["wavelength_sampling"], "importance");
 
-        let (_, ob) = rewrite(Configuration::ObserverWavelengths, &json).unwrap();
-        assert_eq!(ob["lights"][0]["wavelength_sampling"], "observer");
-        parse(&ob, path).unwrap();
+        let mut eq = scene(TINY);
+        assert_eq!(apply(Configuration::EqualWavelengths, &mut eq).unwrap(), "1 light(s)");
+        assert_eq!(light(&eq, 0)["wavelength_sampling"], "equal_wavelengths");
+        let mut ob = scene(TINY);
+        assert_eq!(apply(Configuration::ObserverWavelengths, &mut ob).unwrap(), "1 light(s)");
+        assert_eq!(light(&ob, 0)["wavelength_sampling"], "observer");
         for c in [Configuration::Sobol, Configuration::PathSobol] {
-            let (_, so) = rewrite(c, &json).unwrap();
-            assert_eq!(so["settings"]["sampler"], "sobol");
-            assert_eq!(so["settings"]["seed"], 3);
-            assert_eq!(
-                parse(&so, path).unwrap().settings.sampler,
-                spectrace_tracer::SamplerKind::Sobol
-            );
+            let mut so = scene(TINY);
+            assert_eq!(apply(c, &mut so).unwrap(), "settings.sampler = sobol");
+            assert_eq!(so.settings.sampler, SamplerKind::Sobol);
+            assert_eq!(so.settings.seed, 3);
         }
         assert_eq!(Configuration::PathSobol.integrator(), IntegratorChoice::Path);
         assert_eq!(Configuration::from_name("path_sobol"), Some(Configuration::PathSobol));
 
-        let (changed, pc) = rewrite(Configuration::PiecewiseConstantSpd, &json).unwrap();
-        assert_eq!(changed, "1 SPD(s) in 1 light(s)");
-        let spd = &pc["lights"][0]["spd"];
-        assert_eq!(spd["type"], "Binned");
-        assert_eq!(spd["edges_nm"], serde_json::json!([350.0, 450.0, 550.0, 650.0, 750.0]));
-        assert_eq!(spd["values"], serde_json::json!([0.2, 1.0, 0.6, 0.3]));
-        parse(&pc, path).unwrap();
+        let mut pc = scene(TINY);
+        assert_eq!(apply(Configuration::PiecewiseConstantSpd, &mut pc).unwrap(), "1 light(s)");
+        let binned = spd(&pc, 0);
+        assert_eq!(binned["type"], "Binned");
+        assert_eq!(binned["edges_nm"], serde_json::json!([350.0, 450.0, 550.0, 650.0, 750.0]));
+        let values: Vec<f64> =
+            binned["values"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+        // The node values, up to the normalisation.
+        for (v, expected) in values.iter().zip([0.2, 1.0, 0.6, 0.3]) {
+            assert!((v / values[1] - expected).abs() < 1e-12, "{values:?}");
+        }
 
-        // Inside a LightSet, with a delta line skipped and a tabulated CIE illuminant rewritten.
-        let mut set = json.clone();
-        set["lights"] = serde_json::json!([{"type": "LightSet", "lights": [
-            json["lights"][0].clone(),
+        // Inside a LightSet, with a delta line skipped and a tabulated CIE illuminant re-binned.
+        let mut json: serde_json::Value = serde_json::from_str(TINY).unwrap();
+        let first = json["lights"][0].clone();
+        json["lights"] = serde_json::json!([{"type": "LightSet", "lights": [
+            first,
             {"type": "PointLight", "position": [0, 1, 0], "power": 1,
              "spd": {"type": "Monochromatic", "lambda_nm": 550}},
             {"type": "PointLight", "position": [0, 1, 0], "power": 1,
              "spd": {"type": "CieIlluminant", "name": "D65"}}
         ]}]);
-        let (changed, eq) = rewrite(Configuration::EqualWavelengths, &set).unwrap();
-        assert_eq!(changed, "2 light(s); 1 with delta lines left on importance");
-        let inner = &eq["lights"][0]["lights"];
-        assert_eq!(inner[0]["wavelength_sampling"], "equal_wavelengths");
-        assert!(inner[1].get("wavelength_sampling").is_none());
-        parse(&eq, path).unwrap();
-        let (changed, pc) = rewrite(Configuration::PiecewiseConstantSpd, &set).unwrap();
-        assert_eq!(changed, "2 SPD(s) in 2 light(s)");
-        let d65 = &pc["lights"][0]["lights"][2]["spd"];
+        let set = json.to_string();
+        let mut eq = scene(&set);
+        assert_eq!(
+            apply(Configuration::EqualWavelengths, &mut eq).unwrap(),
+            "2 light(s); 1 with delta lines left on importance"
+        );
+        assert_eq!(light(&eq, 0)["wavelength_sampling"], "equal_wavelengths");
+        assert_eq!(light(&eq, 1)["wavelength_sampling"], "importance");
+        let mut pc = scene(&set);
+        assert_eq!(apply(Configuration::PiecewiseConstantSpd, &mut pc).unwrap(), "2 light(s)");
+        let d65 = spd(&pc, 2);
         assert_eq!(d65["type"], "Binned");
         assert_eq!(d65["values"].as_array().unwrap().len(), 97);
         assert_eq!(d65["edges_nm"][0], 297.5);
-        parse(&pc, path).unwrap();
+        assert_eq!(spd(&pc, 1)["type"], "Monochromatic");
 
         // Not applicable: no tabulated SPD; only delta lines.
-        let mut bb = json.clone();
-        bb["lights"][0]["spd"] = serde_json::json!({"type": "Blackbody", "kelvin": 3200});
-        assert!(rewrite(Configuration::PiecewiseConstantSpd, &bb).is_err());
-        let mut line = json.clone();
-        line["lights"][0]["spd"] = serde_json::json!({"type": "Monochromatic", "lambda_nm": 550});
-        assert!(rewrite(Configuration::EqualWavelengths, &line).is_err());
-
-        // Resolution limit keeps the aspect ratio.
-        let mut big = json.clone();
-        assert!(limit_resolution(&mut big, 16));
-        assert_eq!(
-            (big["camera"]["width"].as_u64(), big["camera"]["height"].as_u64()),
-            (Some(16), Some(12))
+        let bb = TINY.replace(
+            r#"{"type": "Tabulated", "nm": [400, 500, 600, 700], "values": [0.2, 1.0, 0.6, 0.3]}"#,
+            r#"{"type": "Blackbody", "kelvin": 3200}"#,
         );
-        assert!(!limit_resolution(&mut big, 16));
+        assert_ne!(bb, TINY);
+        assert!(apply(Configuration::PiecewiseConstantSpd, &mut scene(&bb)).is_err());
+        let line = TINY.replace(
+            r#"{"type": "Tabulated", "nm": [400, 500, 600, 700], "values": [0.2, 1.0, 0.6, 0.3]}"#,
+            r#"{"type": "Monochromatic", "lambda_nm": 550}"#,
+        );
+        let reason = apply(Configuration::EqualWavelengths, &mut scene(&line)).unwrap_err();
+        assert!(reason.contains("delta lines"), "{reason}");
+
+        // The resolution limit keeps the aspect ratio.
+        let mut small = load(TINY, path, Some(16)).unwrap();
+        assert_eq!((small.camera.width(), small.camera.height()), (16, 12));
+        assert!(!limit_resolution(&mut small, 16).unwrap());
     }
 
     #[test]
@@ -1869,7 +1678,7 @@ mod tests {
 
         // The bench's measurement: the same paths for every estimator.
         let loaded = Scene::load(&scene).unwrap();
-        let row = integrator_benchmark(&loaded, 2000, 2).unwrap();
+        let row = spectrace_renderer::integrator_benchmark(&loaded, 2000, 2).unwrap();
         assert_eq!(row.auto_picks, IntegratorChoice::Path);
         let asked: Vec<_> = row.timings.iter().map(|t| t.integrator).collect();
         assert_eq!(
