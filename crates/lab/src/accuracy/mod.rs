@@ -18,6 +18,19 @@
 //! | `sobol` | Owen-scrambled Sobol points instead of independent uniforms (`settings.sampler: "sobol"`), light tracer |
 //! | `path_sobol` | the path tracer with `settings.sampler: "sobol"` (compare with `path`) |
 //!
+//! Which knobs act on which estimator ([`KNOBS_BY_ESTIMATOR`], also in the report): the sampler
+//! and the SPD sampler act on all three (a piecewise-constant SPD is another spectrum, so every
+//! estimator converges to another image); the lights' wavelength strategy acts on the light
+//! tracer and BDPT (whose light subpaths start with a light's beam), not on the path tracer,
+//! whose camera paths draw their own wavelengths (`settings.camera_wavelengths`); the effects
+//! analysis sets the light tracer's wavelengths per path and whether its beams and the path
+//! tracer's paths continue after a diffuse hit, and BDPT ignores it. The sweep applies each
+//! non-estimator knob to the light tracer, where all of them act, and the sampler also to the
+//! path tracer.
+//!
+//! Code: this module runs the sweep; `knobs` sets configurations on the typed scene, `cache`
+//! keeps the references, `report` analyses and writes the Markdown, `plot` draws the SVG.
+//!
 //! Each point records the wall time of the render alone and the relative RMSE of the XYZ image
 //! against the reference, `sqrt(sum |xyz - ref|^2 / sum |ref|^2)` over all pixels. Monte Carlo
 //! error falls as `time^(-1/2)`; the report fits the slope of log error against log time per
@@ -41,7 +54,11 @@
 //! (a new camera from the same [`CameraRepr`] with a smaller `width`/`height`, keeping the aspect
 //! ratio); the field of view is unchanged, so the image shows the same view with fewer pixels.
 
-use std::fmt::Write as _;
+mod cache;
+mod knobs;
+mod plot;
+mod report;
+
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -50,6 +67,12 @@ use spectrace_lights::WavelengthSampling;
 use spectrace_renderer::{Scene, choose_integrator, decide_effects, render_xyz};
 use spectrace_spectrum::{SpectralPowerDistribution, Xyz};
 use spectrace_tracer::{CameraRepr, EffectsMode, IntegratorChoice, PinholeCamera, SamplerKind};
+
+use cache::{cache_key, read_reference, write_reference};
+pub use knobs::apply;
+use knobs::limit_resolution;
+pub use plot::write_plot;
+pub use report::markdown;
 
 /// Settings of an accuracy run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -60,8 +83,10 @@ pub struct AccuracyOptions {
     pub out_dir: PathBuf,
     /// Where reference images are cached (default `target/accuracy-cache`).
     pub cache_dir: PathBuf,
-    /// Paths of the reference image (default 2^23; keep it at least 8 times the largest sweep
-    /// point, so the reference's own noise adds at most ~6% to the measured errors).
+    /// Paths of the reference image (default 2^24, 16 times the largest default sweep point, so
+    /// the reference's own noise adds at most ~3% to the errors of its own estimator; keep it at
+    /// least 8 times the largest sweep point). Its noise still limits how small an error can be
+    /// measured: see the "reference's noise" column of the report's summary.
     pub reference_beams: u64,
     /// Paths of the first sweep point (default 2^12: one sample per pixel at the default width).
     pub start_beams: u64,
@@ -85,13 +110,15 @@ fn all_configurations() -> Vec<Configuration> {
 
 impl Default for AccuracyOptions {
     /// Settings measured to finish every shipped scene with every configuration in under 20
-    /// minutes on 2 shared cores (see the run time in `docs/accuracy.md`).
+    /// minutes on 2 shared cores, references included (see the run time in `docs/accuracy.md`):
+    /// the sweep stops at 2^20 paths, where the faster configurations pass 10% and a few pass 2%;
+    /// the other times to 2% are extrapolated along the fitted slopes and marked so.
     fn default() -> Self {
         Self {
             scenes: default_scenes(),
             out_dir: PathBuf::from("docs"),
             cache_dir: PathBuf::from("target/accuracy-cache"),
-            reference_beams: 1 << 23,
+            reference_beams: 1 << 24,
             start_beams: 1 << 12,
             steps: 9,
             threads: 0,
@@ -363,6 +390,17 @@ pub struct AccuracyReport {
     /// Files written.
     pub files: Vec<String>,
 }
+
+/// Which knobs act on which estimator, as the report states it (see the module documentation).
+pub const KNOBS_BY_ESTIMATOR: &str = "the sampler (`sobol`, `path_sobol`) and the SPD sampler \
+     (`piecewise_constant_spd`, another spectrum) act on every estimator; the lights' wavelength \
+     strategy (`equal_wavelengths`, `observer_wavelengths`) acts on the light tracer and BDPT \
+     (light subpaths start with a light's beam) but not on the path tracer, whose camera paths \
+     draw their own wavelengths (`settings.camera_wavelengths`); the effects analysis \
+     (`effects_off`) sets the light tracer's wavelengths per path and whether light-tracer beams \
+     and path-tracer paths continue after a diffuse hit, and BDPT ignores it. The sweep applies \
+     each of these knobs to the light tracer, where all of them act, and the sampler also to the \
+     path tracer";
 
 /// The Monte Carlo expectation for the slope of log error against log time.
 pub const EXPECTED_SLOPE: f64 = -0.5;
@@ -688,933 +726,10 @@ fn sweep_seed(seed: u64, c: u64, k: u64) -> u64 {
     if s == seed { s ^ 1 } else { s }
 }
 
-// ---------------------------------------------------------------------------------------------
-// The knobs, on the typed scene.
-
-/// Scales the camera down so the image is at most `max_width` pixels wide, keeping the aspect
-/// ratio (a new camera from the same [`CameraRepr`]). Returns whether it changed anything.
-fn limit_resolution(scene: &mut Scene, max_width: u32) -> Result<bool, String> {
-    let mut repr: CameraRepr = scene.camera.clone().into();
-    let max = max_width.max(1);
-    if repr.width <= max {
-        return Ok(false);
-    }
-    let height = (f64::from(repr.height) * f64::from(max) / f64::from(repr.width)).round();
-    repr.height = (height as u32).max(1);
-    repr.width = max;
-    scene.camera = PinholeCamera::new(repr).map_err(|e| format!("camera: {e}"))?;
-    Ok(true)
-}
-
-/// "`n` light(s)", with the lights left as written and why.
-fn lights_changed(changed: usize, lines: usize, unsupported: usize) -> String {
-    let mut text = format!("{changed} light(s)");
-    if lines > 0 {
-        text += &format!("; {lines} with delta lines left on importance");
-    }
-    if unsupported > 0 {
-        text += &format!("; {unsupported} of a type without the hook left as written");
-    }
-    text
-}
-
-/// Sets every light's wavelength sampling (lights whose SPD has delta lines keep importance:
-/// lines have no density to weight by). Returns (changed, skipped for lines, without the hook).
-fn set_wavelength_sampling(
-    scene: &mut Scene,
-    sampling: WavelengthSampling,
-) -> Result<(usize, usize, usize), String> {
-    let (mut changed, mut lines, mut unsupported) = (0, 0, 0);
-    let mut failure = None;
-    scene
-        .lights
-        .modify_lights(&mut |id, light| {
-            let spd = light.spd();
-            let has_lines = spd.is_delta() || (integral_of_density(&*spd) - 1.0).abs() > 1e-6;
-            if has_lines {
-                lines += 1;
-                return;
-            }
-            match light.set_wavelength_sampling(sampling) {
-                Ok(()) => changed += 1,
-                Err(spectrace_lights::LightError::Unsupported { .. }) => unsupported += 1,
-                Err(e) => failure = Some(format!("lights[{}]: {e}", id.0)),
-            }
-        })
-        .map_err(|e| format!("lights: {e}"))?;
-    failure.map_or(Ok((changed, lines, unsupported)), Err)
-}
-
-/// The integral of an SPD's density alone (its delta lines excluded): 1 without lines.
-fn integral_of_density(spd: &dyn SpectralPowerDistribution) -> f64 {
-    let (lo, hi) = spd.range();
-    spectrace_spectrum::integrate_panels(&|l| spd.value(l), lo, hi, &spd.breakpoints())
-}
-
-/// Replaces every light's tabulated SPD by its piecewise-constant counterpart. Returns (lights
-/// changed, lights without the hook).
-fn set_piecewise_constant(scene: &mut Scene) -> Result<(usize, usize), String> {
-    let (mut changed, mut unsupported) = (0, 0);
-    let mut failure = None;
-    scene
-        .lights
-        .modify_lights(&mut |id, light| match light
-            .map_spd(&|spd: &dyn SpectralPowerDistribution| spd.piecewise_constant())
-        {
-            Ok(true) => changed += 1,
-            Ok(false) => {}
-            Err(spectrace_lights::LightError::Unsupported { .. }) => unsupported += 1,
-            Err(e) => failure = Some(format!("lights[{}]: {e}", id.0)),
-        })
-        .map_err(|e| format!("lights: {e}"))?;
-    failure.map_or(Ok((changed, unsupported)), Err)
-}
-
-/// Sets the knobs of `configuration` on the typed scene (the estimator and the effects mode are
-/// chosen when rendering, see [`Configuration::integrator`]). Returns what changed (empty for
-/// the scene as written), or why the configuration does not apply to the scene.
-///
-/// # Errors
-/// Why the configuration does not apply (e.g. no light with a tabulated SPD).
-pub fn apply(configuration: Configuration, scene: &mut Scene) -> Result<String, String> {
-    if configuration.sampler() == SamplerKind::Sobol {
-        scene.settings.sampler = SamplerKind::Sobol;
-        return Ok("settings.sampler = sobol".to_owned());
-    }
-    if let Some(sampling) = configuration.wavelength_sampling() {
-        return match set_wavelength_sampling(scene, sampling)? {
-            (0, 0, 0) => Err(format!("every light already samples {}", sampling.name())),
-            (0, _, 0) => Err("every light's SPD contains delta lines (kept as lines)".to_owned()),
-            (0, _, _) => Err("no light offers the wavelength-sampling hook".to_owned()),
-            (changed, lines, unsupported) => Ok(lights_changed(changed, lines, unsupported)),
-        };
-    }
-    if configuration == Configuration::PiecewiseConstantSpd {
-        return match set_piecewise_constant(scene)? {
-            (0, _) => Err("no light has a Tabulated SPD or a tabulated CieIlluminant (nothing \
-                 piecewise linear to make piecewise constant)"
-                .to_owned()),
-            (changed, unsupported) => Ok(lights_changed(changed, 0, unsupported)),
-        };
-    }
-    Ok(String::new())
-}
-
-// ---------------------------------------------------------------------------------------------
-// The reference cache.
-
-const CACHE_MAGIC: &[u8; 8] = b"SPXYZREF";
-const CACHE_VERSION: u32 = 3;
-const CACHE_HEADER: usize = 8 + 4 + 4 + 4 + 8 + 8;
-
-/// FNV-1a over the scene file and the reference's settings (and the crate version, so a changed
-/// tracer renders a new reference).
-fn cache_key(
-    scene_text: &str,
-    integrator: IntegratorChoice,
-    beams: u64,
-    seed: u64,
-    width: u32,
-    height: u32,
-) -> u64 {
-    let settings = format!(
-        "|{}|beams={beams}|seed={seed}|{width}x{height}|v{}|cache{CACHE_VERSION}",
-        integrator.name(),
-        env!("CARGO_PKG_VERSION")
-    );
-    scene_text
-        .bytes()
-        .chain(settings.bytes())
-        .fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
-}
-
-/// Layout (little-endian): magic, version u32, width u32, height u32, beams u64, seconds f64,
-/// then x, y, z f64 per pixel, row-major.
-fn write_reference(
-    path: &Path,
-    width: u32,
-    height: u32,
-    beams: u64,
-    seconds: f64,
-    image: &[Xyz],
-) -> Result<(), String> {
-    let mut bytes = Vec::with_capacity(CACHE_HEADER + image.len() * 24);
-    bytes.extend_from_slice(CACHE_MAGIC);
-    bytes.extend_from_slice(&CACHE_VERSION.to_le_bytes());
-    bytes.extend_from_slice(&width.to_le_bytes());
-    bytes.extend_from_slice(&height.to_le_bytes());
-    bytes.extend_from_slice(&beams.to_le_bytes());
-    bytes.extend_from_slice(&seconds.to_le_bytes());
-    for p in image {
-        for v in [p.x, p.y, p.z] {
-            bytes.extend_from_slice(&v.to_le_bytes());
-        }
-    }
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    }
-    std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
-}
-
-/// The cached image and its render time, if the file exists and matches the size.
-fn read_reference(path: &Path, width: u32, height: u32) -> Option<(Vec<Xyz>, f64)> {
-    let bytes = std::fs::read(path).ok()?;
-    let pixels = width as usize * height as usize;
-    if bytes.len() != CACHE_HEADER + pixels * 24 || &bytes[..8] != CACHE_MAGIC {
-        return None;
-    }
-    let u32_at = |i: usize| bytes.get(i..i + 4)?.try_into().ok().map(u32::from_le_bytes);
-    let f64_at = |i: usize| bytes.get(i..i + 8)?.try_into().ok().map(f64::from_le_bytes);
-    if u32_at(8)? != CACHE_VERSION || u32_at(12)? != width || u32_at(16)? != height {
-        return None;
-    }
-    let seconds = f64_at(28)?;
-    let image = (0..pixels)
-        .map(|i| {
-            let at = CACHE_HEADER + i * 24;
-            Some(Xyz::new(f64_at(at)?, f64_at(at + 8)?, f64_at(at + 16)?))
-        })
-        .collect::<Option<Vec<_>>>()?;
-    Some((image, seconds))
-}
-
-// ---------------------------------------------------------------------------------------------
-// Analysis and the report.
-
-/// How long a configuration takes to reach an error.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Reach {
-    /// Interpolated between two sweep points (log-log).
-    Interpolated(f64),
-    /// Already below the target at the first point: at most this long.
-    AtMost(f64),
-    /// Beyond the sweep, extrapolated along the fitted slope.
-    Extrapolated(f64),
-    /// Not reached, and the error does not fall clearly enough to extrapolate.
-    NotReached,
-}
-
-impl Reach {
-    fn seconds(self) -> Option<f64> {
-        match self {
-            Reach::Interpolated(t) | Reach::AtMost(t) | Reach::Extrapolated(t) => Some(t),
-            Reach::NotReached => None,
-        }
-    }
-
-    fn describe(self) -> String {
-        match self {
-            Reach::Interpolated(t) => format!("{} s", sig(t)),
-            Reach::AtMost(t) => format!("<= {} s (first point)", sig(t)),
-            Reach::Extrapolated(t) => format!("~{} s (extrapolated)", sig(t)),
-            Reach::NotReached => "not reached (error stops falling)".to_owned(),
-        }
-    }
-}
-
-fn time_to_reach(result: &ConfigurationResult, target: f64) -> Reach {
-    let pts = &result.points;
-    let Some(first) = pts.first() else { return Reach::NotReached };
-    if first.relative_rmse <= target {
-        return Reach::AtMost(first.seconds);
-    }
-    for w in pts.windows(2) {
-        let (a, b) = (w[0], w[1]);
-        if b.relative_rmse <= target {
-            let (la, lb) = (a.relative_rmse.ln(), b.relative_rmse.ln());
-            let f = if la > lb { (la - target.ln()) / (la - lb) } else { 1.0 };
-            let lt = a.seconds.ln() + f * (b.seconds.ln() - a.seconds.ln());
-            return Reach::Interpolated(lt.exp());
-        }
-    }
-    match (pts.last(), result.slope_vs_time) {
-        (Some(last), Some(slope)) if slope < -0.3 && !levels_off(result) => {
-            Reach::Extrapolated(last.seconds * (target / last.relative_rmse).powf(1.0 / slope))
-        }
-        _ => Reach::NotReached,
-    }
-}
-
-/// Least-squares slope of log error against log time over the last three sweep points (`None`
-/// for fewer than three).
-fn tail_slope(result: &ConfigurationResult) -> Option<f64> {
-    let pts = &result.points;
-    let tail = pts.get(pts.len().checked_sub(3)?..)?;
-    fit_slope(&tail.iter().map(|p| (p.seconds.ln(), p.relative_rmse.ln())).collect::<Vec<_>>())
-}
-
-/// Whether the error levels off at the end of the sweep (the last three points' slope is flatter
-/// than [`LEVELS_OFF_SLOPE`]): the estimator converges to another image (bias), so extrapolating
-/// its time to a smaller error would be wrong.
-fn levels_off(result: &ConfigurationResult) -> bool {
-    tail_slope(result).is_some_and(|s| s > LEVELS_OFF_SLOPE)
-}
-
-/// Time to `target` measured within the sweep only: interpolated, or at most the first point;
-/// `None` when the sweep does not reach it (never extrapolated).
-fn measured_reach(result: &ConfigurationResult, target: f64) -> Option<Reach> {
-    match time_to_reach(result, target) {
-        r @ (Reach::Interpolated(_) | Reach::AtMost(_)) => Some(r),
-        Reach::Extrapolated(_) | Reach::NotReached => None,
-    }
-}
-
-/// One estimator's time to [`ROUND_TARGET`] in words, for the integrator tables.
-fn reach_text(result: Option<&ConfigurationResult>) -> String {
-    let Some(result) = result.filter(|r| !r.points.is_empty()) else { return "-".to_owned() };
-    match measured_reach(result, ROUND_TARGET) {
-        Some(Reach::AtMost(t)) => format!("<= {}", sig(t)),
-        Some(r) => r.seconds().map_or_else(|| "-".to_owned(), sig),
-        None => {
-            let last = result.points.last().map_or(f64::NAN, |p| p.relative_rmse);
-            if levels_off(result) {
-                format!(
-                    "does not reach {} (levels off at {})",
-                    percent(ROUND_TARGET),
-                    percent(last)
-                )
-            } else {
-                format!(
-                    "does not reach {} in the sweep ({} at the end)",
-                    percent(ROUND_TARGET),
-                    percent(last)
-                )
-            }
-        }
-    }
-}
-
-/// Auto's time to [`ROUND_TARGET`] over the fastest of light, path and bdpt, and the text of the
-/// ratio column (`None` when the ratio cannot be measured).
-fn auto_ratio(scene: &SceneResult) -> (Option<f64>, String) {
-    let reach = |c: Configuration| {
-        scene
-            .configurations
-            .iter()
-            .find(|r| r.configuration == c)
-            .and_then(|r| measured_reach(r, ROUND_TARGET))
-            .and_then(Reach::seconds)
-    };
-    let fastest = [Configuration::Baseline, Configuration::Path, Configuration::Bdpt]
-        .into_iter()
-        .filter_map(|c| reach(c).map(|t| (c, t)))
-        .min_by(|a, b| a.1.total_cmp(&b.1));
-    match (reach(Configuration::Auto), fastest) {
-        (Some(auto), Some((c, best))) => {
-            let ratio = auto / best;
-            (Some(ratio), format!("{ratio:.2} (fastest: {})", c.integrator_label()))
-        }
-        (None, Some((c, _))) => {
-            (Some(f64::INFINITY), format!("auto does not reach it; {} does", c.integrator_label()))
-        }
-        (_, None) => {
-            let converging: Vec<&str> =
-                [Configuration::Baseline, Configuration::Path, Configuration::Bdpt]
-                    .into_iter()
-                    .filter(|&c| {
-                        scene
-                            .configurations
-                            .iter()
-                            .find(|r| r.configuration == c)
-                            .is_some_and(|r| r.points.len() >= 3 && !levels_off(r))
-                    })
-                    .map(Configuration::integrator_label)
-                    .collect();
-            let text = if converging.is_empty() {
-                "none reaches it in the sweep".to_owned()
-            } else {
-                format!("none reaches it in the sweep; still falling: {}", converging.join(", "))
-            };
-            (None, text)
-        }
-    }
-}
-
-/// Three significant digits.
-fn sig(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
-    }
-    let digits = (2 - v.abs().log10().floor() as i32).max(0) as usize;
-    format!("{v:.digits$}")
-}
-
-fn percent(v: f64) -> String {
-    format!("{}%", sig(v * 100.0))
-}
-
-fn beams_text(beams: u64) -> String {
-    if beams.is_power_of_two() {
-        format!("2^{}", beams.trailing_zeros())
-    } else {
-        beams.to_string()
-    }
-}
-
-fn slope_text(slope: Option<f64>) -> String {
-    slope.map_or_else(|| "-".to_owned(), |s| format!("{s:.3}"))
-}
-
-/// The report as Markdown (what `accuracy.md` holds).
-pub fn markdown(report: &AccuracyReport) -> String {
-    let o = &report.options;
-    let mut md = String::new();
-    let _ = writeln!(md, "# What accuracy costs in time\n");
-    let _ = writeln!(
-        md,
-        "Generated by `cargo xtask accuracy` (`spectrace_lab::accuracy::run`) on {} thread(s) \
-         in {:.0} s; do not edit by hand. Reference: the scene as written (effects analysis \
-         `auto`), rendered by an estimator that is unbiased on it (the path tracer where `auto` \
-         picks it, BDPT everywhere else), at {} paths, seed {}, cached in `{}`. Sweep: {} to {} \
-         paths (doubling; a camera integrator traces ceil(paths / pixels) samples per pixel), every \
-         point with its own seed. Images are scaled to at most {} pixels wide. Error: relative RMSE \
-         of XYZ over all pixels, `sqrt(sum |xyz - ref|^2 / sum |ref|^2)`; time: wall time of the \
-         render alone (not loading). Plain Monte Carlo error falls as time^(-1/2): a flatter \
-         slope means bias (the configuration converges to another image) or costs that do not \
-         grow with the beams.\n",
-        report.threads,
-        report.total_seconds,
-        beams_text(o.reference_beams),
-        o.seed,
-        o.cache_dir.display(),
-        beams_text(o.start_beams),
-        beams_text(o.start_beams << (o.steps.saturating_sub(1)).min(62)),
-        o.max_width.map_or_else(|| "(unlimited)".to_owned(), |w| w.to_string()),
-    );
-    let _ = writeln!(md, "Configurations:\n");
-    for &c in &o.configurations {
-        let _ = writeln!(md, "- `{}`: {}.", c.name(), c.description());
-    }
-    summary_markdown(&mut md, report);
-    if o.configurations.iter().any(|c| c.integrator() != IntegratorChoice::Light) {
-        integrators_markdown(&mut md, report);
-    }
-    let _ = writeln!(
-        md,
-        "\n![relative RMSE against wall time, log-log](accuracy.svg)\n\n\
-         *Relative RMSE of XYZ against wall time (log-log), one panel per scene, one line per configuration; \
-         the legend gives each line's fitted slope against time; dashed: slope -1/2; dotted: the \
-         10% and 2% targets.*\n"
-    );
-    for scene in &report.scenes {
-        scene_markdown(&mut md, scene);
-    }
-    md
-}
-
-/// The fastest configuration to `target` among those that apply, and its reach (measured, or
-/// extrapolated along the fitted slope where no sweep point gets there; never for a
-/// configuration whose error levels off).
-fn fastest_to(scene: &SceneResult, target: f64) -> Option<(Configuration, Reach)> {
-    scene
-        .configurations
-        .iter()
-        .filter(|c| c.not_applicable.is_none())
-        .filter_map(|c| {
-            let reach = time_to_reach(c, target);
-            reach.seconds().map(|t| (c.configuration, reach, t))
-        })
-        .min_by(|a, b| a.2.total_cmp(&b.2))
-        .map(|(c, reach, _)| (c, reach))
-}
-
-/// Whether a configuration's image is visibly brighter or darker than the reference's at its
-/// last sweep point (mean Y off by more than 2%): it converges to another image.
-fn visibly_biased(scene: &SceneResult, configuration: Configuration) -> Option<f64> {
-    let result = scene.configurations.iter().find(|r| r.configuration == configuration)?;
-    let ratio = result.points.last()?.mean_ratio;
-    ((ratio - 1.0).abs() > 0.02).then_some(ratio)
-}
-
-/// The "fastest to" cell of the summary table.
-fn fastest_text(scene: &SceneResult, target: f64) -> String {
-    match fastest_to(scene, target) {
-        Some((c, reach)) => {
-            let biased = visibly_biased(scene, c)
-                .map_or_else(String::new, |r| format!(" (biased: mean Y {r:.2}x the reference)"));
-            format!("`{}` {}{biased}", c.name(), reach.describe())
-        }
-        None => "none reaches it".to_owned(),
-    }
-}
-
-/// Auto's time to `target` over the fastest configuration's, as the summary table's cell
-/// ("extrapolated" when either time is).
-fn auto_vs_fastest_text(scene: &SceneResult, target: f64) -> String {
-    let Some(auto) = scene.configurations.iter().find(|r| r.configuration == Configuration::Auto)
-    else {
-        return "- (auto not swept)".to_owned();
-    };
-    let Some((fastest, best)) = fastest_to(scene, target) else { return "-".to_owned() };
-    let reach = time_to_reach(auto, target);
-    match (reach.seconds(), best.seconds()) {
-        (Some(a), Some(b)) => {
-            let extrapolated =
-                matches!(reach, Reach::Extrapolated(_)) || matches!(best, Reach::Extrapolated(_));
-            let note = if fastest == Configuration::Auto {
-                " (auto is the fastest)"
-            } else if extrapolated {
-                " (extrapolated)"
-            } else {
-                ""
-            };
-            format!("{:.2}{note}", a / b.max(1e-300))
-        }
-        _ => "auto does not reach it".to_owned(),
-    }
-}
-
-/// The summary: per scene the fastest configuration to each of [`TARGETS`] and auto's time over
-/// its time.
-fn summary_markdown(md: &mut String, report: &AccuracyReport) {
-    let [coarse, fine] = TARGETS.map(|t| format!("{}%", t * 100.0));
-    let _ = writeln!(
-        md,
-        "\n## Fastest to {coarse} and to {fine}\n\n\
-         Per scene, the configuration that reaches {coarse} and {fine} relative RMSE soonest, \
-         among every configuration swept, and auto's time to the same error over that time. \
-         Times are interpolated between sweep points (`<=` when the first point is already \
-         below the target); `~... (extrapolated)` marks a time extrapolated along the \
-         configuration's fitted slope beyond the sweep (never for one whose error levels off). \
-         Reaching {fine} takes about 25 times the effort of {coarse}, so most {fine} times are \
-         extrapolated, and errors near the reference's own noise (see each scene) are inflated by \
-         it. \"biased\" marks a configuration whose image is visibly brighter or darker than the \
-         reference (e.g. the light tracer where the camera sees mirrors, left black): it reaches \
-         the target because the target is coarse, not because its image is right.\n"
-    );
-    let _ = writeln!(
-        md,
-        "| scene | pixels | auto picks | fastest to {coarse} | auto / fastest | fastest to {fine} | auto / fastest |"
-    );
-    let _ = writeln!(md, "|---|---|---|---|---:|---|---:|");
-    for scene in &report.scenes {
-        let _ = writeln!(
-            md,
-            "| {} | {}x{} | {} | {} | {} | {} | {} |",
-            scene.name,
-            scene.width,
-            scene.height,
-            scene.auto_picks.name(),
-            fastest_text(scene, ROUND_TARGET),
-            auto_vs_fastest_text(scene, ROUND_TARGET),
-            fastest_text(scene, FINE_TARGET),
-            auto_vs_fastest_text(scene, FINE_TARGET),
-        );
-    }
-    let _ = writeln!(md);
-}
-
-/// The place for "estimate vs truth" rows: the renderer's own live error estimate of a render
-/// against the error measured here against the reference. A later change fills it in (the
-/// estimate is being added to the renderer separately); until then it writes nothing.
-fn estimate_vs_truth_markdown(md: &mut String, scene: &SceneResult) {
-    let _ = (md, scene);
-}
-
-/// The estimator summary: time to [`ROUND_TARGET`] per scene and estimator, and auto's ratio.
-fn integrators_markdown(md: &mut String, report: &AccuracyReport) {
-    let _ = writeln!(
-        md,
-        "\n## Which estimator reaches {target} first\n\n\
-         Seconds to reach {target} relative RMSE for each estimator (interpolated between sweep \
-         points; `<=` when the first point is already below it). An estimator that is biased on \
-         a scene (the light tracer where the camera sees mirrors or glass, the path tracer where \
-         lights are skies, lasers or lines) levels off: it is reported as not reaching the target, \
-         never extrapolated. The last column is auto's time over the fastest of light, path and \
-         bdpt, measured in the same run (auto renders with its own seeds, so a ratio near 1 is \
-         timing and noise); `auto` is a good pick when it is within {AUTO_FACTOR}x.\n",
-        target = percent(ROUND_TARGET)
-    );
-    let _ = writeln!(
-        md,
-        "| scene | pixels | reference | auto picks | light | path | bdpt | auto | auto / fastest | within {AUTO_FACTOR}x |"
-    );
-    let _ = writeln!(md, "|---|---|---|---|---:|---:|---:|---:|---:|---|");
-    for scene in &report.scenes {
-        let find = |c: Configuration| scene.configurations.iter().find(|r| r.configuration == c);
-        let (ratio, ratio_text) = auto_ratio(scene);
-        let within = match ratio {
-            Some(r) if r <= AUTO_FACTOR => "yes",
-            Some(_) => "**no**",
-            None => "-",
-        };
-        let _ = writeln!(
-            md,
-            "| {} | {}x{} | {} | {} | {} | {} | {} | {} | {ratio_text} | {within} |",
-            scene.name,
-            scene.width,
-            scene.height,
-            scene.reference.integrator.name(),
-            scene.auto_picks.name(),
-            reach_text(find(Configuration::Baseline)),
-            reach_text(find(Configuration::Path)),
-            reach_text(find(Configuration::Bdpt)),
-            reach_text(find(Configuration::Auto)),
-        );
-    }
-    let _ = writeln!(md, "\nWhy auto picks what it picks:\n");
-    for scene in &report.scenes {
-        let _ = writeln!(md, "- `{}`: {}.", scene.name, scene.auto_reason);
-    }
-    let _ = writeln!(md);
-}
-
-fn scene_markdown(md: &mut String, scene: &SceneResult) {
-    let r = &scene.reference;
-    let _ = writeln!(md, "## {} (`{}`)\n", scene.name, scene.scene);
-    let _ = writeln!(
-        md,
-        "{}x{} pixels; {}. Auto picks {}. Reference: {} paths by {}, {} s{}.\n",
-        scene.width,
-        scene.height,
-        scene.effects_summary,
-        scene.auto_reason,
-        beams_text(r.beams),
-        r.integrator.name(),
-        sig(r.seconds),
-        if r.cached { " (read from the cache)" } else { "" },
-    );
-    let baseline = scene.configurations.iter().find(|c| c.configuration == Configuration::Baseline);
-    let same = match r.integrator {
-        IntegratorChoice::Path => Configuration::Path,
-        IntegratorChoice::Bdpt => Configuration::Bdpt,
-        _ => Configuration::Baseline,
-    };
-    let same_estimator = scene.configurations.iter().find(|c| c.configuration == same);
-    if let Some(last) = same_estimator.and_then(|b| b.points.last()) {
-        // The reference carries its estimator's noise at its own path count; it adds in
-        // quadrature to every measured error.
-        let noise = last.relative_rmse * (last.beams as f64 / r.beams as f64).sqrt();
-        let _ = writeln!(
-            md,
-            "The reference's own noise is about {} (`{}`'s last error scaled to the reference's \
-             paths); errors near it are inflated by it.\n",
-            percent(noise),
-            same.name()
-        );
-    }
-    if scene.configurations.iter().any(|c| c.configuration.integrator() != IntegratorChoice::Light)
-    {
-        let _ = writeln!(
-            md,
-            "| estimator | seconds to {} | slope vs time (last 3 points) |",
-            percent(ROUND_TARGET)
-        );
-        let _ = writeln!(md, "|---|---:|---:|");
-        for c in Configuration::INTEGRATORS {
-            let Some(result) = scene.configurations.iter().find(|r| r.configuration == c) else {
-                continue;
-            };
-            let _ = writeln!(
-                md,
-                "| {} | {} | {} |",
-                c.integrator_label(),
-                reach_text(Some(result)),
-                slope_text(tail_slope(result))
-            );
-        }
-        let _ = writeln!(md, "\nauto / fastest: {}.\n", auto_ratio(scene).1);
-    }
-    let _ =
-        writeln!(md, "| configuration | paths | seconds | relative RMSE | mean Y / reference |");
-    let _ = writeln!(md, "|---|---:|---:|---:|---:|");
-    for c in &scene.configurations {
-        for p in &c.points {
-            let _ = writeln!(
-                md,
-                "| {} | {} | {} | {} | {:.3} |",
-                c.configuration.name(),
-                beams_text(p.beams),
-                sig(p.seconds),
-                percent(p.relative_rmse),
-                p.mean_ratio
-            );
-        }
-    }
-    let _ = writeln!(
-        md,
-        "\n| configuration | what changed | slope vs time | slope vs beams | expected | error x sqrt(seconds) at the last point |"
-    );
-    let _ = writeln!(md, "|---|---|---:|---:|---:|---:|");
-    for c in &scene.configurations {
-        match &c.not_applicable {
-            Some(reason) => {
-                let _ = writeln!(
-                    md,
-                    "| {} | not applicable: {} | - | - | {EXPECTED_SLOPE} | - |",
-                    c.configuration.name(),
-                    reason.replace('|', "/").replace('\n', " ")
-                );
-            }
-            None => {
-                let merit = c
-                    .points
-                    .last()
-                    .map_or_else(|| "-".to_owned(), |p| sig(p.relative_rmse * p.seconds.sqrt()));
-                let _ = writeln!(
-                    md,
-                    "| {} | {} | {} | {} | {EXPECTED_SLOPE} | {merit} |",
-                    c.configuration.name(),
-                    if c.changed.is_empty() { "-" } else { &c.changed },
-                    slope_text(c.slope_vs_time),
-                    slope_text(c.slope_vs_beams),
-                );
-            }
-        }
-    }
-    let _ = writeln!(md);
-    let mut targets = Vec::new();
-    if let Some(last) = baseline.and_then(|b| b.points.last()) {
-        targets.push((last.relative_rmse, "the smallest error the baseline reached"));
-    }
-    targets.push((ROUND_TARGET, "a round target"));
-    targets.push((FINE_TARGET, "the fine target"));
-    for (target, what) in targets {
-        let applicable: Vec<_> =
-            scene.configurations.iter().filter(|c| c.not_applicable.is_none()).collect();
-        let reaches: Vec<_> = applicable.iter().map(|c| (c, time_to_reach(c, target))).collect();
-        let fastest = reaches
-            .iter()
-            .filter_map(|(c, r)| r.seconds().map(|t| (c, *r, t)))
-            .min_by(|a, b| a.2.total_cmp(&b.2));
-        let times = reaches
-            .iter()
-            .map(|(c, r)| format!("`{}` {}", c.configuration.name(), r.describe()))
-            .collect::<Vec<_>>()
-            .join(", ");
-        match fastest {
-            Some((c, reach, best)) => {
-                let ties: Vec<String> = reaches
-                    .iter()
-                    .filter(|(o, r)| {
-                        o.configuration != c.configuration
-                            && r.seconds().is_some_and(|t| t <= best * TIE_FACTOR)
-                    })
-                    .map(|(o, _)| format!("`{}`", o.configuration.name()))
-                    .collect();
-                let tie = if ties.is_empty() {
-                    String::new()
-                } else {
-                    format!(
-                        ", tied within timing noise (less than {:.0}% slower) with {}",
-                        (TIE_FACTOR - 1.0) * 100.0,
-                        ties.join(" and ")
-                    )
-                };
-                let _ = writeln!(
-                    md,
-                    "To reach {} ({what}), **`{}`** is fastest{}{tie}: {times}.\n",
-                    percent(target),
-                    c.configuration.name(),
-                    if matches!(reach, Reach::Extrapolated(_)) {
-                        " (by extrapolation beyond the sweep)"
-                    } else {
-                        ""
-                    },
-                );
-            }
-            None => {
-                let _ = writeln!(
-                    md,
-                    "No configuration reaches {} ({what}) within the sweep: {times}.\n",
-                    percent(target)
-                );
-            }
-        }
-    }
-    estimate_vs_truth_markdown(md, scene);
-}
-
-/// Line colours, one per [`Configuration`] in order (colour-blind-friendly, after Okabe and Ito).
-const PLOT_COLOURS: [(u8, u8, u8); 8] = [
-    (0, 0, 0),
-    (0, 114, 178),
-    (213, 94, 0),
-    (0, 158, 115),
-    (204, 121, 167),
-    (86, 180, 233),
-    (230, 159, 0),
-    (240, 228, 66),
-];
-
-/// The marker of the `i`-th configuration, as pixel offsets: circle, triangle, square, diamond, ...
-fn marker_shape(i: usize) -> Vec<(i32, i32)> {
-    let (sides, radius, turn) = match i % 4 {
-        0 => (12, 3.5, 0.0),
-        1 => (3, 5.0, -0.25),
-        2 => (4, 4.5, 0.125),
-        _ => (4, 5.0, 0.0),
-    };
-    (0..sides)
-        .map(|k| {
-            let a = std::f64::consts::TAU * (k as f64 / sides as f64 + turn);
-            ((radius * a.cos()).round() as i32, (radius * a.sin()).round() as i32)
-        })
-        .collect()
-}
-
-/// One line of the plot.
-struct PlotSeries {
-    label: String,
-    configuration: usize,
-    points: Vec<(f64, f64)>,
-}
-
-/// Draws the log-log plot of error against time (SVG): one panel per scene, one line per
-/// configuration (colour by configuration, the same in every panel), a dashed line of slope -1/2.
-///
-/// # Errors
-/// A message if the file cannot be written.
-pub fn write_plot(report: &AccuracyReport, path: &Path) -> Result<(), String> {
-    use plotters::prelude::*;
-    let err = |e: &dyn std::fmt::Display| format!("{}: plot: {e}", path.display());
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).map_err(|e| err(&e))?;
-    }
-    let panels = report.scenes.len().max(1);
-    let cols = panels.min(2);
-    let rows = panels.div_ceil(cols);
-    let size = (560 * cols as u32, 60 + 400 * rows as u32);
-    let root = SVGBackend::new(path, size).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let root = root
-        .titled("Spectrace: relative RMSE of XYZ against wall time", ("sans-serif", 22))
-        .map_err(|e| err(&e))?;
-    let areas = root.split_evenly((rows, cols));
-    for (scene, area) in report.scenes.iter().zip(&areas) {
-        let series: Vec<PlotSeries> = scene
-            .configurations
-            .iter()
-            .filter(|c| !c.points.is_empty())
-            .map(|c| PlotSeries {
-                label: format!(
-                    "{} (slope {})",
-                    c.configuration.name(),
-                    slope_text(c.slope_vs_time)
-                ),
-                configuration: Configuration::ALL
-                    .iter()
-                    .position(|&k| k == c.configuration)
-                    .unwrap_or_default(),
-                points: c
-                    .points
-                    .iter()
-                    .filter(|p| p.seconds > 0.0 && p.relative_rmse > 0.0)
-                    .map(|p| (p.seconds, p.relative_rmse))
-                    .collect(),
-            })
-            .collect();
-        draw_panel(area, &scene.name, &series).map_err(|e| err(&e))?;
-    }
-    root.present().map_err(|e| err(&e))?;
-    Ok(())
-}
-
-/// One scene's panel of [`write_plot`].
-fn draw_panel<DB: plotters::prelude::DrawingBackend>(
-    area: &plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
-    title: &str,
-    series: &[PlotSeries],
-) -> Result<(), String> {
-    use plotters::prelude::*;
-    let err = |e: &dyn std::fmt::Display| format!("panel {title}: {e}");
-    let all: Vec<(f64, f64)> = series.iter().flat_map(|s| s.points.iter().copied()).collect();
-    let bounds = |f: fn(&(f64, f64)) -> f64| {
-        let lo = all.iter().map(f).fold(f64::INFINITY, f64::min);
-        let hi = all.iter().map(f).fold(0.0, f64::max);
-        if lo.is_finite() && hi > lo { (lo / 1.5, hi * 1.5) } else { (1e-3, 1.0) }
-    };
-    let (x0, x1) = bounds(|p| p.0);
-    let (y0, y1) = bounds(|p| p.1);
-    let mut chart = ChartBuilder::on(area)
-        .caption(title, ("sans-serif", 18))
-        .margin(10)
-        .x_label_area_size(36)
-        .y_label_area_size(56)
-        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
-        .map_err(|e| err(&e))?;
-    chart
-        .configure_mesh()
-        .x_desc("wall time of the render (s)")
-        .y_desc("relative RMSE of XYZ")
-        .light_line_style(BLACK.mix(0.05))
-        .max_light_lines(4)
-        .x_label_formatter(&|x| sig(*x))
-        .y_label_formatter(&|y| {
-            let text = sig(*y * 100.0);
-            let text = if text.contains('.') {
-                text.trim_end_matches('0').trim_end_matches('.')
-            } else {
-                &text
-            };
-            format!("{text}%")
-        })
-        .draw()
-        .map_err(|e| err(&e))?;
-    for PlotSeries { label, configuration: ci, points } in series {
-        let (r, g, b) = PLOT_COLOURS[ci % PLOT_COLOURS.len()];
-        let color = RGBColor(r, g, b);
-        let marker = marker_shape(*ci);
-        let legend_marker = marker.clone();
-        chart
-            .draw_series(LineSeries::new(points.iter().copied(), color.stroke_width(2)))
-            .map_err(|e| err(&e))?
-            .label(label.clone())
-            .legend(move |(x, y)| {
-                EmptyElement::at((x + 10, y))
-                    + PathElement::new(vec![(-10, 0), (10, 0)], color.stroke_width(2))
-                    + Polygon::new(legend_marker.clone(), color.filled())
-            });
-        chart
-            .draw_series(
-                points
-                    .iter()
-                    .map(|&p| EmptyElement::at(p) + Polygon::new(marker.clone(), color.filled())),
-            )
-            .map_err(|e| err(&e))?;
-    }
-    if !all.is_empty() {
-        // Slope -1/2 through the geometric centre of the data.
-        let n = all.len() as f64;
-        let cx = (all.iter().map(|p| p.0.ln()).sum::<f64>() / n).exp();
-        let cy = (all.iter().map(|p| p.1.ln()).sum::<f64>() / n).exp();
-        let line = [x0, x1].map(|x| (x, cy * (x / cx).powf(EXPECTED_SLOPE)));
-        chart
-            .draw_series(DashedLineSeries::new(line, 8, 6, BLACK.stroke_width(1)))
-            .map_err(|e| err(&e))?
-            .label("slope -1/2 (Monte Carlo)")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(1)));
-    }
-    // The error targets of the summary, where they fall inside the panel.
-    let targets: Vec<f64> = TARGETS.into_iter().filter(|t| (y0..=y1).contains(t)).collect();
-    for (k, &target) in targets.iter().enumerate() {
-        let series = chart
-            .draw_series(DashedLineSeries::new(
-                [(x0, target), (x1, target)],
-                2,
-                4,
-                BLACK.mix(0.5).stroke_width(1),
-            ))
-            .map_err(|e| err(&e))?;
-        if k == 0 {
-            series.label("10% and 2% targets").legend(|(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], BLACK.mix(0.5).stroke_width(1))
-            });
-        }
-    }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .label_font(("sans-serif", 11))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| err(&e))?;
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
+    use super::knobs::*;
+    use super::report::*;
     use super::*;
 
     const TINY: &str = r#"{
@@ -1766,7 +881,9 @@ mod tests {
         assert!(md.contains("| baseline | 2^10 |"));
         assert!(md.contains("is fastest"));
         assert!(md.contains("## Fastest to 10% and to 2%"), "{md}");
-        assert!(md.contains("| tiny | 32x24 | path | `"), "{md}");
+        let row = md.lines().find(|l| l.starts_with("| tiny | 32x24 | path | ")).unwrap();
+        // The reference's noise, then the fastest configuration to 10% by name.
+        assert!(row.contains("% | `"), "{row}");
         assert!(md.contains("To reach 2.00% (the fine target)"), "{md}");
         let svg = std::fs::read_to_string(dir.join("docs/accuracy.svg")).unwrap();
         assert!(svg.contains("<svg") && svg.contains("slope -1/2"));
