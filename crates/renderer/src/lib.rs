@@ -11,7 +11,11 @@
 //! same image a single machine would make, bit for bit. The key design decision: one render path
 //! for every estimator ([`with_integrator`]), so sharding, time budgets, probes and outputs work
 //! the same for all. The `spectrace` binary exposes it; the xtask's `render` subcommand calls it.
-//! Nothing but `xtask` and the tests depend on this crate.
+//! The accuracy report is not here: it is an experiment harness with its own crate,
+//! `spectrace-lab`, so programs that render do not link its plotting library; this crate keeps
+//! the timed measurement both it and `spectrace bench` use ([`render_xyz`],
+//! [`integrator_benchmark`]). Nothing but `spectrace-lab`, `xtask` and the tests depend on this
+//! crate.
 
 pub mod cli;
 mod files;
