@@ -245,17 +245,29 @@ pub(super) fn reference_noise(scene: &SceneResult) -> Option<(Configuration, f64
 /// The fastest configuration to `target` among those that apply, and its reach (measured, or
 /// extrapolated along the fitted slope where no sweep point gets there; never for a
 /// configuration whose error levels off).
-pub(super) fn fastest_to(scene: &SceneResult, target: f64) -> Option<(Configuration, Reach)> {
+pub(super) fn fastest_to(
+    scene: &SceneResult,
+    target: f64,
+    converging_only: bool,
+) -> Option<(Configuration, Reach)> {
     scene
         .configurations
         .iter()
         .filter(|c| c.not_applicable.is_none())
+        .filter(|c| !converging_only || converges(scene, c))
         .filter_map(|c| {
             let reach = time_to_reach(c, target);
             reach.seconds().map(|t| (c.configuration, reach, t))
         })
         .min_by(|a, b| a.2.total_cmp(&b.2))
         .map(|(c, reach, _)| (c, reach))
+}
+
+/// Whether a configuration converges to the reference's image as far as the report can tell: no
+/// bias known from the scene's features ([`known_bias`]) and a mean brightness within 2% of the
+/// reference's.
+pub(super) fn converges(scene: &SceneResult, result: &ConfigurationResult) -> bool {
+    result.known_bias.is_none() && visibly_biased(scene, result.configuration).is_none()
 }
 
 /// Whether a configuration's image is visibly brighter or darker than the reference's at its
@@ -268,14 +280,26 @@ pub(super) fn visibly_biased(scene: &SceneResult, configuration: Configuration) 
 
 /// The "fastest to" cell of the summary table.
 pub(super) fn fastest_text(scene: &SceneResult, target: f64) -> String {
-    match fastest_to(scene, target) {
-        Some((c, reach)) => {
-            let biased = visibly_biased(scene, c)
-                .map_or_else(String::new, |r| format!(" (biased: mean Y {r:.2}x the reference)"));
-            format!("`{}` {}{biased}", c.name(), reach.describe())
-        }
-        None => "none reaches it".to_owned(),
+    let seconds = |r: &Option<(Configuration, Reach)>| r.and_then(|(_, r)| r.seconds());
+    let converging = fastest_to(scene, target, true);
+    let any = fastest_to(scene, target, false);
+    let mut text = match converging {
+        Some((c, reach)) => format!("`{}` {}", c.name(), reach.describe()),
+        None => "none that converges reaches it".to_owned(),
+    };
+    if let Some((c, reach)) = any
+        && seconds(&any) < seconds(&converging).or(Some(f64::INFINITY))
+    {
+        let why = scene
+            .configurations
+            .iter()
+            .find(|r| r.configuration == c)
+            .and_then(|r| r.known_bias.clone())
+            .or_else(|| visibly_biased(scene, c).map(|r| format!("mean Y {r:.2}x the reference")))
+            .unwrap_or_default();
+        text += &format!("; sooner but biased: `{}` {} ({why})", c.name(), reach.describe());
     }
+    text
 }
 
 /// Auto's time to `target` over the fastest configuration's, as the summary table's cell
@@ -285,7 +309,7 @@ pub(super) fn auto_vs_fastest_text(scene: &SceneResult, target: f64) -> String {
     else {
         return "- (auto not swept)".to_owned();
     };
-    let Some((fastest, best)) = fastest_to(scene, target) else { return "-".to_owned() };
+    let Some((fastest, best)) = fastest_to(scene, target, true) else { return "-".to_owned() };
     let reach = time_to_reach(auto, target);
     match (reach.seconds(), best.seconds()) {
         (Some(a), Some(b)) => {
@@ -311,17 +335,21 @@ pub(super) fn summary_markdown(md: &mut String, report: &AccuracyReport) {
     let _ = writeln!(
         md,
         "\n## Fastest to {coarse} and to {fine}\n\n\
-         Per scene, the configuration that reaches {coarse} and {fine} relative RMSE soonest, \
-         among every configuration swept, and auto's time to the same error over that time. \
-         Times are interpolated between sweep points (`<=` when the first point is already \
-         below the target); `~... (extrapolated)` marks a time extrapolated along the \
-         configuration's fitted slope beyond the sweep (never for one whose error levels off). \
-         Reaching {fine} takes about 25 times the effort of {coarse}, so most {fine} times are \
-         extrapolated. Every measured error includes the reference's own noise in quadrature \
-         (its column, estimated from the reference's estimator in the sweep): a target near or \
-         below it cannot be measured, only extrapolated from the slope of the larger errors. \"biased\" marks a configuration whose image is visibly brighter or darker than the \
-         reference (e.g. the light tracer where the camera sees mirrors, left black): it reaches \
-         the target because the target is coarse, not because its image is right.\n"
+         Per scene, the configuration that reaches {coarse} and {fine} relative RMSE soonest \
+         among those that converge to the reference's image, and auto's time to the same error \
+         over that time. A configuration converges unless a bias is known from the scene (a \
+         piecewise-constant SPD is another spectrum; the light tracer shows mirrors and glass \
+         seen by the camera black, flagged wherever the scene has specular surfaces; the path \
+         tracer misses lasers, skies, lines and point-light caustics) or its mean brightness is \
+         more than 2% off the reference's; a biased configuration that gets there sooner is \
+         named after it (its image is wrong, the error target is just coarse). Times are \
+         interpolated between sweep points (`<=` when the first point is already below the \
+         target); `~... (extrapolated)` marks a time extrapolated along the configuration's \
+         fitted slope beyond the sweep (never for one whose error levels off). Reaching {fine} \
+         takes about 25 times the effort of {coarse}, so most {fine} times are extrapolated. \
+         Every measured error includes the reference's own noise in quadrature (its column, \
+         estimated from the reference's estimator in the sweep): a target near or below it \
+         cannot be measured, only extrapolated from the slope of the larger errors.\n"
     );
     let _ = writeln!(
         md,
@@ -488,7 +516,12 @@ pub(super) fn scene_markdown(md: &mut String, scene: &SceneResult) {
                     md,
                     "| {} | {} | {} | {} | {EXPECTED_SLOPE} | {merit} |",
                     c.configuration.name(),
-                    if c.changed.is_empty() { "-" } else { &c.changed },
+                    match (&c.known_bias, c.changed.is_empty()) {
+                        (Some(bias), true) => format!("- (biased: {bias})"),
+                        (Some(bias), false) => format!("{} (biased: {bias})", c.changed),
+                        (None, true) => "-".to_owned(),
+                        (None, false) => c.changed.clone(),
+                    },
                     slope_text(c.slope_vs_time),
                     slope_text(c.slope_vs_beams),
                 );
