@@ -274,7 +274,7 @@ def read_spectrace(out_dir, name):
 
 
 def relative_rmse(image, reference, mask):
-    """accuracy.rs's definition, sqrt(sum |xyz - ref|^2 / sum |ref|^2), over the pixels of mask."""
+    """The accuracy report's definition (crates/lab, relative_rmse), sqrt(sum |xyz - ref|^2 / sum |ref|^2), over the pixels of mask."""
     diff = ((image - reference) ** 2).sum(axis=2)[mask].sum()
     norm = (reference**2).sum(axis=2)[mask].sum()
     return float(math.sqrt(diff / norm))

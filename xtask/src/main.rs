@@ -1,6 +1,7 @@
 //! Spectrace's project automation, run as `cargo xtask <command>` (a cargo alias in
 //! `.cargo/config.toml`). It has no dependencies and one function per subcommand; rendering
-//! commands build the `spectrace` binary in release mode and run it.
+//! commands build the `spectrace` binary (the accuracy report: `spectrace-lab`) in release mode
+//! and run it.
 //!
 //! Commands today:
 //! - `cargo xtask` / `cargo xtask status`: what Spectrace contains so far and how to use it.
@@ -10,7 +11,9 @@
 //!   scene (default `scenes/showcase.json`); options go to `spectrace render`.
 //! - `cargo xtask estimate SCENE --target-error E [options]`: predicts the render time to E for
 //!   each estimator from short pilots (`spectrace estimate`).
-//! - `cargo xtask accuracy [SCENES]`: the error-against-time report, `docs/accuracy.md`.
+//! - `cargo xtask accuracy [SCENES] [options]`: the error-against-time report, `docs/accuracy.md`:
+//!   builds `spectrace-lab` in release mode and runs `spectrace-lab accuracy` from the workspace
+//!   root.
 //! - `cargo xtask fuzz [--cases N] [--seed S]`: a longer run of the scene and part-file fuzzer
 //!   (`tests/tests/fuzz.rs`) in release mode.
 //! - `cargo xtask peer [options]`: the race against Mitsuba 3 (`docs/peer.md`): builds a Python
@@ -67,7 +70,13 @@ const CRATES: &[CrateInfo] = &[
     CrateInfo {
         package: "spectrace-renderer",
         path: "crates/renderer",
-        what: "scene files, EXR/PNG/JSON outputs, sharding and merge, accuracy report; `spectrace`",
+        what: "scene files, EXR/PNG/JSON outputs, sharding and merge, estimator bench; `spectrace`",
+    },
+    CrateInfo {
+        package: "spectrace-lab",
+        path: "crates/lab",
+        what: "experiment harness: the accuracy report (error against time for every knob, plots); \
+               `spectrace-lab`",
     },
 ];
 
@@ -133,13 +142,26 @@ fn render(args: &[String]) -> ExitCode {
     run_spectrace(&command)
 }
 
-/// `cargo xtask accuracy [SCENES] [options]`: the error-against-time report (docs/accuracy.md),
-/// run from the workspace root (scene paths are relative to it).
+/// `cargo xtask accuracy [SCENES] [options]`: the error-against-time report (docs/accuracy.md):
+/// builds `spectrace-lab` in release mode and runs `spectrace-lab accuracy` from the workspace
+/// root (scene paths are relative to it).
 fn accuracy(args: &[String]) -> ExitCode {
     let mut command: Vec<String> = vec!["accuracy".into()];
     command.extend(args.iter().cloned());
-    run_spectrace_in(&command, Some(&workspace_root()))
+    run_binary_in(LAB, &command, Some(&workspace_root()))
 }
+
+/// A binary of the workspace that the xtask builds and runs: its package and name.
+struct Binary {
+    package: &'static str,
+    name: &'static str,
+}
+
+/// The renderer's command line.
+const SPECTRACE: Binary = Binary { package: "spectrace-renderer", name: "spectrace" };
+
+/// The experiment harness's command line (the accuracy report).
+const LAB: Binary = Binary { package: "spectrace-lab", name: "spectrace-lab" };
 
 /// `cargo xtask fuzz [--cases N] [--seed S]`: the fuzz tests with N mutants per target (default
 /// 5000) from seed S (default: the time), in release mode.
@@ -184,12 +206,12 @@ fn fuzz(args: &[String]) -> ExitCode {
 
 /// Builds `spectrace` in release mode, then runs it with `args` in the current directory.
 fn run_spectrace(args: &[String]) -> ExitCode {
-    run_spectrace_in(args, None)
+    run_binary_in(SPECTRACE, args, None)
 }
 
-/// Builds `spectrace` in release mode, then runs it with `args` in `dir` (or here).
-fn run_spectrace_in(args: &[String], dir: Option<&std::path::Path>) -> ExitCode {
-    let binary = match build_spectrace() {
+/// Builds `binary` in release mode, then runs it with `args` in `dir` (or here).
+fn run_binary_in(binary: Binary, args: &[String], dir: Option<&std::path::Path>) -> ExitCode {
+    let binary = match build_release(&binary) {
         Ok(binary) => binary,
         Err(code) => return code,
     };
@@ -217,15 +239,18 @@ fn target_dir() -> std::path::PathBuf {
 
 /// Builds `spectrace` in release mode; its path, or the exit code of the failure (reported).
 fn build_spectrace() -> Result<std::path::PathBuf, ExitCode> {
+    build_release(&SPECTRACE)
+}
+
+/// Builds `binary` in release mode; its path, or the exit code of the failure (reported).
+fn build_release(binary: &Binary) -> Result<std::path::PathBuf, ExitCode> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
-    eprintln!("$ cargo build --release -p spectrace-renderer --bin spectrace");
-    match Command::new(&cargo)
-        .args(["build", "--release", "-p", "spectrace-renderer", "--bin", "spectrace"])
-        .status()
-    {
+    let args = ["build", "--release", "-p", binary.package, "--bin", binary.name];
+    eprintln!("$ cargo {}", args.join(" "));
+    match Command::new(&cargo).args(args).status() {
         Ok(s) if s.success() => {}
         Ok(s) => {
-            eprintln!("building the renderer failed ({s})");
+            eprintln!("building {} failed ({s})", binary.name);
             return Err(ExitCode::FAILURE);
         }
         Err(e) => {
@@ -233,7 +258,11 @@ fn build_spectrace() -> Result<std::path::PathBuf, ExitCode> {
             return Err(ExitCode::FAILURE);
         }
     }
-    Ok(target_dir().join("release").join(format!("spectrace{}", std::env::consts::EXE_SUFFIX)))
+    Ok(target_dir().join("release").join(format!(
+        "{}{}",
+        binary.name,
+        std::env::consts::EXE_SUFFIX
+    )))
 }
 
 fn print_help() {
@@ -245,7 +274,9 @@ fn print_help() {
                   build in release and render SCENE (default scenes/showcase.json)\n  \
          estimate SCENE --target-error E [--pilot-seconds S] [--integrators light,path,bdpt]\n           \
                   predict the render time to E for each estimator from short pilots\n  \
-         accuracy [SCENES]  error against time for every accuracy knob (docs/accuracy.md)\n  \
+         accuracy [SCENES] [--max-width W] [--start-beams N] [--steps K] [--reference-beams N]\n           \
+                  [--configurations A,B] [--out DIR]\n           \
+                  error against time for every knob (docs/accuracy.md; runs spectrace-lab)\n  \
          fuzz [--cases N] [--seed S]  fuzz the scene and part-file loaders (release)\n  \
          peer [--scenes A,B] [--max-seconds S] [--reference-scale F] [--no-docs]\n           \
                   the race against Mitsuba 3 (docs/peer.md); needs python3, pip, libLLVM >= 16\n  \

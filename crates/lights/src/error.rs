@@ -27,6 +27,13 @@ pub enum LightError {
         /// What is wrong with the spectrum.
         source: SpectrumError,
     },
+    /// An experiment hook (e.g. [`crate::LightSource::set_wavelength_sampling`]) that this light
+    /// type does not offer.
+    #[error("{field}: this light type cannot change it once built")]
+    Unsupported {
+        /// The field that could not be changed, e.g. `"wavelength_sampling"`.
+        field: &'static str,
+    },
     /// A light set without lights, or whose lights have no power.
     #[error("LightSet.lights: {reason}")]
     EmptySet {

@@ -54,7 +54,7 @@ pub use laser::Laser;
 pub use set::LightSet;
 pub use sky::Sky;
 pub use source::{
-    EmissionSample, LightFlags, LightSample, LightSource, LightSurface, SpdLight,
+    EmissionSample, LightFlags, LightSample, LightSource, LightSurface, SpdLight, SpdMap,
     WavelengthSampling,
 };
 pub use spot::{FadingSpotLight, PointLight, UniformSpotLight};

@@ -111,6 +111,24 @@ impl LightSet {
         Ok(Self { lights, choice, spd, power, counter: BeamCounter::new() })
     }
 
+    /// Calls `f` on every light in `parent` order (for experiment hooks such as
+    /// [`LightSource::set_wavelength_sampling`]), then rebuilds the set's spectrum and light
+    /// choice from the lights as they are now. The lights keep their order, so every
+    /// [`LightId`] still names the same light.
+    ///
+    /// # Errors
+    /// As [`LightSet::new`] (a light whose power `f` made invalid); the set is then empty.
+    pub fn modify_lights(
+        &mut self,
+        f: &mut dyn FnMut(LightId, &mut dyn LightSource),
+    ) -> Result<(), LightError> {
+        for (i, light) in self.lights.iter_mut().enumerate() {
+            f(LightId(i as u32), light.as_mut());
+        }
+        *self = Self::new(std::mem::take(&mut self.lights))?;
+        Ok(())
+    }
+
     /// The lights, in `parent` order.
     pub fn lights(&self) -> &[Box<dyn LightSource>] {
         &self.lights

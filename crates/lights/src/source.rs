@@ -82,6 +82,31 @@ pub trait LightSource: Send + Sync + Debug {
         (self.spd().sample_lambda(u), 1.0)
     }
 
+    /// Experiment hook (the accuracy report's wavelength-strategy knob): switches how the light
+    /// draws its beams' wavelengths, keeping its SPD and power. The default returns
+    /// [`LightError::Unsupported`], so light types from other crates keep compiling; the
+    /// built-in lights implement it through [`SpdLight::set_sampling`].
+    ///
+    /// # Errors
+    /// [`LightError::Unsupported`] by default; as [`SpdLight::new`] otherwise (equal wavelengths
+    /// for an SPD with delta lines).
+    fn set_wavelength_sampling(&mut self, sampling: WavelengthSampling) -> Result<(), LightError> {
+        let _ = sampling;
+        Err(LightError::Unsupported { field: "wavelength_sampling" })
+    }
+
+    /// Experiment hook (the accuracy report's SPD-sampler knob): replaces the light's SPD by
+    /// `f(spd)` where `f` returns one, keeping the power and wavelength sampling; `Ok(true)` if it
+    /// was replaced, `Ok(false)` if `f` returned `None`. The default returns
+    /// [`LightError::Unsupported`].
+    ///
+    /// # Errors
+    /// [`LightError::Unsupported`] by default; as [`SpdLight::new`] for the new SPD.
+    fn map_spd(&mut self, f: &SpdMap<'_>) -> Result<bool, LightError> {
+        let _ = f;
+        Err(LightError::Unsupported { field: "spd" })
+    }
+
     /// For a group of lights (a [`crate::LightSet`]): hands over its lights, leaving it empty.
     /// [`crate::LightSet::new`] uses it to flatten nested sets, so that every beam's `parent` is
     /// a plain light. Plain lights return `None` (the default).
@@ -311,6 +336,8 @@ fn observer_table(spd: &dyn SpectralPowerDistribution) -> Option<PiecewiseConsta
 /// Every built-in light embeds one.
 #[derive(Debug, Clone)]
 pub struct SpdLight {
+    /// The light type, for errors.
+    light: &'static str,
     spd: Arc<dyn SpectralPowerDistribution>,
     power: f64,
     sampling: WavelengthSampling,
@@ -359,7 +386,7 @@ impl SpdLight {
         } else {
             None
         };
-        Ok(Self { spd, power, sampling, observer, counter: BeamCounter::new() })
+        Ok(Self { light, spd, power, sampling, observer, counter: BeamCounter::new() })
     }
 
     /// Draws a wavelength (nm) and the beam's `scale` from a uniform `u` in `[0, 1)`, according
@@ -428,7 +455,33 @@ impl SpdLight {
     pub fn sampling(&self) -> WavelengthSampling {
         self.sampling
     }
+
+    /// Switches how wavelengths are drawn (rebuilding the observer table), keeping the SPD and
+    /// power; the beam count starts again at zero.
+    ///
+    /// # Errors
+    /// As [`SpdLight::new`].
+    pub fn set_sampling(&mut self, sampling: WavelengthSampling) -> Result<(), LightError> {
+        *self = Self::new(self.light, self.spd.clone(), self.power, sampling)?;
+        Ok(())
+    }
+
+    /// Replaces the SPD by `f(spd)` when `f` returns one (keeping the power and sampling);
+    /// whether it did.
+    ///
+    /// # Errors
+    /// As [`SpdLight::new`] for the new SPD.
+    pub fn map_spd(&mut self, f: &SpdMap<'_>) -> Result<bool, LightError> {
+        let Some(spd) = f(self.spd.as_ref()) else { return Ok(false) };
+        *self = Self::new(self.light, Arc::from(spd), self.power, self.sampling)?;
+        Ok(true)
+    }
 }
+
+/// A function that maps an SPD to its replacement, or `None` to keep it (see
+/// [`LightSource::map_spd`]).
+pub type SpdMap<'a> =
+    dyn Fn(&dyn SpectralPowerDistribution) -> Option<Box<dyn SpectralPowerDistribution>> + 'a;
 
 /// Draws a uniform in `[0, 1)` from a generator (53 random bits).
 #[inline]
@@ -463,6 +516,18 @@ macro_rules! delegate_to_spd_light {
         }
         fn sample_wavelength(&self, u: f64) -> (f64, f64) {
             self.$field.companion_wavelength(u)
+        }
+        fn set_wavelength_sampling(
+            &mut self,
+            sampling: $crate::WavelengthSampling,
+        ) -> ::std::result::Result<(), $crate::LightError> {
+            self.$field.set_sampling(sampling)
+        }
+        fn map_spd(
+            &mut self,
+            f: &$crate::SpdMap<'_>,
+        ) -> ::std::result::Result<bool, $crate::LightError> {
+            self.$field.map_spd(f)
         }
     };
 }

@@ -957,3 +957,91 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn the_experiment_hooks_retune_lights_in_place_and_keep_the_set_consistent() {
+    let table: Arc<dyn SpectralPowerDistribution> = Arc::new(
+        spectrum::Tabulated::new(&[400.0, 500.0, 600.0, 700.0], &[0.2, 1.0, 0.6, 0.3]).unwrap(),
+    );
+    // A Gaussian with a spectral line: delta lines have no density to weight by.
+    let line: Arc<dyn SpectralPowerDistribution> = Arc::new(
+        spectrum::Mixture::new(vec![
+            spectrum::Component { weight: 1.0, spd: Arc::new(Gaussian::new(500.0, 40.0).unwrap()) },
+            spectrum::Component { weight: 1.0, spd: Arc::new(Monochromatic::new(550.0).unwrap()) },
+        ])
+        .unwrap(),
+    );
+    let lights: Vec<Box<dyn LightSource>> = vec![
+        Box::new(PointLight::new(DVec3::ZERO, 3.0, table, WavelengthSampling::Importance).unwrap()),
+        Box::new(PointLight::new(DVec3::ONE, 1.0, line, WavelengthSampling::Importance).unwrap()),
+    ];
+    let mut set = LightSet::new(lights).unwrap();
+    let sampling = |set: &LightSet, i: usize| {
+        serde_json::to_value(&set.lights()[i]).unwrap()["wavelength_sampling"].clone()
+    };
+
+    // Equal wavelengths: allowed for the table, refused (naming the field) for the line.
+    let mut outcomes = Vec::new();
+    set.modify_lights(&mut |id, light| {
+        outcomes.push((id, light.set_wavelength_sampling(WavelengthSampling::EqualWavelengths)));
+    })
+    .unwrap();
+    assert!(outcomes[0].1.is_ok());
+    let refused = outcomes[1].1.as_ref().unwrap_err().to_string();
+    assert!(refused.contains("wavelength_sampling"), "{refused}");
+    assert_eq!(sampling(&set, 0), "equal_wavelengths");
+    assert_eq!(sampling(&set, 1), "importance");
+    // Power and order unchanged: light 0 still has 3/4 of the power.
+    assert_eq!(set.power(), 4.0);
+    assert!((set.pmf(LightId(0)) - 0.75).abs() < 1e-12);
+
+    // Piecewise-constant SPD for the table; the line has none and stays.
+    let mut replaced = Vec::new();
+    set.modify_lights(&mut |_, light| {
+        replaced.push(
+            light.map_spd(&|spd: &dyn SpectralPowerDistribution| spd.piecewise_constant()).unwrap(),
+        );
+    })
+    .unwrap();
+    assert_eq!(replaced, [true, false]);
+    let spd = serde_json::to_value(set.lights()[0].spd().as_ref()).unwrap();
+    assert_eq!(spd["type"], "Binned");
+    assert_eq!(sampling(&set, 0), "equal_wavelengths");
+    // The set's own spectrum is rebuilt from the lights as they are now.
+    let rebinned = set.lights()[0].spd();
+    assert_eq!(rebinned.value(451.0), rebinned.value(549.0));
+    let expected = 0.75 * rebinned.value(451.0) + 0.25 * set.lights()[1].spd().value(451.0);
+    assert!((set.spd().value(451.0) - expected).abs() < 1e-12);
+}
+
+/// A light from another crate that implements only the seed's four methods.
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+struct SeedOnlyLight {
+    power: f64,
+}
+
+#[typetag::serde]
+impl LightSource for SeedOnlyLight {
+    fn next_beam(&self, _rng: &mut dyn rand::Rng) -> Beam {
+        Beam::new(DVec3::ZERO, DVec3::Z, 550.0, 1.0)
+    }
+    fn number_of_beams(&self) -> u64 {
+        0
+    }
+    fn power(&self) -> f64 {
+        self.power
+    }
+    fn spd(&self) -> Arc<dyn SpectralPowerDistribution> {
+        Arc::new(Monochromatic::new(550.0).unwrap())
+    }
+}
+
+#[test]
+fn a_light_without_the_hooks_says_so_by_field() {
+    let mut light = SeedOnlyLight { power: 1.0 };
+    let e = light.set_wavelength_sampling(WavelengthSampling::Observer).unwrap_err();
+    assert_eq!(e, LightError::Unsupported { field: "wavelength_sampling" });
+    assert!(e.to_string().starts_with("wavelength_sampling: "), "{e}");
+    let e = light.map_spd(&|spd: &dyn SpectralPowerDistribution| spd.piecewise_constant());
+    assert_eq!(e, Err(LightError::Unsupported { field: "spd" }));
+}

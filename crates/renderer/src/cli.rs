@@ -95,30 +95,6 @@ enum Command {
         #[arg(long, default_value_t = 0, allow_negative_numbers = true, value_parser = parse_threads)]
         threads: usize,
     },
-    /// Error against time for every accuracy knob: writes docs/accuracy.md and docs/accuracy.svg.
-    Accuracy {
-        /// Scene files (default: every scenes/*.json).
-        scenes: Vec<PathBuf>,
-        /// Beams of the cached reference image.
-        #[arg(long)]
-        reference_beams: Option<u64>,
-        /// Beams of the first sweep point (doubled at each step).
-        #[arg(long)]
-        start_beams: Option<u64>,
-        /// Number of sweep points.
-        #[arg(long)]
-        steps: Option<u32>,
-        /// Largest image width (scenes are scaled down to it; 0 keeps their size).
-        #[arg(long)]
-        max_width: Option<u32>,
-        /// The configurations to sweep, comma-separated (default: all): baseline (or light),
-        /// equal_wavelengths, piecewise_constant_spd, effects_off, path, bdpt, auto.
-        #[arg(long, value_delimiter = ',', value_parser = parse_configuration)]
-        configurations: Vec<crate::accuracy::Configuration>,
-        /// Where accuracy.md and accuracy.svg go.
-        #[arg(long, default_value = "docs")]
-        out: PathBuf,
-    },
     /// Predict, from a short pilot render of each estimator, how long the scene takes to reach a
     /// target error, and recommend the fastest estimator.
     Estimate {
@@ -158,16 +134,6 @@ enum Command {
 fn parse_integrator(s: &str) -> Result<IntegratorChoice, String> {
     IntegratorChoice::from_name(s.trim())
         .ok_or_else(|| format!("`{s}`: must be auto, light, path or bdpt"))
-}
-
-/// An accuracy configuration's name.
-fn parse_configuration(s: &str) -> Result<crate::accuracy::Configuration, String> {
-    crate::accuracy::Configuration::from_name(s.trim()).ok_or_else(|| {
-        format!(
-            "`{s}`: must be baseline (or light), equal_wavelengths, piecewise_constant_spd, \
-             effects_off, path, bdpt or auto"
-        )
-    })
 }
 
 /// A whole number of at least 1 (beams).
@@ -256,7 +222,7 @@ fn bench(scenes: &[PathBuf], beams: u64, threads: usize) -> ExitCode {
         let row = crate::Scene::load(path)
             .map_err(|e| crate::RenderError::from(e).to_string())
             .and_then(|scene| {
-                let integrators = crate::accuracy::integrator_benchmark(&scene, beams, threads)?;
+                let integrators = crate::integrator_benchmark(&scene, beams, threads)?;
                 let effects =
                     crate::effects_benchmark(&scene, beams, threads).map_err(|e| e.to_string())?;
                 Ok((integrators, effects))
@@ -407,46 +373,6 @@ where
             );
         }
         Command::Bench { scenes, beams, threads } => return bench(&scenes, beams, threads),
-        Command::Accuracy {
-            scenes,
-            reference_beams,
-            start_beams,
-            steps,
-            max_width,
-            configurations,
-            out,
-        } => {
-            let mut options = crate::accuracy::AccuracyOptions::default();
-            if !scenes.is_empty() {
-                options.scenes = scenes;
-            }
-            if let Some(b) = reference_beams {
-                options.reference_beams = b;
-            }
-            if let Some(b) = start_beams {
-                options.start_beams = b;
-            }
-            if let Some(n) = steps {
-                options.steps = n;
-            }
-            if let Some(w) = max_width {
-                options.max_width = (w > 0).then_some(w);
-            }
-            if !configurations.is_empty() {
-                options.configurations = configurations;
-            }
-            options.out_dir = out;
-            return match crate::accuracy::run(&options) {
-                Ok(report) => {
-                    println!("wrote {}", report.files.join(", "));
-                    ExitCode::SUCCESS
-                }
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    ExitCode::from(2)
-                }
-            };
-        }
     };
     match result {
         Ok(report) => {

@@ -11,9 +11,12 @@
 //! same image a single machine would make, bit for bit. The key design decision: one render path
 //! for every estimator ([`with_integrator`]), so sharding, time budgets, probes and outputs work
 //! the same for all. The `spectrace` binary exposes it; the xtask's `render` subcommand calls it.
-//! Nothing but `xtask` and the tests depend on this crate.
+//! The accuracy report is not here: it is an experiment harness with its own crate,
+//! `spectrace-lab`, so programs that render do not link its plotting library; this crate keeps
+//! the timed measurement both it and `spectrace bench` use ([`render_xyz`],
+//! [`integrator_benchmark`]). Nothing but `spectrace-lab`, `xtask` and the tests depend on this
+//! crate.
 
-pub mod accuracy;
 pub mod cli;
 mod files;
 mod output;
@@ -1243,5 +1246,125 @@ pub fn effects_benchmark(
         off_seconds,
         auto_spectral_samples_per_second: auto_rate,
         off_spectral_samples_per_second: off_rate,
+    })
+}
+
+// ---------------------------------------------------------------------------------------------
+// The estimators side by side (`spectrace bench`).
+
+/// Renders `paths` paths with `integrator` (for a camera integrator, `ceil(paths / pixels)`
+/// samples per pixel) and returns the XYZ image, the wall time of the render alone and the paths
+/// traced. The measurement of [`integrator_benchmark`] and of the accuracy report
+/// (`spectrace-lab`).
+///
+/// # Errors
+/// A message for an invalid plan (zero paths, too many threads) or a failed render.
+pub fn render_xyz(
+    scene: &Scene,
+    integrator: IntegratorChoice,
+    mode: EffectsMode,
+    paths: u64,
+    seed: u64,
+    threads: usize,
+) -> Result<(Vec<spectrace_spectrum::Xyz>, f64, u64), String> {
+    let options = RenderOptions {
+        beams: Some(paths),
+        seed: Some(seed),
+        threads: Some(threads),
+        effects: Some(mode),
+        ..RenderOptions::default()
+    };
+    let (choice, _) = choose_integrator(scene, Some(integrator));
+    let mut plan = plan_with(scene, &options, choice).map_err(|e| e.to_string())?;
+    if choice == IntegratorChoice::Light {
+        // At least ~16 chunks per render, so small sweep points use every thread too; the chunk
+        // size depends on the beams alone, so a cached reference stays valid whatever the thread
+        // count. (A camera integrator's chunk is a pass of one sample per pixel.)
+        plan.chunk_beams = (paths / 16).clamp(1, plan.chunk_beams.max(1024)).min(plan.chunk_beams);
+    }
+    let effects = decide_effects(scene, Some(mode));
+    scene.lights.reset_count();
+    let started = Instant::now();
+    // The image by the estimator's own `image_scale` (its documented film units; the same as
+    // the renderer's `normalisation`).
+    let (output, scale) = with_integrator(scene, choice, effects, |tracer| {
+        render(tracer, &plan, &|_| {}).map(|out| {
+            let scale = tracer.image_scale(out.beams);
+            (out, scale)
+        })
+    })
+    .map_err(|e| e.to_string())?;
+    let seconds = started.elapsed().as_secs_f64();
+    scene.lights.reset_count();
+    Ok((output.film.to_xyz(scale), seconds, output.beams))
+}
+
+/// One estimator's measurement in [`integrator_benchmark`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IntegratorTiming {
+    /// The estimator asked for (`auto` included).
+    pub integrator: IntegratorChoice,
+    /// Paths traced (beams for the light tracer; `ceil(paths / pixels)` samples per pixel for
+    /// the camera integrators).
+    pub paths: u64,
+    /// Wall time of the render alone (s).
+    pub seconds: f64,
+}
+
+impl IntegratorTiming {
+    /// Paths per second.
+    pub fn paths_per_second(&self) -> f64 {
+        self.paths as f64 / self.seconds.max(1e-9)
+    }
+}
+
+/// One scene of `spectrace bench`: paths per second of every estimator with the same paths.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IntegratorBenchmarkRow {
+    /// The scene file.
+    pub scene: String,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// The estimator `auto` picks.
+    pub auto_picks: IntegratorChoice,
+    /// Why, in words.
+    pub auto_reason: String,
+    /// Light, path, bdpt and auto, in that order.
+    pub timings: Vec<IntegratorTiming>,
+}
+
+/// Renders `scene` with light, path, bdpt and auto, each with `paths` paths (N beams for the
+/// light tracer, `ceil(N / pixels)` samples per pixel for the camera integrators) and the same
+/// seed, and measures each (the integrator columns of `spectrace bench`).
+///
+/// # Errors
+/// A message naming the estimator for zero paths, too many threads or a failed render.
+pub fn integrator_benchmark(
+    scene: &Scene,
+    paths: u64,
+    threads: usize,
+) -> Result<IntegratorBenchmarkRow, String> {
+    let (auto_picks, auto_reason) = choose_integrator(scene, Some(IntegratorChoice::Auto));
+    let mut timings = Vec::new();
+    for integrator in [
+        IntegratorChoice::Light,
+        IntegratorChoice::Path,
+        IntegratorChoice::Bdpt,
+        IntegratorChoice::Auto,
+    ] {
+        let (_, seconds, traced) =
+            render_xyz(scene, integrator, EffectsMode::Auto, paths, 1, threads)
+                .map_err(|e| format!("{}: {}: {e}", scene.path.display(), integrator.name()))?;
+        timings.push(IntegratorTiming { integrator, paths: traced, seconds });
+    }
+    Ok(IntegratorBenchmarkRow {
+        scene: scene.path.display().to_string(),
+        width: scene.camera.width(),
+        height: scene.camera.height(),
+        auto_picks,
+        auto_reason,
+        timings,
     })
 }

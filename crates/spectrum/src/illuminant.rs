@@ -143,4 +143,8 @@ impl SpectralPowerDistribution for CieIlluminant {
     fn breakpoints(&self) -> Vec<f64> {
         self.spd.breakpoints()
     }
+    fn piecewise_constant(&self) -> Option<Box<dyn SpectralPowerDistribution>> {
+        // The D and F series are tables; A (a formula) and E (constant) have none.
+        self.spd.piecewise_constant()
+    }
 }

@@ -179,4 +179,26 @@ impl SpectralPowerDistribution for Mixture {
             .enumerate()
             .all(|(i, c)| self.choice.pmf(i) == 0.0 || c.spd.is_delta())
     }
+    fn piecewise_constant(&self) -> Option<Box<dyn SpectralPowerDistribution>> {
+        // Every tabulated component re-binned, the others kept; `None` if none is tabulated.
+        let mut any = false;
+        let components = self
+            .components
+            .iter()
+            .map(|c| Component {
+                weight: c.weight,
+                spd: match c.spd.piecewise_constant() {
+                    Some(binned) => {
+                        any = true;
+                        Arc::from(binned)
+                    }
+                    None => c.spd.clone(),
+                },
+            })
+            .collect();
+        if !any {
+            return None;
+        }
+        Mixture::new(components).ok().map(|m| Box::new(m) as _)
+    }
 }

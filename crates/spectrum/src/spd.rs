@@ -45,6 +45,15 @@ pub trait SpectralPowerDistribution: Send + Sync + Debug {
     fn is_delta(&self) -> bool {
         false
     }
+
+    /// Experiment hook (the accuracy report's "piecewise constant SPD" knob): the same table as
+    /// bins of constant value, each bin centred on one of the table's nodes with that node's
+    /// value (the seed's "choppy" generator instead of linear interpolation). `None`, the
+    /// default, when the SPD has no table to re-bin (formulas, lines, bins already), so SPD
+    /// types from other crates need not implement it.
+    fn piecewise_constant(&self) -> Option<Box<dyn SpectralPowerDistribution>> {
+        None
+    }
 }
 
 /// Nodes and weights of 4-point Gauss-Legendre quadrature on `[-1, 1]` (exact to degree 7).

@@ -113,6 +113,9 @@ impl SpectralPowerDistribution for Tabulated {
     fn breakpoints(&self) -> Vec<f64> {
         self.table.xs().to_vec()
     }
+    fn piecewise_constant(&self) -> Option<Box<dyn SpectralPowerDistribution>> {
+        Binned::centred_on_nodes(self.table.xs(), self.table.ys()).ok().map(|b| Box::new(b) as _)
+    }
 }
 
 /// A spectrum given as bins of constant value (the seed's "choppy" distribution), normalised to
@@ -145,6 +148,26 @@ impl From<Binned> for BinnedRepr {
 }
 
 impl Binned {
+    /// Bins centred on the nodes `nm` (edges half-way between neighbours, the outer bins as wide
+    /// as their inner neighbour, the first edge kept positive), bin `i` with value `values[i]`:
+    /// the piecewise-constant counterpart of a [`Tabulated`] with the same table.
+    ///
+    /// # Errors
+    /// As [`Binned::new`]; fewer than two nodes also give [`SpectrumError::Table`].
+    pub fn centred_on_nodes(nm: &[f64], values: &[f64]) -> Result<Self, SpectrumError> {
+        let n = nm.len();
+        if n < 2 || values.len() != n {
+            // Binned::new reports the real problem (too few edges, or lengths that differ).
+            return Self::new(nm, values);
+        }
+        let mut edges = Vec::with_capacity(n + 1);
+        let first = nm[0] - 0.5 * (nm[1] - nm[0]);
+        edges.push(if first > 0.0 { first } else { nm[0] });
+        edges.extend(nm.windows(2).map(|w| 0.5 * (w[0] + w[1])));
+        edges.push(nm[n - 1] + 0.5 * (nm[n - 1] - nm[n - 2]));
+        Self::new(&edges, values)
+    }
+
     /// Builds the spectrum from `n + 1` strictly increasing bin edges (nm) and `n` relative values.
     ///
     /// # Errors

@@ -641,3 +641,41 @@ fn a_gaussian_far_outside_its_range_samples_every_u_inside_it() {
         assert!((360.0..=830.0).contains(&l), "u = {u}: {l}");
     }
 }
+
+#[test]
+fn piecewise_constant_rebins_tables_and_leaves_formulas_alone() {
+    use std::sync::Arc;
+    // A table: bins centred on its nodes, the node values (up to the normalisation).
+    let table = Tabulated::new(&[400.0, 500.0, 600.0, 700.0], &[0.2, 1.0, 0.6, 0.3]).unwrap();
+    let binned = table.piecewise_constant().unwrap();
+    let expected =
+        Binned::centred_on_nodes(&[400.0, 500.0, 600.0, 700.0], &[0.2, 1.0, 0.6, 0.3]).unwrap();
+    assert_eq!(binned.range(), (350.0, 750.0));
+    for lambda in [360.0, 449.0, 451.0, 520.0, 610.0, 740.0] {
+        assert_eq!(binned.value(lambda), expected.value(lambda), "at {lambda} nm");
+    }
+    // Constant on each bin: 451 and 549 nm share the 500 nm node's value, five times 400 nm's.
+    assert_eq!(binned.value(451.0), binned.value(549.0));
+    assert!((binned.value(451.0) / binned.value(360.0) - 5.0).abs() < 1e-12);
+    // A formula has no table; a tabulated illuminant has one, A (Planck's law) does not.
+    assert!(Blackbody::new(3200.0).unwrap().piecewise_constant().is_none());
+    assert!(CieIlluminant::new("A").unwrap().piecewise_constant().is_none());
+    let d65 = CieIlluminant::new("D65").unwrap().piecewise_constant().unwrap();
+    assert_eq!(d65.range().0, 297.5);
+    // A mixture re-bins its tabulated components and keeps the rest.
+    let mixture = Mixture::new(vec![
+        Component { weight: 1.0, spd: Arc::new(table.clone()) },
+        Component { weight: 1.0, spd: Arc::new(Blackbody::new(3200.0).unwrap()) },
+    ])
+    .unwrap();
+    let rebinned = mixture.piecewise_constant().unwrap();
+    assert_ne!(rebinned.value(451.0), mixture.value(451.0));
+    let formulas = Mixture::new(vec![Component {
+        weight: 1.0,
+        spd: Arc::new(Blackbody::new(3200.0).unwrap()),
+    }])
+    .unwrap();
+    assert!(formulas.piecewise_constant().is_none());
+    // Too few nodes: the error names the field instead of panicking.
+    assert!(Binned::centred_on_nodes(&[500.0], &[1.0]).is_err());
+}

@@ -1,0 +1,1187 @@
+//! What accuracy costs in time: error-against-time sweeps of every accuracy knob, the estimator
+//! included.
+//!
+//! [`run`] renders, for each scene, a *reference* image once at high effort (the scene as written,
+//! effects analysis on, by an estimator that is unbiased on the scene: see
+//! [`reference_integrator`]; cached on disk with the settings that made it), then sweeps the
+//! number of paths (doubling from [`AccuracyOptions::start_beams`]) for each [`Configuration`]:
+//!
+//! | configuration | what changes |
+//! |---|---|
+//! | `baseline` | nothing: the light tracer on the scene as written, effects analysis `auto` |
+//! | `equal_wavelengths` | every light draws its wavelengths uniformly with weights (`"wavelength_sampling": "equal_wavelengths"`) instead of by importance |
+//! | `piecewise_constant_spd` | every `Tabulated` SPD of the lights (and every tabulated `CieIlluminant`) becomes the seed's "choppy" `Binned` SPD: bins centred on the table's nodes, the same values |
+//! | `effects_off` | the effects analysis off (one wavelength per path, beams continue after diffuse hits) |
+//! | `path`, `bdpt` | the estimator: N paths are `ceil(N / pixels)` camera samples per pixel |
+//! | `auto` | the estimator `auto` picks ([`IntegratorChoice::decide`]) |
+//! | `observer_wavelengths` | every light draws its wavelengths from SPD x observer sensitivity with weights (`"wavelength_sampling": "observer"`), light tracer |
+//! | `sobol` | Owen-scrambled Sobol points instead of independent uniforms (`settings.sampler: "sobol"`), light tracer |
+//! | `path_sobol` | the path tracer with `settings.sampler: "sobol"` (compare with `path`) |
+//!
+//! Which knobs act on which estimator ([`KNOBS_BY_ESTIMATOR`], also in the report): the sampler
+//! and the SPD sampler act on all three (a piecewise-constant SPD is another spectrum, so every
+//! estimator converges to another image); the lights' wavelength strategy acts on the light
+//! tracer and BDPT (whose light subpaths start with a light's beam), not on the path tracer,
+//! whose camera paths draw their own wavelengths (`settings.camera_wavelengths`); the effects
+//! analysis sets the light tracer's wavelengths per path and whether its beams and the path
+//! tracer's paths continue after a diffuse hit, and BDPT ignores it. The sweep applies each
+//! non-estimator knob to the light tracer, where all of them act, and the sampler also to the
+//! path tracer.
+//!
+//! Code: this module runs the sweep; `knobs` sets configurations on the typed scene, `cache`
+//! keeps the references, `report` analyses and writes the Markdown, `plot` draws the SVG.
+//!
+//! Each point records the wall time of the render alone and the relative RMSE of the XYZ image
+//! against the reference, `sqrt(sum |xyz - ref|^2 / sum |ref|^2)` over all pixels. Monte Carlo
+//! error falls as `time^(-1/2)`; the report fits the slope of log error against log time per
+//! configuration and puts it beside -1/2 (a flatter slope means bias, as with a changed spectrum
+//! or an estimator that misses some light, or fixed costs that do not scale with paths).
+//!
+//! Outputs: `accuracy.md` (a table per scene, the slopes, which configuration reaches a given
+//! error fastest, and the seconds to 10% of each estimator with auto's time over the fastest's)
+//! and `accuracy.svg` (log-log plot of error against time, one panel per scene, one line per
+//! configuration, with a dashed line of slope -1/2), both in [`AccuracyOptions::out_dir`].
+//!
+//! Every configuration is the scene file loaded as the renderer's typed [`Scene`] with its knobs
+//! set on typed fields ([`apply`]): `settings.sampler`, the effects mode and the estimator
+//! directly, a light's wavelength sampling through
+//! [`spectrace_lights::LightSource::set_wavelength_sampling`] and its SPD through [`spectrace_lights::LightSource::map_spd`] with
+//! [`SpectralPowerDistribution::piecewise_constant`] (hooks whose defaults say "not supported",
+//! so third-party lights and spectra keep compiling; such lights are left as written and counted
+//! in the report). No scene JSON is edited.
+//!
+//! To keep the default run short, [`AccuracyOptions::max_width`] scales the camera resolution down
+//! (a new camera from the same [`CameraRepr`] with a smaller `width`/`height`, keeping the aspect
+//! ratio); the field of view is unchanged, so the image shows the same view with fewer pixels.
+
+mod cache;
+mod knobs;
+mod plot;
+mod report;
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+use spectrace_lights::WavelengthSampling;
+use spectrace_renderer::{Scene, choose_integrator, decide_effects, render_xyz, tracer_scene};
+use spectrace_spectrum::{SpectralPowerDistribution, Xyz};
+use spectrace_tracer::{
+    CameraRepr, EffectsMode, IntegratorChoice, PinholeCamera, SamplerKind, SceneFeatures,
+};
+
+use cache::{cache_key, read_reference, write_reference};
+pub use knobs::apply;
+use knobs::limit_resolution;
+pub use plot::write_plot;
+pub use report::markdown;
+
+/// Settings of an accuracy run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AccuracyOptions {
+    /// The scene files.
+    pub scenes: Vec<PathBuf>,
+    /// Where `accuracy.md` and `accuracy.svg` go (default `docs`).
+    pub out_dir: PathBuf,
+    /// Where reference images are cached (default `target/accuracy-cache`).
+    pub cache_dir: PathBuf,
+    /// Paths of the reference image (default 2^24, 16 times the largest default sweep point, so
+    /// the reference's own noise adds at most ~3% to the errors of its own estimator; keep it at
+    /// least 8 times the largest sweep point). Its noise still limits how small an error can be
+    /// measured: see the "reference's noise" column of the report's summary.
+    pub reference_beams: u64,
+    /// Paths of the first sweep point (default 2^12: one sample per pixel at the default width).
+    pub start_beams: u64,
+    /// Sweep points per configuration: `start_beams * 2^k` for `k < steps` (default 8).
+    pub steps: u32,
+    /// Worker threads (0: one per core, the default).
+    pub threads: usize,
+    /// Seed of the reference; the sweep points use seeds derived from it (never equal to it).
+    pub seed: u64,
+    /// Scale the camera down to at most this many pixels wide, keeping the aspect ratio (default
+    /// `Some(96)`; `None` renders at the scene's own resolution).
+    pub max_width: Option<u32>,
+    /// The configurations to sweep, in report order (default: [`Configuration::ALL`]).
+    #[serde(default = "all_configurations")]
+    pub configurations: Vec<Configuration>,
+}
+
+fn all_configurations() -> Vec<Configuration> {
+    Configuration::ALL.to_vec()
+}
+
+impl Default for AccuracyOptions {
+    /// Settings measured to finish every shipped scene with every configuration in under 20
+    /// minutes on 2 shared cores, references included (see the run time in `docs/accuracy.md`):
+    /// the sweep stops at 2^20 paths, where the faster configurations pass 10% and a few pass 2%;
+    /// the other times to 2% are extrapolated along the fitted slopes and marked so.
+    fn default() -> Self {
+        Self {
+            scenes: default_scenes(),
+            out_dir: PathBuf::from("docs"),
+            cache_dir: PathBuf::from("target/accuracy-cache"),
+            reference_beams: 1 << 24,
+            start_beams: 1 << 12,
+            steps: 9,
+            threads: 0,
+            seed: 0x5EED_ACC0,
+            max_width: Some(96),
+            configurations: all_configurations(),
+        }
+    }
+}
+
+/// The scenes of the default report: every shipped scene, `scenes/*.json` relative to the working
+/// directory, sorted by name (none if the folder cannot be read).
+pub fn default_scenes() -> Vec<PathBuf> {
+    let Ok(entries) = std::fs::read_dir("scenes") else { return Vec::new() };
+    let mut scenes: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_file() && p.extension().is_some_and(|x| x == "json"))
+        .collect();
+    scenes.sort();
+    scenes
+}
+
+/// One accuracy knob setting the sweep renders.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Configuration {
+    /// The scene as written, effects analysis `auto`.
+    Baseline,
+    /// Every light samples wavelengths uniformly with weights.
+    EqualWavelengths,
+    /// Every tabulated SPD of the lights becomes piecewise constant (the seed's `Binned`).
+    PiecewiseConstantSpd,
+    /// The effects analysis off.
+    EffectsOff,
+    /// The scene as written, rendered by the path tracer.
+    Path,
+    /// The scene as written, rendered by bidirectional path tracing.
+    Bdpt,
+    /// The scene as written, rendered by the estimator `auto` picks.
+    Auto,
+    /// Every light draws wavelengths from SPD x observer sensitivity (light tracer).
+    ObserverWavelengths,
+    /// The Sobol sampler (light tracer).
+    Sobol,
+    /// The Sobol sampler with the path tracer.
+    PathSobol,
+}
+
+impl Configuration {
+    /// Every configuration, in report order.
+    pub const ALL: [Configuration; 10] = [
+        Configuration::Baseline,
+        Configuration::EqualWavelengths,
+        Configuration::PiecewiseConstantSpd,
+        Configuration::EffectsOff,
+        Configuration::Path,
+        Configuration::Bdpt,
+        Configuration::Auto,
+        Configuration::ObserverWavelengths,
+        Configuration::Sobol,
+        Configuration::PathSobol,
+    ];
+
+    /// The estimator knob: the light tracer (`baseline`), `path`, `bdpt` and `auto`.
+    pub const INTEGRATORS: [Configuration; 4] =
+        [Configuration::Baseline, Configuration::Path, Configuration::Bdpt, Configuration::Auto];
+
+    /// Parses a name as in reports (`baseline`, `equal_wavelengths`, ..., `path`, `bdpt`, `auto`;
+    /// `light` is accepted for `baseline`).
+    pub fn from_name(name: &str) -> Option<Self> {
+        if name == "light" {
+            return Some(Configuration::Baseline);
+        }
+        Configuration::ALL.into_iter().find(|c| c.name() == name)
+    }
+
+    /// The estimator the configuration renders with (the light-tracer knobs use the light
+    /// tracer).
+    pub fn integrator(self) -> IntegratorChoice {
+        match self {
+            Configuration::Path | Configuration::PathSobol => IntegratorChoice::Path,
+            Configuration::Bdpt => IntegratorChoice::Bdpt,
+            Configuration::Auto => IntegratorChoice::Auto,
+            _ => IntegratorChoice::Light,
+        }
+    }
+
+    /// The estimator's name in the integrator tables (`light` for `baseline`).
+    pub fn integrator_label(self) -> &'static str {
+        match self {
+            Configuration::Baseline => "light",
+            other => other.name(),
+        }
+    }
+
+    /// The name used in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Configuration::Baseline => "baseline",
+            Configuration::EqualWavelengths => "equal_wavelengths",
+            Configuration::PiecewiseConstantSpd => "piecewise_constant_spd",
+            Configuration::EffectsOff => "effects_off",
+            Configuration::Path => "path",
+            Configuration::Bdpt => "bdpt",
+            Configuration::Auto => "auto",
+            Configuration::ObserverWavelengths => "observer_wavelengths",
+            Configuration::Sobol => "sobol",
+            Configuration::PathSobol => "path_sobol",
+        }
+    }
+
+    /// What the configuration changes, in words.
+    pub fn description(self) -> &'static str {
+        match self {
+            Configuration::Baseline => {
+                "the light tracer on the scene as written: wavelengths by importance, SPDs as \
+                 given, effects analysis auto (the `light` of the integrator tables)"
+            }
+            Configuration::EqualWavelengths => {
+                "every light draws wavelengths uniformly over its SPD's range, weighted by the SPD \
+                 (lights whose SPD has delta lines keep importance sampling)"
+            }
+            Configuration::PiecewiseConstantSpd => {
+                "every Tabulated SPD of the lights (and every tabulated CieIlluminant) replaced by a \
+                 Binned SPD with bins centred on the table's nodes and the same values: the seed's \
+                 choppy generator instead of piecewise linear"
+            }
+            Configuration::EffectsOff => {
+                "effects analysis off: one wavelength per path, beams continue after diffuse hits"
+            }
+            Configuration::Path => {
+                "the path tracer (camera paths, next-event estimation, MIS) on the scene as \
+                 written; N paths are ceil(N / pixels) samples per pixel"
+            }
+            Configuration::Bdpt => {
+                "bidirectional path tracing with MIS on the scene as written; N paths are \
+                 ceil(N / pixels) samples per pixel"
+            }
+            Configuration::Auto => {
+                "the estimator `auto` picks (`IntegratorChoice::decide`), with its own seeds"
+            }
+            Configuration::ObserverWavelengths => {
+                "every light draws wavelengths in proportion to SPD x (xbar + ybar + zbar), \
+                 weighted by SPD / density (lights whose SPD has delta lines keep importance \
+                 sampling); the light tracer"
+            }
+            Configuration::Sobol => {
+                "the light tracer with Owen-scrambled Sobol points (settings.sampler \"sobol\") \
+                 instead of independent uniforms"
+            }
+            Configuration::PathSobol => {
+                "the path tracer with Owen-scrambled Sobol points (settings.sampler \"sobol\"); \
+                 N paths are ceil(N / pixels) samples per pixel"
+            }
+        }
+    }
+
+    /// The sampler the configuration sets (`settings.sampler`).
+    pub fn sampler(self) -> SamplerKind {
+        match self {
+            Configuration::Sobol | Configuration::PathSobol => SamplerKind::Sobol,
+            _ => SamplerKind::Independent,
+        }
+    }
+
+    /// The wavelength sampling the configuration gives every light (`None`: as written).
+    pub fn wavelength_sampling(self) -> Option<WavelengthSampling> {
+        match self {
+            Configuration::EqualWavelengths => Some(WavelengthSampling::EqualWavelengths),
+            Configuration::ObserverWavelengths => Some(WavelengthSampling::Observer),
+            _ => None,
+        }
+    }
+
+    /// The effects mode the configuration renders with.
+    pub fn effects_mode(self) -> EffectsMode {
+        match self {
+            Configuration::EffectsOff => EffectsMode::Off,
+            _ => EffectsMode::Auto,
+        }
+    }
+}
+
+/// One rendered sweep point.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct AccuracyPoint {
+    /// Beams traced.
+    pub beams: u64,
+    /// Seed of the render.
+    pub seed: u64,
+    /// Wall time of the render alone (s).
+    pub seconds: f64,
+    /// Relative RMSE of XYZ against the reference.
+    pub relative_rmse: f64,
+    /// Sum of Y over the image over the reference's: 1 for an unbiased estimator (up to noise);
+    /// far from 1 when light is missing or added.
+    #[serde(default)]
+    pub mean_ratio: f64,
+}
+
+/// The sweep of one configuration on one scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ConfigurationResult {
+    /// Which configuration.
+    pub configuration: Configuration,
+    /// What the rewrite changed in this scene (e.g. "2 lights"), empty for none.
+    pub changed: String,
+    /// Why the configuration does not apply to this scene (then `points` is empty).
+    pub not_applicable: Option<String>,
+    /// Why the configuration converges to another image than the reference on this scene, when
+    /// it is known from the scene's features alone (see [`known_bias`]); `None` for none known.
+    #[serde(default)]
+    pub known_bias: Option<String>,
+    /// The sweep, by increasing beams.
+    pub points: Vec<AccuracyPoint>,
+    /// Least-squares slope of log error against log time (-1/2 for plain Monte Carlo).
+    pub slope_vs_time: Option<f64>,
+    /// Least-squares slope of log error against log beams (-1/2 for plain Monte Carlo).
+    pub slope_vs_beams: Option<f64>,
+}
+
+/// The reference image of a scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ReferenceInfo {
+    /// The estimator that rendered it (see [`reference_integrator`]).
+    pub integrator: IntegratorChoice,
+    /// Paths (beams for the light tracer, camera samples for the others).
+    pub beams: u64,
+    /// Seed.
+    pub seed: u64,
+    /// Wall time of its render (s), as recorded when it was made.
+    pub seconds: f64,
+    /// Whether it was read from the cache.
+    pub cached: bool,
+    /// The cache file.
+    pub file: String,
+}
+
+/// The results of one scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SceneResult {
+    /// The scene file, as given.
+    pub scene: String,
+    /// A short name (the file stem).
+    pub name: String,
+    /// Image width used (after [`AccuracyOptions::max_width`]).
+    pub width: u32,
+    /// Image height used.
+    pub height: u32,
+    /// The baseline's effects decision.
+    pub effects_summary: String,
+    /// The estimator `auto` picks for the scene.
+    pub auto_picks: IntegratorChoice,
+    /// Why, in words.
+    pub auto_reason: String,
+    /// The reference.
+    pub reference: ReferenceInfo,
+    /// One sweep per configuration.
+    pub configurations: Vec<ConfigurationResult>,
+}
+
+/// Everything an accuracy run measured.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AccuracyReport {
+    /// Worker threads used.
+    pub threads: usize,
+    /// The options of the run.
+    pub options: AccuracyOptions,
+    /// One entry per scene.
+    pub scenes: Vec<SceneResult>,
+    /// Wall time of the whole run (s).
+    pub total_seconds: f64,
+    /// Files written.
+    pub files: Vec<String>,
+}
+
+/// Which knobs act on which estimator, as the report states it (see the module documentation).
+pub const KNOBS_BY_ESTIMATOR: &str = "the sampler (`sobol`, `path_sobol`) and the SPD sampler \
+     (`piecewise_constant_spd`, another spectrum) act on every estimator; the lights' wavelength \
+     strategy (`equal_wavelengths`, `observer_wavelengths`) acts on the light tracer and BDPT \
+     (light subpaths start with a light's beam) but not on the path tracer, whose camera paths \
+     draw their own wavelengths (`settings.camera_wavelengths`); the effects analysis \
+     (`effects_off`) sets the light tracer's wavelengths per path and whether light-tracer beams \
+     and path-tracer paths continue after a diffuse hit, and BDPT ignores it. The sweep applies \
+     each of these knobs to the light tracer, where all of them act, and the sampler also to the \
+     path tracer";
+
+/// The Monte Carlo expectation for the slope of log error against log time.
+pub const EXPECTED_SLOPE: f64 = -0.5;
+
+/// A round error target the report also names the fastest configuration for (10%: reached within
+/// the default sweep on the small scenes, so the answer is interpolated, not extrapolated).
+pub const ROUND_TARGET: f64 = 0.10;
+
+/// The finer error target: about (10/2)^2 = 25 times the effort of [`ROUND_TARGET`] for plain
+/// Monte Carlo, so usually beyond the default sweep and extrapolated (and said so).
+pub const FINE_TARGET: f64 = 0.02;
+
+/// The error targets of the summary table: [`ROUND_TARGET`] and [`FINE_TARGET`].
+pub const TARGETS: [f64; 2] = [ROUND_TARGET, FINE_TARGET];
+
+/// Times within this factor of the fastest are reported as a tie: single timings on a shared
+/// machine vary by about this much.
+pub const TIE_FACTOR: f64 = 1.15;
+
+/// `auto` counts as a good pick when its time to [`ROUND_TARGET`] is within this factor of the
+/// fastest estimator's.
+pub const AUTO_FACTOR: f64 = 1.3;
+
+/// A slope of log error against log time over the last three points flatter than this means the
+/// error levels off (bias); such a configuration's time to a target is never extrapolated.
+pub const LEVELS_OFF_SLOPE: f64 = -0.25;
+
+/// Runs the sweeps, writes `accuracy.md` and `accuracy.svg` into `options.out_dir`, and returns
+/// the measurements. Progress goes to stderr.
+///
+/// # Errors
+/// A message for invalid options, a scene that cannot be loaded or renders black, or a file
+/// that cannot be written.
+pub fn run(options: &AccuracyOptions) -> Result<AccuracyReport, String> {
+    let started = Instant::now();
+    if options.scenes.is_empty() {
+        return Err("accuracy: no scenes given (and none of the default scenes exists)".to_owned());
+    }
+    if options.configurations.is_empty() {
+        return Err("accuracy: configurations: none given (name at least one)".to_owned());
+    }
+    if options.start_beams == 0 || options.steps == 0 || options.reference_beams == 0 {
+        return Err(
+            "accuracy: reference_beams, start_beams and steps must be at least 1".to_owned()
+        );
+    }
+    let largest = options
+        .start_beams
+        .checked_mul(1u64 << (options.steps - 1).min(62))
+        .filter(|_| options.steps <= 63)
+        .ok_or("accuracy: start_beams * 2^(steps - 1) overflows")?;
+    if largest >= options.reference_beams {
+        eprintln!(
+            "accuracy: warning: the largest sweep point ({largest} beams) is not below the \
+             reference ({} beams); errors will be dominated by the reference's own noise",
+            options.reference_beams
+        );
+    }
+    let threads = if options.threads == 0 {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    } else {
+        options.threads
+    };
+    let mut scenes = Vec::new();
+    for path in &options.scenes {
+        scenes.push(run_scene(path, options, threads)?);
+    }
+    std::fs::create_dir_all(&options.out_dir)
+        .map_err(|e| format!("{}: {e}", options.out_dir.display()))?;
+    let md_path = options.out_dir.join("accuracy.md");
+    let svg_path = options.out_dir.join("accuracy.svg");
+    let mut report = AccuracyReport {
+        threads,
+        options: options.clone(),
+        scenes,
+        total_seconds: 0.0,
+        files: vec![md_path.display().to_string(), svg_path.display().to_string()],
+    };
+    write_plot(&report, &svg_path)?;
+    report.total_seconds = started.elapsed().as_secs_f64();
+    std::fs::write(&md_path, markdown(&report))
+        .map_err(|e| format!("{}: {e}", md_path.display()))?;
+    eprintln!(
+        "accuracy: wrote {} and {} in {:.1} s",
+        md_path.display(),
+        svg_path.display(),
+        report.total_seconds
+    );
+    Ok(report)
+}
+
+/// A configuration's scene, ready to render, or why it does not apply.
+struct Prepared {
+    configuration: Configuration,
+    changed: String,
+    scene: Result<Scene, String>,
+}
+
+fn run_scene(
+    path: &Path,
+    options: &AccuracyOptions,
+    threads: usize,
+) -> Result<SceneResult, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene".to_owned());
+    let baseline = load(&text, path, options.max_width).map_err(|e| format!("accuracy: {e}"))?;
+    let (width, height) = (baseline.camera.width(), baseline.camera.height());
+    let effects_summary = decide_effects(&baseline, Some(EffectsMode::Auto)).summary();
+    let (auto_picks, auto_reason) = choose_integrator(&baseline, Some(IntegratorChoice::Auto));
+    let reference_integrator = reference_integrator(&baseline);
+    let features = tracer_scene(&baseline).features(&baseline.non_convex);
+    eprintln!(
+        "accuracy: {name}: {width}x{height} pixels; {effects_summary}; auto picks {auto_reason}; \
+         reference by {}",
+        reference_integrator.name()
+    );
+
+    // Warm-up (page faults, thread start-up) so the first timed point is not penalised.
+    for integrator in [IntegratorChoice::Light, reference_integrator] {
+        let seed = options.seed ^ 0xFFFF;
+        render_xyz(&baseline, integrator, EffectsMode::Auto, options.start_beams, seed, threads)?;
+    }
+
+    let key = cache_key(
+        &text,
+        reference_integrator,
+        options.reference_beams,
+        options.seed,
+        width,
+        height,
+    );
+    let cache_file = options.cache_dir.join(format!("{name}-{key:016x}.xyz"));
+    let (reference, reference_seconds, cached) = match read_reference(&cache_file, width, height) {
+        Some((image, seconds)) => {
+            eprintln!(
+                "accuracy: {name}: reference {} beams from the cache ({})",
+                options.reference_beams,
+                cache_file.display()
+            );
+            (image, seconds, true)
+        }
+        None => {
+            eprintln!(
+                "accuracy: {name}: rendering the reference, {} paths by {}...",
+                options.reference_beams,
+                reference_integrator.name()
+            );
+            let (image, seconds, _) = render_xyz(
+                &baseline,
+                reference_integrator,
+                EffectsMode::Auto,
+                options.reference_beams,
+                options.seed,
+                threads,
+            )?;
+            eprintln!("accuracy: {name}: reference took {seconds:.1} s");
+            write_reference(&cache_file, width, height, options.reference_beams, seconds, &image)?;
+            (image, seconds, false)
+        }
+    };
+    if reference.iter().all(|p| p.x == 0.0 && p.y == 0.0 && p.z == 0.0) {
+        return Err(format!(
+            "accuracy: {}: the reference image is black; no light reaches the camera",
+            path.display()
+        ));
+    }
+
+    let mut prepared = Vec::new();
+    for &configuration in &options.configurations {
+        let (changed, scene) = match load(&text, path, options.max_width)
+            .and_then(|mut scene| apply(configuration, &mut scene).map(|changed| (changed, scene)))
+        {
+            Ok((changed, scene)) => (changed, Ok(scene)),
+            Err(reason) => (String::new(), Err(reason)),
+        };
+        if let Err(reason) = &scene {
+            eprintln!("accuracy: {name}: {} not applicable: {reason}", configuration.name());
+        }
+        prepared.push(Prepared { configuration, changed, scene });
+    }
+
+    // Beam counts in the outer loop, configurations inside: slow drifts of a shared machine's
+    // speed then spread over every configuration instead of biasing one.
+    let mut points: Vec<Vec<AccuracyPoint>> = vec![Vec::new(); prepared.len()];
+    for k in 0..options.steps {
+        let nominal = options.start_beams << k;
+        for (c, p) in prepared.iter().enumerate() {
+            let Ok(scene) = &p.scene else { continue };
+            // Seeds by the configuration's place in `ALL`, so a subset sweeps with the same seeds.
+            let index = Configuration::ALL.iter().position(|&k| k == p.configuration).unwrap_or(c);
+            let seed = sweep_seed(options.seed, index as u64, u64::from(k));
+            let integrator = p.configuration.integrator();
+            let mode = p.configuration.effects_mode();
+            let (xyz, seconds, beams) =
+                render_xyz(scene, integrator, mode, nominal, seed, threads)?;
+            let relative_rmse = relative_rmse(&xyz, &reference)?;
+            let mean_ratio = mean_ratio(&xyz, &reference);
+            eprintln!(
+                "accuracy: {name}: {:<22} {beams:>10} paths {seconds:>8.3} s  error {:.3}%  \
+                 mean Y {mean_ratio:.3}x the reference",
+                p.configuration.name(),
+                relative_rmse * 100.0
+            );
+            points[c].push(AccuracyPoint { beams, seed, seconds, relative_rmse, mean_ratio });
+        }
+    }
+    let configurations = prepared
+        .into_iter()
+        .zip(points)
+        .map(|(p, points)| {
+            let log = |f: fn(&AccuracyPoint) -> f64| -> Vec<(f64, f64)> {
+                points.iter().map(|q| (f(q).ln(), q.relative_rmse.ln())).collect()
+            };
+            ConfigurationResult {
+                configuration: p.configuration,
+                changed: p.changed,
+                not_applicable: p.scene.err(),
+                known_bias: known_bias(p.configuration, auto_picks, &features).map(str::to_owned),
+                slope_vs_time: fit_slope(&log(|q| q.seconds)),
+                slope_vs_beams: fit_slope(&log(|q| q.beams as f64)),
+                points,
+            }
+        })
+        .collect();
+    Ok(SceneResult {
+        scene: path.display().to_string(),
+        name,
+        width,
+        height,
+        effects_summary,
+        auto_picks,
+        auto_reason,
+        reference: ReferenceInfo {
+            integrator: reference_integrator,
+            beams: options.reference_beams,
+            seed: options.seed,
+            seconds: reference_seconds,
+            cached,
+            file: cache_file.display().to_string(),
+        },
+        configurations,
+    })
+}
+
+/// The scene of `text` (the file `path`) as the renderer's typed [`Scene`], its camera scaled
+/// down to at most `max_width` pixels wide.
+fn load(text: &str, path: &Path, max_width: Option<u32>) -> Result<Scene, String> {
+    let mut scene = Scene::from_json(text, path).map_err(|e| e.to_string())?;
+    if let Some(max_width) = max_width {
+        limit_resolution(&mut scene, max_width)?;
+    }
+    Ok(scene)
+}
+
+/// Why `configuration` converges to another image than the reference on a scene with
+/// `features`, when the features alone say so (`auto_picks`: what `auto` renders with): a
+/// piecewise-constant SPD is another spectrum; the light tracer shows mirrors and glass that the
+/// camera sees black (flagged wherever the scene has specular surfaces, seen or not); the path
+/// tracer misses lasers, skies, beam-only lights, spectral lines and the caustics of point and
+/// spot lights. `None` when no bias is known (the report also flags a mean brightness off by
+/// more than 2%, and errors that level off).
+pub fn known_bias(
+    configuration: Configuration,
+    auto_picks: IntegratorChoice,
+    features: &SceneFeatures,
+) -> Option<&'static str> {
+    if configuration == Configuration::PiecewiseConstantSpd {
+        return Some("another spectrum (piecewise constant)");
+    }
+    let integrator = match configuration.integrator() {
+        IntegratorChoice::Auto => auto_picks,
+        other => other,
+    };
+    match integrator {
+        IntegratorChoice::Light if features.specular => {
+            Some("the light tracer shows mirrors and glass seen by the camera black")
+        }
+        IntegratorChoice::Path
+            if features.beam_only_lights + features.delta_direction_lights > 0
+                || features.line_spectra
+                || (features.delta_position_lights > 0 && features.specular) =>
+        {
+            Some("the path tracer misses lasers, skies, spectral lines or point-light caustics")
+        }
+        _ => None,
+    }
+}
+
+/// The estimator of a scene's reference image: one that is unbiased on it. The path tracer where
+/// `auto` picks it (every light can be reached from the camera), BDPT everywhere else (the light
+/// tracer shows mirrors and glass black; the path tracer misses skies, lasers, spectral lines and
+/// the caustics of point lights).
+pub fn reference_integrator(scene: &Scene) -> IntegratorChoice {
+    match choose_integrator(scene, Some(IntegratorChoice::Auto)).0 {
+        IntegratorChoice::Path => IntegratorChoice::Path,
+        _ => IntegratorChoice::Bdpt,
+    }
+}
+
+/// Relative RMSE of an XYZ image against a reference:
+/// `sqrt(sum |xyz - ref|^2 / sum |ref|^2)` over all pixels and the three channels.
+///
+/// # Errors
+/// A message when the sizes differ or the reference is black.
+pub fn relative_rmse(image: &[Xyz], reference: &[Xyz]) -> Result<f64, String> {
+    if image.len() != reference.len() {
+        return Err(format!(
+            "image of {} pixels against a reference of {}",
+            image.len(),
+            reference.len()
+        ));
+    }
+    let (mut diff, mut norm) = (0.0, 0.0);
+    for (a, r) in image.iter().zip(reference) {
+        diff += (a.x - r.x).powi(2) + (a.y - r.y).powi(2) + (a.z - r.z).powi(2);
+        norm += r.x * r.x + r.y * r.y + r.z * r.z;
+    }
+    if !(norm > 0.0) {
+        return Err("the reference image is black".to_owned());
+    }
+    Ok((diff / norm).sqrt())
+}
+
+/// Sum of Y over `image` over the sum over `reference` (NaN for a black reference).
+fn mean_ratio(image: &[Xyz], reference: &[Xyz]) -> f64 {
+    let sum = |img: &[Xyz]| img.iter().map(|p| p.y).sum::<f64>();
+    sum(image) / sum(reference)
+}
+
+/// Least-squares slope of `y` against `x` (`None` for fewer than two distinct `x` or
+/// non-finite values).
+fn fit_slope(points: &[(f64, f64)]) -> Option<f64> {
+    if points.len() < 2 || points.iter().any(|(x, y)| !x.is_finite() || !y.is_finite()) {
+        return None;
+    }
+    let n = points.len() as f64;
+    let mx = points.iter().map(|p| p.0).sum::<f64>() / n;
+    let my = points.iter().map(|p| p.1).sum::<f64>() / n;
+    let sxx: f64 = points.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let sxy: f64 = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
+/// splitmix64's finaliser.
+fn mix(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// The seed of sweep point `k` of configuration `c`: derived from the reference seed, never
+/// equal to it.
+fn sweep_seed(seed: u64, c: u64, k: u64) -> u64 {
+    let s = mix(seed ^ mix(0x9E37_79B9_7F4A_7C15 ^ (c << 32) ^ k));
+    if s == seed { s ^ 1 } else { s }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::knobs::*;
+    use super::report::*;
+    use super::*;
+
+    const TINY: &str = r#"{
+      "camera": {"position": [0, 2, 3], "look_at": [0, 0, 0], "fov": 50, "width": 32, "height": 24},
+      "objects": [
+        {"shape": {"type": "Rectangle", "corner": [-2, 0, 2], "edge_u": [4, 0, 0], "edge_v": [0, 0, -4]},
+         "material": {"type": "Diffuse", "reflectance": 0.8}}
+      ],
+      "lights": [
+        {"type": "PointLight", "position": [0, 1.5, 0], "power": 40,
+         "spd": {"type": "Tabulated", "nm": [400, 500, 600, 700], "values": [0.2, 1.0, 0.6, 0.3]}}
+      ],
+      "settings": {"beams": 1000, "seed": 3}
+    }"#;
+
+    fn temp(name: &str) -> PathBuf {
+        std::env::temp_dir().join(format!("spectrace-accuracy-{}-{name}", std::process::id()))
+    }
+
+    #[test]
+    fn the_knobs_are_set_on_the_typed_scene() {
+        let path = Path::new("tiny.json");
+        let scene = |text: &str| load(text, path, None).unwrap();
+        let light = |s: &Scene, i: usize| serde_json::to_value(&s.lights.lights()[i]).unwrap();
+        let spd = |s: &Scene, i: usize| {
+            serde_json::to_value(s.lights.lights()[i].spd().as_ref()).unwrap()
+        };
+
+        let mut baseline = scene(TINY);
+        assert_eq!(apply(Configuration::Baseline, &mut baseline).unwrap(), "");
+        // Biases known from the scene's features: none on a diffuse floor under a point light;
+        // with a mirror, the light tracer's (black mirrors) and the path tracer's (caustics).
+        let features = tracer_scene(&baseline).features(&baseline.non_convex);
+        let bias = |c, f: &SceneFeatures| known_bias(c, IntegratorChoice::Path, f);
+        for c in Configuration::ALL {
+            let expected = c == Configuration::PiecewiseConstantSpd;
+            assert_eq!(bias(c, &features).is_some(), expected, "{c:?}");
+        }
+        let mirror = SceneFeatures { specular: true, ..features };
+        assert!(bias(Configuration::Baseline, &mirror).unwrap().contains("light tracer"));
+        assert!(bias(Configuration::Auto, &mirror).unwrap().contains("path tracer"));
+        assert_eq!(bias(Configuration::Bdpt, &mirror), None);
+        assert_eq!(light(&baseline, 0)["wavelength_sampling"], "importance");
+
+        let mut eq = scene(TINY);
+        assert_eq!(apply(Configuration::EqualWavelengths, &mut eq).unwrap(), "1 light(s)");
+        assert_eq!(light(&eq, 0)["wavelength_sampling"], "equal_wavelengths");
+        let mut ob = scene(TINY);
+        assert_eq!(apply(Configuration::ObserverWavelengths, &mut ob).unwrap(), "1 light(s)");
+        assert_eq!(light(&ob, 0)["wavelength_sampling"], "observer");
+        for c in [Configuration::Sobol, Configuration::PathSobol] {
+            let mut so = scene(TINY);
+            assert_eq!(apply(c, &mut so).unwrap(), "settings.sampler = sobol");
+            assert_eq!(so.settings.sampler, SamplerKind::Sobol);
+            assert_eq!(so.settings.seed, 3);
+        }
+        assert_eq!(Configuration::PathSobol.integrator(), IntegratorChoice::Path);
+        assert_eq!(Configuration::from_name("path_sobol"), Some(Configuration::PathSobol));
+
+        let mut pc = scene(TINY);
+        assert_eq!(apply(Configuration::PiecewiseConstantSpd, &mut pc).unwrap(), "1 light(s)");
+        let binned = spd(&pc, 0);
+        assert_eq!(binned["type"], "Binned");
+        assert_eq!(binned["edges_nm"], serde_json::json!([350.0, 450.0, 550.0, 650.0, 750.0]));
+        let values: Vec<f64> =
+            binned["values"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+        // The node values, up to the normalisation.
+        for (v, expected) in values.iter().zip([0.2, 1.0, 0.6, 0.3]) {
+            assert!((v / values[1] - expected).abs() < 1e-12, "{values:?}");
+        }
+
+        // Inside a LightSet, with a delta line skipped and a tabulated CIE illuminant re-binned.
+        let mut json: serde_json::Value = serde_json::from_str(TINY).unwrap();
+        let first = json["lights"][0].clone();
+        json["lights"] = serde_json::json!([{"type": "LightSet", "lights": [
+            first,
+            {"type": "PointLight", "position": [0, 1, 0], "power": 1,
+             "spd": {"type": "Monochromatic", "lambda_nm": 550}},
+            {"type": "PointLight", "position": [0, 1, 0], "power": 1,
+             "spd": {"type": "CieIlluminant", "name": "D65"}}
+        ]}]);
+        let set = json.to_string();
+        let mut eq = scene(&set);
+        assert_eq!(
+            apply(Configuration::EqualWavelengths, &mut eq).unwrap(),
+            "2 light(s); 1 with delta lines left on importance"
+        );
+        assert_eq!(light(&eq, 0)["wavelength_sampling"], "equal_wavelengths");
+        assert_eq!(light(&eq, 1)["wavelength_sampling"], "importance");
+        let mut pc = scene(&set);
+        assert_eq!(apply(Configuration::PiecewiseConstantSpd, &mut pc).unwrap(), "2 light(s)");
+        let d65 = spd(&pc, 2);
+        assert_eq!(d65["type"], "Binned");
+        assert_eq!(d65["values"].as_array().unwrap().len(), 97);
+        assert_eq!(d65["edges_nm"][0], 297.5);
+        assert_eq!(spd(&pc, 1)["type"], "Monochromatic");
+
+        // A glowing object's light (the tracer's ObjectLight) is retuned like the others.
+        let mut glowing: serde_json::Value = serde_json::from_str(TINY).unwrap();
+        glowing["objects"].as_array_mut().unwrap().push(serde_json::json!(
+            {"shape": {"type": "Sphere", "center": [0, 0.5, 0], "radius": 0.2},
+             "material": {"type": "Diffuse", "reflectance": 0.5},
+             "emission": {"power": 1, "spd": {"type": "Blackbody", "kelvin": 3000}}}
+        ));
+        let mut eq = scene(&glowing.to_string());
+        assert_eq!(apply(Configuration::EqualWavelengths, &mut eq).unwrap(), "2 light(s)");
+        assert_eq!(
+            lights_changed(1, 0, 1),
+            "1 light(s); 1 of a type without the hook left as written"
+        );
+
+        // Not applicable: no tabulated SPD; only delta lines.
+        let bb = TINY.replace(
+            r#"{"type": "Tabulated", "nm": [400, 500, 600, 700], "values": [0.2, 1.0, 0.6, 0.3]}"#,
+            r#"{"type": "Blackbody", "kelvin": 3200}"#,
+        );
+        assert_ne!(bb, TINY);
+        assert!(apply(Configuration::PiecewiseConstantSpd, &mut scene(&bb)).is_err());
+        let line = TINY.replace(
+            r#"{"type": "Tabulated", "nm": [400, 500, 600, 700], "values": [0.2, 1.0, 0.6, 0.3]}"#,
+            r#"{"type": "Monochromatic", "lambda_nm": 550}"#,
+        );
+        let reason = apply(Configuration::EqualWavelengths, &mut scene(&line)).unwrap_err();
+        assert!(reason.contains("delta lines"), "{reason}");
+
+        // The resolution limit keeps the aspect ratio.
+        let mut small = load(TINY, path, Some(16)).unwrap();
+        assert_eq!((small.camera.width(), small.camera.height()), (16, 12));
+        assert!(!limit_resolution(&mut small, 16).unwrap());
+    }
+
+    #[test]
+    fn error_falls_with_beams_and_the_report_is_written() {
+        let dir = temp("run");
+        let scene = dir.join("tiny.json");
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(&scene, TINY).unwrap();
+        let options = AccuracyOptions {
+            scenes: vec![scene],
+            out_dir: dir.join("docs"),
+            cache_dir: dir.join("cache"),
+            reference_beams: 1 << 14,
+            start_beams: 1 << 10,
+            steps: 3,
+            threads: 2,
+            seed: 7,
+            max_width: None,
+            configurations: Configuration::ALL.to_vec(),
+        };
+        let report = run(&options).unwrap();
+        let scene = &report.scenes[0];
+        assert!(!scene.reference.cached);
+        let baseline = &scene.configurations[0];
+        assert_eq!(baseline.configuration, Configuration::Baseline);
+        let errors: Vec<f64> = baseline.points.iter().map(|p| p.relative_rmse).collect();
+        assert_eq!(errors.len(), 3);
+        assert!(errors.windows(2).all(|w| w[1] < w[0]), "errors {errors:?}");
+        assert!(baseline.slope_vs_beams.is_some_and(|s| s < -0.2), "{baseline:?}");
+        assert!(scene.configurations.iter().all(|c| c.not_applicable.is_none()));
+        let md = std::fs::read_to_string(dir.join("docs/accuracy.md")).unwrap();
+        assert!(md.contains("| baseline | 2^10 |"));
+        assert!(md.contains("is fastest"));
+        assert!(md.contains("## Fastest to 10% and to 2%"), "{md}");
+        let row = md.lines().find(|l| l.starts_with("| tiny | 32x24 | path | ")).unwrap();
+        // The reference's noise, then the fastest configuration to 10% by name.
+        assert!(row.contains("% | `"), "{row}");
+        assert!(md.contains("To reach 2.00% (the fine target)"), "{md}");
+        let svg = std::fs::read_to_string(dir.join("docs/accuracy.svg")).unwrap();
+        assert!(svg.contains("<svg") && svg.contains("slope -1/2"));
+
+        // The second run reads the reference from the cache and measures the same errors
+        // (same seeds, exact film sums).
+        let again = run(&options).unwrap();
+        assert!(again.scenes[0].reference.cached);
+        let errors_again: Vec<f64> =
+            again.scenes[0].configurations[0].points.iter().map(|p| p.relative_rmse).collect();
+        assert_eq!(errors, errors_again);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn the_integrator_knob_sweeps_every_estimator_against_an_unbiased_reference() {
+        let dir = temp("integrators");
+        let scene = dir.join("tiny.json");
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(&scene, TINY).unwrap();
+        let options = AccuracyOptions {
+            scenes: vec![scene.clone()],
+            out_dir: dir.join("docs"),
+            cache_dir: dir.join("cache"),
+            reference_beams: 1 << 16,
+            start_beams: 1 << 10,
+            steps: 3,
+            threads: 2,
+            seed: 11,
+            max_width: None,
+            configurations: Configuration::INTEGRATORS.to_vec(),
+        };
+        let report = run(&options).unwrap();
+        let result = &report.scenes[0];
+        // A point light on a diffuse floor: every light is reachable, so auto picks the path
+        // tracer and the reference is the path tracer's.
+        assert_eq!(result.auto_picks, IntegratorChoice::Path);
+        assert_eq!(result.reference.integrator, IntegratorChoice::Path);
+        let names: Vec<_> = result.configurations.iter().map(|c| c.configuration).collect();
+        assert_eq!(names, Configuration::INTEGRATORS);
+        let pixels = 32 * 24;
+        for c in &result.configurations {
+            assert_eq!(c.points.len(), 3, "{:?}", c.configuration);
+            for (k, p) in c.points.iter().enumerate() {
+                let nominal = 1u64 << (10 + k);
+                let expected = match c.configuration {
+                    Configuration::Baseline => nominal,
+                    // ceil(nominal / pixels) samples per pixel.
+                    _ => nominal.div_ceil(pixels) * pixels,
+                };
+                assert_eq!(p.beams, expected, "{:?} point {k}", c.configuration);
+            }
+        }
+        for c in Configuration::INTEGRATORS {
+            let r = result.configurations.iter().find(|r| r.configuration == c).unwrap();
+            let errors: Vec<f64> = r.points.iter().map(|p| p.relative_rmse).collect();
+            assert!(errors.windows(2).all(|w| w[1] < w[0]), "{c:?}: errors {errors:?}");
+            // Unbiased against the reference: the same brightness, up to noise (every estimator
+            // in the same units; the light is 40 W, so a film left relative to the power shows).
+            let last = r.points.last().unwrap();
+            assert!((last.mean_ratio - 1.0).abs() < 0.1, "{c:?}: {last:?}");
+        }
+        let md = std::fs::read_to_string(dir.join("docs/accuracy.md")).unwrap();
+        assert!(md.contains("## Which estimator reaches 10.0% first"), "{md}");
+        assert!(md.contains("| tiny | 32x24 | path | path |"), "{md}");
+        assert!(md.contains("auto / fastest:"));
+
+        // The bench's measurement: the same paths for every estimator.
+        let loaded = Scene::load(&scene).unwrap();
+        let row = spectrace_renderer::integrator_benchmark(&loaded, 2000, 2).unwrap();
+        assert_eq!(row.auto_picks, IntegratorChoice::Path);
+        let asked: Vec<_> = row.timings.iter().map(|t| t.integrator).collect();
+        assert_eq!(
+            asked,
+            [
+                IntegratorChoice::Light,
+                IntegratorChoice::Path,
+                IntegratorChoice::Bdpt,
+                IntegratorChoice::Auto
+            ]
+        );
+        let paths: Vec<u64> = row.timings.iter().map(|t| t.paths).collect();
+        assert_eq!(paths, [2000, 2304, 2304, 2304]);
+        assert!(row.timings.iter().all(|t| t.paths_per_second() > 0.0));
+
+        // No configurations: an error naming the field.
+        let none = AccuracyOptions { configurations: Vec::new(), ..options };
+        assert!(run(&none).unwrap_err().contains("configurations"));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_biased_estimator_levels_off_and_is_not_extrapolated() {
+        let point = |seconds: f64, relative_rmse: f64| AccuracyPoint {
+            beams: 1,
+            seed: 0,
+            seconds,
+            relative_rmse,
+            mean_ratio: 0.5,
+        };
+        // Falls at first, then flattens at 40%: the overall slope is steep enough to
+        // extrapolate, the last three points say bias.
+        let biased = ConfigurationResult {
+            configuration: Configuration::Baseline,
+            changed: String::new(),
+            not_applicable: None,
+            known_bias: None,
+            points: vec![
+                point(1.0, 3.2),
+                point(2.0, 1.6),
+                point(4.0, 0.8),
+                point(8.0, 0.42),
+                point(16.0, 0.41),
+                point(32.0, 0.40),
+            ],
+            slope_vs_time: None,
+            slope_vs_beams: None,
+        };
+        let slope = fit_slope(
+            &biased
+                .points
+                .iter()
+                .map(|p| (p.seconds.ln(), p.relative_rmse.ln()))
+                .collect::<Vec<_>>(),
+        );
+        let biased = ConfigurationResult { slope_vs_time: slope, ..biased };
+        assert!(biased.slope_vs_time.is_some_and(|s| s < -0.3), "{biased:?}");
+        assert!(levels_off(&biased));
+        assert_eq!(time_to_reach(&biased, 0.1), Reach::NotReached);
+        assert_eq!(reach_text(Some(&biased)), "does not reach 10.0% (levels off at 40.0%)");
+        // Still falling at -1/2: not reached within the sweep, and said so (not extrapolated).
+        let falling = ConfigurationResult {
+            points: vec![point(1.0, 0.8), point(4.0, 0.4), point(16.0, 0.2)],
+            slope_vs_time: Some(-0.5),
+            ..biased.clone()
+        };
+        assert!(!levels_off(&falling));
+        assert!(matches!(time_to_reach(&falling, 0.1), Reach::Extrapolated(_)));
+        assert_eq!(
+            reach_text(Some(&falling)),
+            "does not reach 10.0% in the sweep (20.0% at the end)"
+        );
+
+        // Auto against the fastest: auto 2 s, light 1 s, path 4 s, bdpt never.
+        let fair = |seconds, relative_rmse| AccuracyPoint {
+            mean_ratio: 1.0,
+            ..point(seconds, relative_rmse)
+        };
+        let result = |configuration, seconds: f64| ConfigurationResult {
+            configuration,
+            points: vec![fair(seconds / 2.0, 0.2), fair(seconds * 2.0, 0.05)],
+            slope_vs_time: Some(-0.5),
+            ..biased.clone()
+        };
+        let mut scene = SceneResult {
+            scene: "s.json".to_owned(),
+            name: "s".to_owned(),
+            width: 1,
+            height: 1,
+            effects_summary: String::new(),
+            auto_picks: IntegratorChoice::Path,
+            auto_reason: String::new(),
+            reference: ReferenceInfo {
+                integrator: IntegratorChoice::Bdpt,
+                beams: 1,
+                seed: 0,
+                seconds: 0.0,
+                cached: false,
+                file: String::new(),
+            },
+            configurations: vec![
+                result(Configuration::Baseline, 1.0),
+                result(Configuration::Path, 4.0),
+                ConfigurationResult { configuration: Configuration::Bdpt, ..biased.clone() },
+                result(Configuration::Auto, 2.0),
+            ],
+        };
+        let (ratio, text) = auto_ratio(&scene);
+        assert!(ratio.is_some_and(|r| (r - 2.0).abs() < 1e-9), "{ratio:?}");
+        assert_eq!(text, "2.00 (fastest: light)");
+        // The summary: measured at 10%, extrapolated at 2% (and said so).
+        assert!(matches!(
+            fastest_to(&scene, ROUND_TARGET, true),
+            Some((Configuration::Baseline, Reach::Interpolated(t))) if (t - 1.0).abs() < 1e-9
+        ));
+        let text = fastest_text(&scene, ROUND_TARGET);
+        assert!(text.starts_with("`baseline` 1.0") && !text.contains("biased"), "{text}");
+        assert_eq!(auto_vs_fastest_text(&scene, ROUND_TARGET), "2.00");
+        let text = fastest_text(&scene, FINE_TARGET);
+        assert!(text.starts_with("`baseline` ~12.5 s (extrapolated)"), "{text}");
+        assert_eq!(auto_vs_fastest_text(&scene, FINE_TARGET), "2.00 (extrapolated)");
+        // A light tracer known to be biased on the scene is named, but is not "the fastest":
+        // auto is (the half-bright bdpt never reaches 10%).
+        scene.configurations[0].known_bias = Some("black mirrors".to_owned());
+        assert!(matches!(
+            fastest_to(&scene, ROUND_TARGET, true),
+            Some((Configuration::Auto, Reach::Interpolated(_)))
+        ));
+        let text = fastest_text(&scene, ROUND_TARGET);
+        assert!(text.starts_with("`auto` 2.0"), "{text}");
+        assert!(text.contains("; sooner but biased: `baseline` 1.0"), "{text}");
+        assert!(text.ends_with(" s (black mirrors)"), "{text}");
+        assert_eq!(auto_vs_fastest_text(&scene, ROUND_TARGET), "1.00 (auto is the fastest)");
+        // A brightness 2x off is a bias the report sees without knowing why.
+        assert!(!converges(&scene, &scene.configurations[2]));
+        assert!(converges(&scene, &scene.configurations[1]));
+        scene.configurations[3] =
+            ConfigurationResult { configuration: Configuration::Auto, ..biased.clone() };
+        assert_eq!(auto_ratio(&scene).0, Some(f64::INFINITY));
+    }
+
+    #[test]
+    fn slopes_and_reach() {
+        let pts: Vec<(f64, f64)> = (0..5).map(|k| (k as f64, 3.0 - 0.5 * k as f64)).collect();
+        assert!((fit_slope(&pts).unwrap() + 0.5).abs() < 1e-12);
+        let result = ConfigurationResult {
+            configuration: Configuration::Baseline,
+            changed: String::new(),
+            not_applicable: None,
+            known_bias: None,
+            points: vec![
+                AccuracyPoint {
+                    beams: 1,
+                    seed: 0,
+                    seconds: 1.0,
+                    relative_rmse: 0.2,
+                    mean_ratio: 1.0,
+                },
+                AccuracyPoint {
+                    beams: 4,
+                    seed: 0,
+                    seconds: 4.0,
+                    relative_rmse: 0.1,
+                    mean_ratio: 1.0,
+                },
+            ],
+            slope_vs_time: Some(-0.5),
+            slope_vs_beams: Some(-0.5),
+        };
+        let Reach::Interpolated(t) = time_to_reach(&result, 0.1 * 2f64.sqrt()) else { panic!() };
+        assert!((t - 2.0).abs() < 1e-9);
+        let Reach::Extrapolated(t) = time_to_reach(&result, 0.05) else { panic!() };
+        assert!((t - 16.0).abs() < 1e-9);
+        assert!(matches!(time_to_reach(&result, 0.3), Reach::AtMost(_)));
+        assert_ne!(sweep_seed(5, 0, 0), 5);
+    }
+}
