@@ -55,6 +55,7 @@
 //! ratio); the field of view is unchanged, so the image shows the same view with fewer pixels.
 
 mod cache;
+mod check;
 mod knobs;
 mod plot;
 mod report;
@@ -71,6 +72,7 @@ use spectrace_tracer::{
 };
 
 use cache::{cache_key, read_reference, write_reference};
+pub use check::{ESTIMATE_CAP_SECONDS, ESTIMATE_TARGET, EstimateCheck, estimate_check};
 pub use knobs::apply;
 use knobs::limit_resolution;
 pub use plot::write_plot;
@@ -104,6 +106,10 @@ pub struct AccuracyOptions {
     /// The configurations to sweep, in report order (default: [`Configuration::ALL`]).
     #[serde(default = "all_configurations")]
     pub configurations: Vec<Configuration>,
+    /// Check the renderer's own error estimate and the pilot's prediction on every scene
+    /// ([`estimate_check`]; default on).
+    #[serde(default)]
+    pub estimate_check: bool,
 }
 
 fn all_configurations() -> Vec<Configuration> {
@@ -127,6 +133,7 @@ impl Default for AccuracyOptions {
             seed: 0x5EED_ACC0,
             max_width: Some(96),
             configurations: all_configurations(),
+            estimate_check: true,
         }
     }
 }
@@ -380,6 +387,9 @@ pub struct SceneResult {
     pub reference: ReferenceInfo,
     /// One sweep per configuration.
     pub configurations: Vec<ConfigurationResult>,
+    /// The renderer's error estimate and the pilot's prediction against the truth.
+    #[serde(default)]
+    pub estimate_check: Option<EstimateCheck>,
 }
 
 /// Everything an accuracy run measured.
@@ -635,6 +645,22 @@ fn run_scene(
             }
         })
         .collect();
+    let estimate_check = if options.estimate_check {
+        let check = estimate_check(&baseline, auto_picks, &reference, threads, options.seed)?;
+        eprintln!(
+            "accuracy: {name}: estimate check: {} to {}% in {:.2} s (predicted {:?} s), estimated \
+             error {:?}, true error {:.4}",
+            auto_picks.name(),
+            ESTIMATE_TARGET * 100.0,
+            check.measured_seconds,
+            check.prediction().and_then(|p| p.predicted_seconds),
+            check.estimated_error,
+            check.true_error
+        );
+        Some(check)
+    } else {
+        None
+    };
     Ok(SceneResult {
         scene: path.display().to_string(),
         name,
@@ -652,6 +678,7 @@ fn run_scene(
             file: cache_file.display().to_string(),
         },
         configurations,
+        estimate_check,
     })
 }
 
@@ -920,6 +947,7 @@ mod tests {
             seed: 7,
             max_width: None,
             configurations: Configuration::ALL.to_vec(),
+            estimate_check: true,
         };
         let report = run(&options).unwrap();
         let scene = &report.scenes[0];
@@ -939,6 +967,15 @@ mod tests {
         // The reference's noise, then the fastest configuration to 10% by name.
         assert!(row.contains("% | `"), "{row}");
         assert!(md.contains("To reach 2.00% (the fine target)"), "{md}");
+        // The estimate check: the render's own estimate against the reference, and the pilot.
+        let check = scene.estimate_check.as_ref().unwrap();
+        assert_eq!(check.predictions.len(), 3);
+        let (e, t) = (check.estimated_error.unwrap(), check.true_error);
+        // The reference (2^14 paths) carries noise of its own, so only a loose bound here; the
+        // shipped scenes' figures are in docs/accuracy.md.
+        assert!(e > 0.0 && (e / t) > 0.5 && (e / t) < 1.5, "estimate {e}, truth {t}");
+        assert!(md.contains("## Does the renderer know its own error?"), "{md}");
+        assert!(md.contains("### Estimate against truth"), "{md}");
         let svg = std::fs::read_to_string(dir.join("docs/accuracy.svg")).unwrap();
         assert!(svg.contains("<svg") && svg.contains("slope -1/2"));
 
@@ -969,6 +1006,7 @@ mod tests {
             seed: 11,
             max_width: None,
             configurations: Configuration::INTEGRATORS.to_vec(),
+            estimate_check: false,
         };
         let report = run(&options).unwrap();
         let result = &report.scenes[0];
@@ -1108,6 +1146,7 @@ mod tests {
                 cached: false,
                 file: String::new(),
             },
+            estimate_check: None,
             configurations: vec![
                 result(Configuration::Baseline, 1.0),
                 result(Configuration::Path, 4.0),

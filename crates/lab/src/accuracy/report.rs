@@ -209,6 +209,7 @@ pub fn markdown(report: &AccuracyReport) -> String {
     }
     let _ = writeln!(md, "\nWhich knobs act on which estimator: {KNOBS_BY_ESTIMATOR}.");
     summary_markdown(&mut md, report);
+    estimate_summary_markdown(&mut md, report);
     if o.configurations.iter().any(|c| c.integrator() != IntegratorChoice::Light) {
         integrators_markdown(&mut md, report);
     }
@@ -374,11 +375,113 @@ pub(super) fn summary_markdown(md: &mut String, report: &AccuracyReport) {
     let _ = writeln!(md);
 }
 
-/// The place for "estimate vs truth" rows: the renderer's own live error estimate of a render
-/// against the error measured here against the reference. A later change fills it in (the
-/// estimate is being added to the renderer separately); until then it writes nothing.
+/// The true error of a check's render with the reference's own noise taken out (they add in
+/// quadrature): `sqrt(true^2 - noise^2)`, `None` when the noise is as large as the error.
+pub(super) fn corrected_truth(scene: &SceneResult, check: &EstimateCheck) -> Option<f64> {
+    let noise = reference_noise(scene).map_or(0.0, |(_, n)| n);
+    let d = check.true_error.powi(2) - noise * noise;
+    (d > 0.0).then(|| d.sqrt())
+}
+
+/// One scene's estimate check: the pilot's predictions per estimator, and the render to the
+/// target against the truth.
 pub(super) fn estimate_vs_truth_markdown(md: &mut String, scene: &SceneResult) {
-    let _ = (md, scene);
+    let Some(check) = &scene.estimate_check else { return };
+    let _ = writeln!(
+        md,
+        "\n### Estimate against truth\n\n\
+         `spectrace estimate` (a pilot per estimator) predicts the time to {:.0}%; then a render \
+         with `--target-error {}` by `{}` (auto's pick, capped at {ESTIMATE_CAP_SECONDS:.0} s) \
+         ends with its own error estimate, compared with its error against the reference.\n",
+        check.target * 100.0,
+        check.target,
+        check.integrator.name()
+    );
+    let _ = writeln!(
+        md,
+        "| estimator | pilot | pilot error | slope vs time (measured) | predicted time to {:.0}% | \
+         ± (1 sigma) | misses |\n|---|---|---|---|---|---|---|",
+        check.target * 100.0
+    );
+    for p in &check.predictions {
+        let _ = writeln!(
+            md,
+            "| {} | {} items, {} s | {} | {} | {} | {:.0}% | {} |",
+            p.integrator,
+            p.pilot_items,
+            sig(p.pilot_seconds),
+            p.pilot_error.map_or("-".to_owned(), percent),
+            p.measured_slope.map_or("-".to_owned(), |(s, se)| format!("{s:.2} ± {se:.2}")),
+            p.predicted_seconds.map_or("-".to_owned(), |t| format!("{} s", sig(t))),
+            p.relative_uncertainty * 100.0,
+            if p.misses.is_empty() { "nothing".to_owned() } else { p.misses.join("; ") }
+        );
+    }
+    let truth = corrected_truth(scene, check);
+    let _ = writeln!(
+        md,
+        "\nThe pilot recommends `{}`; auto picks `{}`. The render: {} batches in {} s ({}), \
+         estimated error {}, error against the reference {} ({} with the reference's own noise \
+         taken out): estimate / truth = {}.",
+        check.recommended.as_deref().unwrap_or("-"),
+        check.integrator.name(),
+        check.batches,
+        sig(check.measured_seconds),
+        if check.reached { "target reached" } else { "stopped by the time cap" },
+        check.estimated_error.map_or("-".to_owned(), percent),
+        percent(check.true_error),
+        truth.map_or("below the reference's noise".to_owned(), percent),
+        match (check.estimated_error, truth) {
+            (Some(e), Some(t)) => format!("{:.2}", e / t),
+            _ => "-".to_owned(),
+        }
+    );
+}
+
+/// The estimate check of every scene in one table.
+pub(super) fn estimate_summary_markdown(md: &mut String, report: &AccuracyReport) {
+    let checked: Vec<(&SceneResult, &EstimateCheck)> =
+        report.scenes.iter().filter_map(|s| s.estimate_check.as_ref().map(|c| (s, c))).collect();
+    if checked.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        md,
+        "\n## Does the renderer know its own error?\n\n\
+         Per scene, a render with `--target-error {target}` by the estimator auto picks (capped at \
+         {ESTIMATE_CAP_SECONDS:.0} s): its own final error estimate (from the spread between its \
+         chunks) against its true error (against the reference, with the reference's own noise \
+         taken out in quadrature), and its time against the time `spectrace estimate` predicted \
+         from a pilot before it. The issue asks for estimate / truth within 20% and measured / \
+         predicted time within 35%. Last column: the pilot's recommendation beside auto's pick.\n\n\
+         | scene | estimator | estimated error | true error | estimate / truth | predicted time | \
+         measured time | measured / predicted | pilot recommends |\n|---|---|---|---|---|---|---|---|---|",
+        target = ESTIMATE_TARGET
+    );
+    for (scene, check) in checked {
+        let truth = corrected_truth(scene, check);
+        let predicted = check.prediction().and_then(|p| p.predicted_seconds);
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {} | {} | {} s{} | {} | {} |",
+            scene.name,
+            check.integrator.name(),
+            check.estimated_error.map_or("-".to_owned(), percent),
+            truth.map_or("below the reference's noise".to_owned(), percent),
+            match (check.estimated_error, truth) {
+                (Some(e), Some(t)) => format!("{:.2}", e / t),
+                _ => "-".to_owned(),
+            },
+            predicted.map_or("-".to_owned(), |t| format!("{} s", sig(t))),
+            sig(check.measured_seconds),
+            if check.reached { "" } else { " (cap; target not reached)" },
+            match predicted {
+                Some(p) if check.reached => format!("{:.2}", check.measured_seconds / p),
+                _ => "-".to_owned(),
+            },
+            check.recommended.as_deref().unwrap_or("-")
+        );
+    }
 }
 
 /// The estimator summary: time to [`ROUND_TARGET`] per scene and estimator, and auto's ratio.
