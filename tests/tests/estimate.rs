@@ -238,3 +238,66 @@ fn bad_targets_are_refused_naming_the_field() {
         assert_eq!(code, std::process::ExitCode::from(2), "{bad}");
     }
 }
+
+/// `--time` caps a render to a target it cannot reach in time: the sidecar says the target was
+/// not reached, with the estimate it got to.
+#[test]
+fn a_time_cap_stops_a_render_to_an_unreachable_target() {
+    let s = small("fading_spot.json", 48, 32);
+    let out = temp_dir("cap");
+    let report = render_scene(
+        &s,
+        &RenderOptions {
+            target_error: Some(1e-5),
+            time: Some(0.5),
+            threads: Some(2),
+            integrator: Some(IntegratorChoice::Path),
+            out_dir: out,
+            ..RenderOptions::default()
+        },
+    )
+    .unwrap();
+    let e = report.error_estimate.unwrap();
+    assert_eq!(e.target_reached, Some(false));
+    assert!(e.relative_rmse.unwrap() > 1e-5);
+    // The sidecar predicts what 1% would take from here.
+    assert!(e.predicted_seconds.iter().any(|[t, s]| *t == 0.01 && *s > 0.0), "{e:?}");
+}
+
+/// `spectrace estimate` on the command line: a Markdown table on stdout and, with `--json`, the
+/// report as JSON; the JSON file may not replace the scene.
+#[test]
+fn the_estimate_command_writes_its_report() {
+    let dir = temp_dir("cli");
+    let scene = dir.join("scene.json");
+    let mut v: Value = serde_json::from_str(crate::rendering::POINT_OVER_PLANE).unwrap();
+    v["camera"]["width"] = Value::from(32);
+    v["camera"]["height"] = Value::from(24);
+    std::fs::write(&scene, v.to_string()).unwrap();
+    let json = dir.join("estimate.json");
+    let run = |out: &Path| {
+        spectrace_renderer::cli::main_with_args([
+            "spectrace".as_ref(),
+            "estimate".as_ref(),
+            scene.as_os_str(),
+            "--target-error".as_ref(),
+            "0.05".as_ref(),
+            "--pilot-seconds".as_ref(),
+            "0.1".as_ref(),
+            "--integrators".as_ref(),
+            "light,path".as_ref(),
+            "--json".as_ref(),
+            out.as_os_str(),
+        ])
+    };
+    assert_eq!(run(&json), std::process::ExitCode::SUCCESS);
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let predictions = report["predictions"].as_array().unwrap();
+    assert_eq!(predictions.len(), 2);
+    assert!(predictions.iter().all(|p| p["predicted_seconds"].as_f64().unwrap() > 0.0));
+    assert!(report["recommended"].is_string());
+    // The JSON may not replace the scene file.
+    let before = std::fs::read(&scene).unwrap();
+    assert_eq!(run(&scene), std::process::ExitCode::from(2));
+    assert_eq!(std::fs::read(&scene).unwrap(), before);
+}
