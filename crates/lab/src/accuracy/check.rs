@@ -4,7 +4,7 @@
 //! whose time is compared with the prediction.
 
 use serde::{Deserialize, Serialize};
-use spectrace_renderer::pilot::{EstimateOptions, Prediction, estimate};
+use spectrace_renderer::pilot::{EstimateOptions, EstimateReport, Prediction, estimate};
 use spectrace_renderer::{RenderOptions, Scene, render_in_memory};
 use spectrace_spectrum::Xyz;
 use spectrace_tracer::IntegratorChoice;
@@ -24,10 +24,8 @@ pub struct EstimateCheck {
     pub integrator: IntegratorChoice,
     /// The target.
     pub target: f64,
-    /// The pilot's predictions for light, path and bdpt.
-    pub predictions: Vec<Prediction>,
-    /// The estimator the pilot recommends.
-    pub recommended: Option<String>,
+    /// The pilot's predictions for light, path and bdpt, and its recommendation.
+    pub pilot: EstimateReport,
     /// Wall time of the render to the target (s).
     pub measured_seconds: f64,
     /// Whether the render reached the target before [`ESTIMATE_CAP_SECONDS`].
@@ -43,7 +41,7 @@ pub struct EstimateCheck {
 impl EstimateCheck {
     /// The pilot's prediction for the estimator of the render.
     pub fn prediction(&self) -> Option<&Prediction> {
-        self.predictions.iter().find(|p| p.integrator == self.integrator.name())
+        self.pilot.predictions.iter().find(|p| p.integrator == self.integrator.name())
     }
 }
 
@@ -85,8 +83,7 @@ pub fn estimate_check(
     Ok(EstimateCheck {
         integrator: auto,
         target: ESTIMATE_TARGET,
-        predictions: pilot.predictions,
-        recommended: pilot.recommended,
+        pilot,
         measured_seconds: render.output.seconds,
         reached: estimate.is_some_and(|e| e.is_trusted())
             && estimated_error.is_some_and(|e| e <= ESTIMATE_TARGET),

@@ -969,7 +969,7 @@ mod tests {
         assert!(md.contains("To reach 2.00% (the fine target)"), "{md}");
         // The estimate check: the render's own estimate against the reference, and the pilot.
         let check = scene.estimate_check.as_ref().unwrap();
-        assert_eq!(check.predictions.len(), 3);
+        assert_eq!(check.pilot.predictions.len(), 3);
         let (e, t) = (check.estimated_error.unwrap(), check.true_error);
         // The reference (2^14 paths) carries noise of its own, so only a loose bound here; the
         // shipped scenes' figures are in docs/accuracy.md.

@@ -397,34 +397,13 @@ pub(super) fn estimate_vs_truth_markdown(md: &mut String, scene: &SceneResult) {
         check.target,
         check.integrator.name()
     );
-    let _ = writeln!(
-        md,
-        "| estimator | pilot | pilot error | slope vs time (measured) | predicted time to {:.0}% | \
-         ± (1 sigma) | misses |\n|---|---|---|---|---|---|---|",
-        check.target * 100.0
-    );
-    for p in &check.predictions {
-        let _ = writeln!(
-            md,
-            "| {} | {} items, {} s | {} | {} | {} | {:.0}% | {} |",
-            p.integrator,
-            p.pilot_items,
-            sig(p.pilot_seconds),
-            p.pilot_error.map_or("-".to_owned(), percent),
-            p.measured_slope.map_or("-".to_owned(), |(s, se)| format!("{s:.2} ± {se:.2}")),
-            p.predicted_seconds.map_or("-".to_owned(), |t| format!("{} s", sig(t))),
-            p.relative_uncertainty * 100.0,
-            if p.misses.is_empty() { "nothing".to_owned() } else { p.misses.join("; ") }
-        );
-    }
+    let _ = writeln!(md, "{}", spectrace_renderer::pilot::markdown(&check.pilot));
     let truth = corrected_truth(scene, check);
     let _ = writeln!(
         md,
-        "\nThe pilot recommends `{}`; auto picks `{}`. The render: {} batches in {} s ({}), \
+        "The render: {} batches in {} s ({}), \
          estimated error {}, error against the reference {} ({} with the reference's own noise \
          taken out): estimate / truth = {}.",
-        check.recommended.as_deref().unwrap_or("-"),
-        check.integrator.name(),
         check.batches,
         sig(check.measured_seconds),
         if check.reached { "target reached" } else { "stopped by the time cap" },
@@ -479,7 +458,7 @@ pub(super) fn estimate_summary_markdown(md: &mut String, report: &AccuracyReport
                 Some(p) if check.reached => format!("{:.2}", check.measured_seconds / p),
                 _ => "-".to_owned(),
             },
-            check.recommended.as_deref().unwrap_or("-")
+            check.pilot.recommended.as_deref().unwrap_or("-")
         );
     }
 }
