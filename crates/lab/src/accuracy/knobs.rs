@@ -2,6 +2,7 @@
 //! SPDs, the sampler.
 
 use super::*;
+use spectrace_tracer::CameraWavelengths;
 
 /// Scales the camera down so the image is at most `max_width` pixels wide, keeping the aspect
 /// ratio (a new camera from the same [`CameraRepr`]). Returns whether it changed anything.
@@ -89,6 +90,13 @@ pub(super) fn set_piecewise_constant(scene: &mut Scene) -> Result<(usize, usize)
 /// # Errors
 /// Why the configuration does not apply (e.g. no light with a tabulated SPD).
 pub fn apply(configuration: Configuration, scene: &mut Scene) -> Result<String, String> {
+    if configuration == Configuration::PathUniformWavelengths {
+        if scene.settings.camera_wavelengths == CameraWavelengths::Uniform {
+            return Err("the scene already draws camera wavelengths uniformly".to_owned());
+        }
+        scene.settings.camera_wavelengths = CameraWavelengths::Uniform;
+        return Ok("settings.camera_wavelengths = uniform".to_owned());
+    }
     if configuration.sampler() == SamplerKind::Sobol {
         scene.settings.sampler = SamplerKind::Sobol;
         return Ok("settings.sampler = sobol".to_owned());

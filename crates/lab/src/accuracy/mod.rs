@@ -174,11 +174,14 @@ pub enum Configuration {
     Sobol,
     /// The Sobol sampler with the path tracer.
     PathSobol,
+    /// The path tracer with camera wavelengths uniform over 360-830 nm instead of the visible
+    /// density: the camera side's wavelength strategy.
+    PathUniformWavelengths,
 }
 
 impl Configuration {
     /// Every configuration, in report order.
-    pub const ALL: [Configuration; 10] = [
+    pub const ALL: [Configuration; 11] = [
         Configuration::Baseline,
         Configuration::EqualWavelengths,
         Configuration::PiecewiseConstantSpd,
@@ -189,6 +192,7 @@ impl Configuration {
         Configuration::ObserverWavelengths,
         Configuration::Sobol,
         Configuration::PathSobol,
+        Configuration::PathUniformWavelengths,
     ];
 
     /// The estimator knob: the light tracer (`baseline`), `path`, `bdpt` and `auto`.
@@ -208,7 +212,9 @@ impl Configuration {
     /// tracer).
     pub fn integrator(self) -> IntegratorChoice {
         match self {
-            Configuration::Path | Configuration::PathSobol => IntegratorChoice::Path,
+            Configuration::Path
+            | Configuration::PathSobol
+            | Configuration::PathUniformWavelengths => IntegratorChoice::Path,
             Configuration::Bdpt => IntegratorChoice::Bdpt,
             Configuration::Auto => IntegratorChoice::Auto,
             _ => IntegratorChoice::Light,
@@ -236,6 +242,7 @@ impl Configuration {
             Configuration::ObserverWavelengths => "observer_wavelengths",
             Configuration::Sobol => "sobol",
             Configuration::PathSobol => "path_sobol",
+            Configuration::PathUniformWavelengths => "path_uniform_wavelengths",
         }
     }
 
@@ -281,6 +288,11 @@ impl Configuration {
             Configuration::PathSobol => {
                 "the path tracer with Owen-scrambled Sobol points (settings.sampler \"sobol\"); \
                  N paths are ceil(N / pixels) samples per pixel"
+            }
+            Configuration::PathUniformWavelengths => {
+                "the path tracer with camera wavelengths uniform over 360-830 nm \
+                 (settings.camera_wavelengths \"uniform\") instead of the visible density: the \
+                 camera side's wavelength strategy"
             }
         }
     }
@@ -412,7 +424,8 @@ pub const KNOBS_BY_ESTIMATOR: &str = "the sampler (`sobol`, `path_sobol`) and th
      (`piecewise_constant_spd`, another spectrum) act on every estimator; the lights' wavelength \
      strategy (`equal_wavelengths`, `observer_wavelengths`) acts on the light tracer and BDPT \
      (light subpaths start with a light's beam) but not on the path tracer, whose camera paths \
-     draw their own wavelengths (`settings.camera_wavelengths`); the effects analysis \
+     draw their own wavelengths (`settings.camera_wavelengths`, swept as \
+     `path_uniform_wavelengths` against the visible density of `path`); the effects analysis \
      (`effects_off`) sets the light tracer's wavelengths per path and whether light-tracer beams \
      and path-tracer paths continue after a diffuse hit, and BDPT ignores it. The sweep applies \
      each of these knobs to the light tracer, where all of them act, and the sampler also to the \
@@ -857,6 +870,12 @@ mod tests {
         }
         assert_eq!(Configuration::PathSobol.integrator(), IntegratorChoice::Path);
         assert_eq!(Configuration::from_name("path_sobol"), Some(Configuration::PathSobol));
+        let mut uw = scene(TINY);
+        let c = Configuration::PathUniformWavelengths;
+        assert_eq!(apply(c, &mut uw).unwrap(), "settings.camera_wavelengths = uniform");
+        assert_eq!(uw.settings.camera_wavelengths, spectrace_tracer::CameraWavelengths::Uniform);
+        assert_eq!(c.integrator(), IntegratorChoice::Path);
+        assert!(apply(c, &mut uw).is_err(), "already uniform: nothing to compare");
 
         let mut pc = scene(TINY);
         assert_eq!(apply(Configuration::PiecewiseConstantSpd, &mut pc).unwrap(), "1 light(s)");
