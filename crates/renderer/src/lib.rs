@@ -179,6 +179,10 @@ pub struct AccuracyEstimate {
     /// More render time (s) that would halve the error (three times this render's: four
     /// times the work).
     pub seconds_to_halve: f64,
+    /// With a target the render did not reach (a time cap): the predicted total render time
+    /// (s) to reach it; `null` otherwise.
+    #[serde(default)]
+    pub seconds_to_target: Option<f64>,
 }
 
 impl AccuracyEstimate {
@@ -206,6 +210,10 @@ impl AccuracyEstimate {
             target_reached: target.map(|t| e.is_some_and(|e| e <= t) && estimate.is_trusted()),
             predicted_seconds,
             seconds_to_halve: 3.0 * seconds,
+            seconds_to_target: match (e, target) {
+                (Some(e), Some(t)) if e > t && t > 0.0 => Some(seconds * (e / t).powi(2)),
+                _ => None,
+            },
         }
     }
 
