@@ -431,7 +431,7 @@ pub(super) fn estimate_summary_markdown(md: &mut String, report: &AccuracyReport
          {ESTIMATE_CAP_SECONDS:.0} s): its own final error estimate (from the spread between its \
          chunks) against its true error (against the reference, with the reference's own noise \
          taken out in quadrature), and its time against the time `spectrace estimate` predicted \
-         from a pilot before it. The issue asks for estimate / truth within 20% and measured / \
+         from a pilot before it. The goals: estimate / truth within 20% and measured / \
          predicted time within 35%. Last column: the pilot's recommendation beside auto's pick.\n\n\
          | scene | estimator | estimated error | true error | estimate / truth | predicted time | \
          measured time | measured / predicted | pilot recommends |\n|---|---|---|---|---|---|---|---|---|",
