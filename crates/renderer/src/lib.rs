@@ -8,9 +8,12 @@
 //! chooses the integrator ([`choose_integrator`]), checks that light can reach the camera, renders
 //! on threads with a progress bar and writes the outputs normalised per estimator
 //! ([`Normalisation`]), and [`merge_parts`] turns the partial films of a sharded render into the
-//! same image a single machine would make, bit for bit. The key design decision: one render path
-//! for every estimator ([`with_integrator`]), so sharding, time budgets, probes and outputs work
-//! the same for all. The `spectrace` binary exposes it; the xtask's `render` subcommand calls it.
+//! same image a single machine would make, bit for bit. Every render also says how accurate it
+//! is ([`AccuracyEstimate`] in the sidecar, from the tracer's per-chunk moments), can render to a
+//! target error (`--target-error`), and [`pilot::estimate`] predicts the time to a target per
+//! estimator before rendering. The key design decision: one render path for every estimator
+//! ([`with_integrator`]), so sharding, time budgets, targets, probes and outputs work the same for
+//! all. The `spectrace` binary exposes it; the xtask's `render` subcommand calls it.
 //! The accuracy report is not here: it is an experiment harness with its own crate,
 //! `spectrace-lab`, so programs that render do not link its plotting library; this crate keeps
 //! the timed measurement both it and `spectrace bench` use ([`render_xyz`],

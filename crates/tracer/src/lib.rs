@@ -19,7 +19,8 @@
 //! pixel by pixel; and an [`Effects`] analysis decides, before rendering, what the scene needs
 //! (which estimator, a bundle of wavelengths per path when nothing is dispersive, beams that stop
 //! at the first diffuse hit when no interreflection is possible), reports it, and can be
-//! overridden.
+//! overridden. Because chunks are independent, the render loop also estimates the image's error
+//! as it goes, from the spread between chunks ([`Moments`]), with no reference.
 
 mod bdpt;
 mod camera;
