@@ -3,7 +3,7 @@
 //! renders), work predicted by the pilot against the error it gives, targets with shards and
 //! merges, the error image, and bad input.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use serde_json::Value;
 use spectrace_renderer::pilot::{EstimateOptions, estimate};
@@ -123,13 +123,6 @@ fn the_work_the_pilot_predicts_reaches_the_target() {
     }
 }
 
-fn temp_dir(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("spectrace-estimate-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
 fn sidecar(path: &Path) -> Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
@@ -140,7 +133,7 @@ fn sidecar(path: &Path) -> Value {
 fn a_render_to_a_target_stops_there_and_writes_its_error_image() {
     let mut s = small("fading_spot.json", 48, 32);
     s.output.error_image = true;
-    let out = temp_dir("target");
+    let out = crate::rendering::temp_dir("estimate-target");
     let report = render_scene(
         &s,
         &RenderOptions {
@@ -181,7 +174,7 @@ fn a_render_to_a_target_stops_there_and_writes_its_error_image() {
 #[test]
 fn shards_stop_on_their_share_and_the_merge_reports_the_merged_estimate() {
     let s = small("fading_spot.json", 48, 32);
-    let out = temp_dir("shards");
+    let out = crate::rendering::temp_dir("estimate-shards");
     let target = 0.04;
     let mut parts = Vec::new();
     let mut batches = 0;
@@ -244,7 +237,7 @@ fn bad_targets_are_refused_naming_the_field() {
 #[test]
 fn a_time_cap_stops_a_render_to_an_unreachable_target() {
     let s = small("fading_spot.json", 48, 32);
-    let out = temp_dir("cap");
+    let out = crate::rendering::temp_dir("estimate-cap");
     let report = render_scene(
         &s,
         &RenderOptions {
@@ -271,7 +264,7 @@ fn a_time_cap_stops_a_render_to_an_unreachable_target() {
 /// report as JSON; the JSON file may not replace the scene.
 #[test]
 fn the_estimate_command_writes_its_report() {
-    let dir = temp_dir("cli");
+    let dir = crate::rendering::temp_dir("estimate-cli");
     let scene = dir.join("scene.json");
     let mut v: Value = serde_json::from_str(crate::rendering::POINT_OVER_PLANE).unwrap();
     v["camera"]["width"] = Value::from(32);

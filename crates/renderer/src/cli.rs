@@ -265,11 +265,12 @@ fn estimate_command(
     restrict_paths: bool,
 ) -> ExitCode {
     let run = || -> Result<String, String> {
-        if let Some(out) = json {
-            crate::check_no_input_replaced(&[out.to_path_buf()], &[scene.to_path_buf()])?;
-        }
         let scene = crate::Scene::load_with(scene, crate::LoadOptions { restrict_paths })
             .map_err(|e| e.to_string())?;
+        if let Some(out) = json {
+            // Never over an input: the scene file or a mesh it names.
+            crate::check_no_input_replaced(&[out.to_path_buf()], &scene.inputs)?;
+        }
         let mut options = crate::pilot::EstimateOptions {
             target_error,
             pilot_seconds,

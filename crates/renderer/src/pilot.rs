@@ -222,9 +222,9 @@ fn pilot(
         degrees_of_freedom: 0.0,
     });
     let live = live.into_inner().unwrap_or_default();
-    let slope_vs_time = fit_slope(&live.iter().map(|&(t, _, e)| (t, e)).collect::<Vec<_>>());
+    let slope_vs_time = fit_log_slope(&live.iter().map(|&(t, _, e)| (t, e)).collect::<Vec<_>>());
     let slope_vs_items =
-        fit_slope(&live.iter().map(|&(_, n, e)| (n as f64, e)).collect::<Vec<_>>());
+        fit_log_slope(&live.iter().map(|&(_, n, e)| (n as f64, e)).collect::<Vec<_>>());
     // Independent chunks make the error fall as items^-1/2; a measured slope replaces it only
     // when it is clearly different (a sign of chunks that are not independent).
     let slope_used = match slope_vs_items {
@@ -259,27 +259,43 @@ fn pilot(
 }
 
 /// Least-squares slope of log error against log `x` (time or work), with its standard error,
-/// over the points `(x, error)` (`None` for fewer than three).
-fn fit_slope(points: &[(f64, f64)]) -> Option<(f64, f64)> {
-    let pts: Vec<(f64, f64)> = points
+/// over the points `(x, error)` (`None` for fewer than three positive ones).
+fn fit_log_slope(points: &[(f64, f64)]) -> Option<(f64, f64)> {
+    let logs: Vec<(f64, f64)> = points
         .iter()
         .filter(|(t, e)| *t > 0.0 && *e > 0.0)
         .map(|(t, e)| (t.ln(), e.ln()))
         .collect();
-    if pts.len() < 3 {
+    let fit = fit_line(&logs)?;
+    Some((fit.slope, fit.standard_error?))
+}
+
+/// A least-squares line's slope.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SlopeFit {
+    /// The slope of `y` against `x`.
+    pub slope: f64,
+    /// Its standard error, from the residuals (`None` with two points: a line through both).
+    pub standard_error: Option<f64>,
+}
+
+/// The least-squares slope of `y` against `x` (`None` for fewer than two distinct `x` or
+/// non-finite values): the one fit of the pilot and of the accuracy report.
+pub fn fit_line(points: &[(f64, f64)]) -> Option<SlopeFit> {
+    if points.len() < 2 || points.iter().any(|(x, y)| !x.is_finite() || !y.is_finite()) {
         return None;
     }
-    let n = pts.len() as f64;
-    let mx = pts.iter().map(|p| p.0).sum::<f64>() / n;
-    let my = pts.iter().map(|p| p.1).sum::<f64>() / n;
-    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let n = points.len() as f64;
+    let mx = points.iter().map(|p| p.0).sum::<f64>() / n;
+    let my = points.iter().map(|p| p.1).sum::<f64>() / n;
+    let sxx: f64 = points.iter().map(|p| (p.0 - mx).powi(2)).sum();
     if !(sxx > 0.0) {
         return None;
     }
-    let slope = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>() / sxx;
-    let residual: f64 = pts.iter().map(|p| (p.1 - my - slope * (p.0 - mx)).powi(2)).sum();
-    let se = (residual / (n - 2.0) / sxx).sqrt();
-    Some((slope, se))
+    let slope = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>() / sxx;
+    let residual: f64 = points.iter().map(|p| (p.1 - my - slope * (p.0 - mx)).powi(2)).sum();
+    let standard_error = (points.len() > 2).then(|| (residual / (n - 2.0) / sxx).sqrt());
+    Some(SlopeFit { slope, standard_error })
 }
 
 /// The report as a Markdown table with a recommendation.
@@ -317,4 +333,30 @@ pub fn markdown(report: &EstimateReport) -> String {
         None => md.push_str("\nno estimator saw light in its pilot\n"),
     }
     md
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_line_fit_gives_the_slope_and_its_error_from_the_residuals() {
+        assert_eq!(fit_line(&[(1.0, 2.0)]), None);
+        assert_eq!(fit_line(&[(1.0, 2.0), (1.0, 3.0)]), None);
+        assert_eq!(fit_line(&[(0.0, 1.0), (f64::NAN, 2.0)]), None);
+        let two = fit_line(&[(0.0, 1.0), (2.0, 0.0)]).unwrap();
+        assert_eq!((two.slope, two.standard_error), (-0.5, None));
+        let exact = fit_line(&[(0.0, 1.0), (1.0, 0.5), (2.0, 0.0)]).unwrap();
+        assert_eq!((exact.slope, exact.standard_error), (-0.5, Some(0.0)));
+        // Residuals +-0.1 about slope 1: standard error sqrt(sum r^2 / (n - 2) / sxx).
+        let noisy = fit_line(&[(0.0, 0.1), (1.0, 0.9), (2.0, 2.1), (3.0, 2.9)]).unwrap();
+        assert!((noisy.slope - 0.96).abs() < 1e-12, "{noisy:?}");
+        assert!(noisy.standard_error.unwrap() > 0.0);
+        // Error against time on a log-log scale: e = t^-1/2 exactly.
+        let pts: Vec<(f64, f64)> =
+            [1.0, 4.0, 16.0].iter().map(|&t: &f64| (t, t.powf(-0.5))).collect();
+        let (s, se) = fit_log_slope(&pts).unwrap();
+        assert!((s + 0.5).abs() < 1e-12 && se < 1e-12);
+        assert_eq!(fit_log_slope(&pts[..2]), None);
+    }
 }

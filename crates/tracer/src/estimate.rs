@@ -29,6 +29,7 @@ use serde::{Deserialize, Serialize};
 use spectrace_spectrum::Xyz;
 
 use crate::FilmError;
+use crate::film::film_pixels;
 
 /// Chunks (batches) a render needs before its error estimate is trusted to stop it.
 pub const MIN_BATCHES: u64 = 16;
@@ -85,13 +86,6 @@ impl ErrorEstimate {
     pub fn is_trusted(&self) -> bool {
         self.batches >= MIN_BATCHES && self.relative_rmse.is_some()
     }
-
-    /// Work items needed to reach relative error `target`, with error falling as
-    /// `1 / sqrt(items)` (exact for independent chunks); `None` without an estimate.
-    pub fn items_for(&self, target: f64) -> Option<f64> {
-        let e = self.relative_rmse?;
-        (target > 0.0).then(|| self.items as f64 * (e / target).powi(2))
-    }
 }
 
 impl Moments {
@@ -100,18 +94,8 @@ impl Moments {
     /// # Errors
     /// [`FilmError::InvalidSize`] as for [`crate::Film::new`].
     pub fn new(width: u32, height: u32) -> Result<Self, FilmError> {
-        let n = u64::from(width) * u64::from(height);
-        if width == 0 || height == 0 || n > crate::MAX_PIXELS {
-            return Err(FilmError::InvalidSize(width, height));
-        }
-        Ok(Self {
-            width,
-            height,
-            sums: vec![[0.0; 9]; n as usize],
-            chunks: 0,
-            items: 0,
-            totals: [0.0; 2],
-        })
+        let n = film_pixels(width, height)?;
+        Ok(Self { width, height, sums: vec![[0.0; 9]; n], chunks: 0, items: 0, totals: [0.0; 2] })
     }
 
     /// Bytes the moments of a `width x height` film occupy (72 per pixel).
@@ -169,17 +153,22 @@ impl Moments {
         self.totals = [q, s2];
     }
 
+    /// The chunk and item counts, with no error estimated yet.
+    fn no_estimate(&self) -> ErrorEstimate {
+        ErrorEstimate {
+            relative_rmse: None,
+            batches: self.chunks,
+            items: self.items,
+            degrees_of_freedom: 0.0,
+        }
+    }
+
     /// The estimated relative error from the running totals, in O(1) (the live estimate while
     /// rendering; [`Moments::estimate`] is the exact sum over the pixels, with the degrees of
     /// freedom). Equal to it up to rounding, except that it does not clamp a pixel's variance
     /// at zero; `degrees_of_freedom` is left at 0.
     pub fn quick_estimate(&self) -> ErrorEstimate {
-        let mut estimate = ErrorEstimate {
-            relative_rmse: None,
-            batches: self.chunks,
-            items: self.items,
-            degrees_of_freedom: 0.0,
-        };
+        let mut estimate = self.no_estimate();
         if self.chunks < 2 || self.items == 0 {
             return estimate;
         }
@@ -268,12 +257,7 @@ impl Moments {
 
     /// The estimated relative RMSE of the image these chunks make (see the module essay).
     pub fn estimate(&self) -> ErrorEstimate {
-        let mut estimate = ErrorEstimate {
-            relative_rmse: None,
-            batches: self.chunks,
-            items: self.items,
-            degrees_of_freedom: 0.0,
-        };
+        let mut estimate = self.no_estimate();
         if self.chunks < 2 || self.items == 0 {
             return estimate;
         }

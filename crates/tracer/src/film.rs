@@ -158,14 +158,11 @@ impl Film {
     /// [`FilmError::InvalidSize`] for a zero dimension or more than [`MAX_PIXELS`] pixels (each
     /// pixel takes 48 bytes; see [`Film::bytes_for`]).
     pub fn new(width: u32, height: u32) -> Result<Self, FilmError> {
-        let n = u64::from(width) * u64::from(height);
-        if width == 0 || height == 0 || n > MAX_PIXELS {
-            return Err(FilmError::InvalidSize(width, height));
-        }
+        let n = film_pixels(width, height)?;
         Ok(Self {
             width,
             height,
-            sums: vec![[ExactSum::default(); 3]; n as usize],
+            sums: vec![[ExactSum::default(); 3]; n],
             rejected: 0,
             accepted: 0,
         })
@@ -271,6 +268,19 @@ impl Film {
     pub fn accepted(&self) -> u64 {
         self.accepted
     }
+}
+
+/// The pixel count of a `width x height` film (or of its error-estimate moments).
+///
+/// # Errors
+/// [`FilmError::InvalidSize`] for a zero dimension or more than [`MAX_PIXELS`] pixels.
+pub(crate) fn film_pixels(width: u32, height: u32) -> Result<usize, FilmError> {
+    let n = u64::from(width) * u64::from(height);
+    if width == 0 || height == 0 || n > MAX_PIXELS {
+        return Err(FilmError::InvalidSize(width, height));
+    }
+    // At most 2^25: fits in usize.
+    Ok(n as usize)
 }
 
 /// The row-major index of pixel `(x, y)`, if it lies on a `width x height` film.

@@ -781,17 +781,9 @@ fn mean_ratio(image: &[Xyz], reference: &[Xyz]) -> f64 {
 }
 
 /// Least-squares slope of `y` against `x` (`None` for fewer than two distinct `x` or
-/// non-finite values).
+/// non-finite values): the renderer's fit, also used by `spectrace estimate`.
 fn fit_slope(points: &[(f64, f64)]) -> Option<f64> {
-    if points.len() < 2 || points.iter().any(|(x, y)| !x.is_finite() || !y.is_finite()) {
-        return None;
-    }
-    let n = points.len() as f64;
-    let mx = points.iter().map(|p| p.0).sum::<f64>() / n;
-    let my = points.iter().map(|p| p.1).sum::<f64>() / n;
-    let sxx: f64 = points.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    let sxy: f64 = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    (sxx > 0.0).then(|| sxy / sxx)
+    spectrace_renderer::pilot::fit_line(points).map(|f| f.slope)
 }
 
 /// splitmix64's finaliser.
