@@ -1,8 +1,8 @@
 //! Tests of `spectrace-materials` through its public API (one integration-test binary): Fresnel
 //! and Snell against closed forms, dispersion against published glass data, the Lambertian
 //! lobe's distribution (chi-square and Kolmogorov-Smirnov at fixed seeds), eval/pdf/scatter
-//! consistency, energy bookkeeping, serialisation round trips, error messages, and property
-//! tests of finiteness and unit directions.
+//! consistency, energy bookkeeping, serialisation round trips, error messages, property tests of
+//! finiteness and unit directions, and checks of the measured metal tables in `data/metals/`.
 #![allow(clippy::unwrap_used)]
 
 mod bundles;
@@ -10,6 +10,7 @@ mod dielectric;
 mod diffuse;
 mod dispersion;
 mod fresnel;
+mod metal_data;
 mod mirror;
 mod properties;
 mod serde_forms;
