@@ -46,6 +46,7 @@ mod fresnel;
 mod glass;
 mod ior;
 mod material;
+mod microfacet;
 mod mirror;
 mod vectors;
 
@@ -59,6 +60,7 @@ pub use material::{
     BundleScattered, Incoming, Material, ScatterKind, Scattered, Transport, scale_bundle,
     scatter_each,
 };
+pub use microfacet::{Ggx, SMOOTH_ALPHA, fresnel_conductor};
 pub use mirror::Mirror;
 
 /// Vectors (`DVec3`), re-exported so users need no direct dependency.

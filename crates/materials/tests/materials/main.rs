@@ -10,6 +10,7 @@ mod dielectric;
 mod diffuse;
 mod dispersion;
 mod fresnel;
+mod harness;
 mod metal_data;
 mod mirror;
 mod properties;
