@@ -42,6 +42,7 @@
 mod dielectric;
 mod diffuse;
 mod error;
+mod fluorescent;
 mod fresnel;
 mod glass;
 mod ior;
@@ -53,6 +54,7 @@ mod vectors;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
 pub use error::MaterialError;
+pub use fluorescent::{Fluorescent, Reemission, reemission_lobe};
 pub use fresnel::{Polarised, fresnel_dielectric, fresnel_dielectric_polarised, reflect, refract};
 pub use glass::{GLASSES, Glass, find_glass, known_glasses};
 pub use ior::{FRAUNHOFER_C_NM, FRAUNHOFER_D_NM, FRAUNHOFER_F_NM, Ior, VALID_MAX_NM, VALID_MIN_NM};

@@ -5,6 +5,8 @@ use std::fmt::Debug;
 
 use glam::DVec3;
 
+use crate::Fluorescent;
+
 /// A beam arriving at a surface, as the material sees it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Incoming {
@@ -190,6 +192,16 @@ pub trait Material: Send + Sync + Debug {
     /// `true` if the directions this material scatters into depend on the wavelength (a
     /// dispersive index of refraction): paths through it cannot be shared between wavelengths.
     fn is_dispersive(&self) -> bool;
+
+    /// The material's re-emission at other wavelengths (fluorescence), or `None` (the default)
+    /// for a material that keeps every wavelength. When `Some`, [`scatter`](Self::scatter),
+    /// [`eval`](Self::eval) and [`pdf`](Self::pdf) describe only the *elastic* part, and an
+    /// integrator first chooses between it and re-emission with
+    /// [`Fluorescent::choose_forward`] or [`Fluorescent::choose_adjoint`]; the effects
+    /// analysis asks this to know whether a scene fluoresces.
+    fn fluorescence(&self) -> Option<&Fluorescent> {
+        None
+    }
 }
 
 /// [`Material::scatter_bundle`] done the general way: [`Material::scatter_with`] once per live

@@ -1191,6 +1191,7 @@ fn add_counts(merged: &RenderOutput, part: &RenderOutput) -> Result<(), &'static
     fits(merged.stats.splats, part.stats.splats, "splat count")?;
     fits(merged.stats.roulette_kills, part.stats.roulette_kills, "roulette count")?;
     fits(merged.stats.depth_limited, part.stats.depth_limited, "depth-limit count")?;
+    fits(merged.stats.reemissions, part.stats.reemissions, "re-emission count")?;
     fits(merged.film.accepted(), part.film.accepted(), "accepted-contribution count")?;
     fits(merged.film.rejected(), part.film.rejected(), "rejected-contribution count")?;
     Ok(())

@@ -441,6 +441,11 @@ impl Reflectance {
     }
 
     /// [`Reflectance::constant`] with messages for `kind`.
+    /// The fraction 1 at every wavelength (a white, lossless surface).
+    pub fn white() -> Self {
+        Self { nm: Vec::new(), values: vec![1.0] }
+    }
+
     fn constant_of(kind: Kind, value: f64) -> Result<Self, SpectrumError> {
         check_fraction(kind, "constant", 0, value)?;
         Ok(Self { nm: Vec::new(), values: vec![value] })

@@ -79,6 +79,7 @@ use serde::{Deserialize, Serialize};
 use spectrace_geometry::{Hit, Ray};
 use spectrace_lights::{LightFlags, LightId, LightSource, LightSurface, uniform};
 use spectrace_materials::{Incoming, ScatterKind, Transport};
+use spectrace_materials::{Material, Reemission, reemission_lobe};
 use spectrace_spectrum::{CIE_Y_INTEGRAL, SpectralPowerDistribution, cmf};
 
 use crate::light_tracer::{LightTracerScene, TraceStats, shading_correction};
@@ -128,6 +129,19 @@ pub struct MisVertex {
 /// lens, is not part of the scene: paths never hit it). Zero densities (delta vertices) count as 1, so deltas cancel. `s` must be a valid
 /// strategy; the result is in `[0, 1]`.
 pub fn mis_weight(path: &[MisVertex], s: usize, light_is_delta: bool) -> f64 {
+    mis_weight_up_to(path, s, light_is_delta, usize::MAX)
+}
+
+/// [`mis_weight`] over the strategies with at most `most_light_vertices` light vertices: the
+/// strategies that can make a path that fluoresced on its camera side (re-emission is sampled
+/// by camera subpaths only, and only next-event estimation and emission hits join them to a
+/// light at the new wavelength). `s` must be at most `most_light_vertices`.
+pub(crate) fn mis_weight_up_to(
+    path: &[MisVertex],
+    s: usize,
+    light_is_delta: bool,
+    most_light_vertices: usize,
+) -> f64 {
     let n = path.len();
     if n < 2 || s >= n {
         return 0.0;
@@ -145,7 +159,7 @@ pub fn mis_weight(path: &[MisVertex], s: usize, light_is_delta: bool) -> f64 {
     }
     // More light vertices: strategy i + 1 takes vertex i from the light side.
     let mut r = 1.0;
-    for i in s..n - 1 {
+    for i in s..(n - 1).min(most_light_vertices) {
         r *= remap(path[i].from_light) / remap(path[i].from_camera);
         if !path[i].delta && !path[i + 1].delta {
             sum += r * r;
@@ -180,10 +194,18 @@ struct Vertex {
     pdf_fwd: f64,
     /// Area density of this vertex sampled from the other side.
     pdf_rev: f64,
+    /// The wavelength (nm) at which this vertex connects to the other subpath: the sample's
+    /// own, or, beyond a fluorescent re-emission, the new one (on a camera subpath the
+    /// wavelength the light had before it was absorbed; on a light subpath the re-emitted one).
+    lambda: f64,
+    /// This vertex re-emitted (scatters with [`reemission_lobe`] instead of its material).
+    reemitted: bool,
+    /// This vertex or one before it on its subpath re-emitted.
+    fluoresced: bool,
 }
 
 impl Vertex {
-    fn camera(point: DVec3) -> Self {
+    fn camera(point: DVec3, lambda: f64) -> Self {
         Self {
             kind: VertexKind::Camera,
             point,
@@ -192,10 +214,13 @@ impl Vertex {
             delta: false,
             pdf_fwd: 0.0,
             pdf_rev: 0.0,
+            lambda,
+            reemitted: false,
+            fluoresced: false,
         }
     }
 
-    fn surface(hit: Hit, beta: f64) -> Self {
+    fn surface(hit: Hit, beta: f64, lambda: f64, fluoresced: bool) -> Self {
         Self {
             kind: VertexKind::Surface(hit),
             point: hit.point,
@@ -204,6 +229,9 @@ impl Vertex {
             delta: false,
             pdf_fwd: 0.0,
             pdf_rev: 0.0,
+            lambda,
+            reemitted: false,
+            fluoresced,
         }
     }
 }
@@ -320,14 +348,7 @@ impl<'a> Bdpt<'a> {
 
     /// Area density with which `v`, reached from `prev`, samples `next` (pbrt's `Vertex::Pdf`).
     /// Light vertices ignore `prev`; `light` is the light of a vertex that emits.
-    fn pdf(
-        &self,
-        v: &Vertex,
-        prev: Option<&Vertex>,
-        next: &Vertex,
-        light: Option<LightId>,
-        wl: &Wavelength,
-    ) -> f64 {
+    fn pdf(&self, v: &Vertex, prev: Option<&Vertex>, next: &Vertex, light: Option<LightId>) -> f64 {
         let solid = match v.kind {
             VertexKind::Camera => self.camera_pdf(v.point, next.point),
             VertexKind::Light(id) => self.light_pdfs(id, v.point, next.point - v.point).1,
@@ -336,16 +357,34 @@ impl<'a> Bdpt<'a> {
                     self.light_pdfs(id, v.point, next.point - v.point).1
                 } else {
                     let Some(prev) = prev else { return 0.0 };
-                    let Some(material) = self.scene.materials.get(hit.primitive as usize) else {
-                        return 0.0;
-                    };
+                    let Some(material) = self.lobe(v, &hit) else { return 0.0 };
                     let wp = (prev.point - v.point).normalize();
                     let wn = (next.point - v.point).normalize();
-                    material.pdf(wp, wn, hit.shading_normal, wl.lambda)
+                    material.pdf(wp, wn, hit.shading_normal, v.lambda)
                 }
             }
         };
         if solid > 0.0 { Self::to_area(solid, v.point, next) } else { 0.0 }
+    }
+
+    /// What scatters at surface vertex `v` (on `hit`): its material, or the white Lambertian
+    /// lobe of a fluorescent re-emission.
+    fn lobe(&self, v: &Vertex, hit: &Hit) -> Option<&dyn Material> {
+        if v.reemitted {
+            return Some(reemission_lobe());
+        }
+        self.scene.materials.get(hit.primitive as usize).map(|m| m.as_ref())
+    }
+
+    /// The sample's wavelength record for the wavelength `lambda` a camera vertex connects at
+    /// (its film wavelength `wl`, or beyond a re-emission the light's wavelength, with the
+    /// light set's density there).
+    fn wavelength_at(&self, lambda: f64, wl: &Wavelength) -> Wavelength {
+        if lambda == wl.lambda {
+            *wl
+        } else {
+            Wavelength { lambda, density: self.set_spd.value(lambda) }
+        }
     }
 
     /// A light's `(position, direction)` emission densities from `point` along `direction`
@@ -395,7 +434,7 @@ impl<'a> Bdpt<'a> {
         if camera_strategies {
             generate_camera_subpath(self, px, py, &wl, rng, buffers, stats);
         } else {
-            buffers.camera.push(Vertex::camera(scene.camera.position()));
+            buffers.camera.push(Vertex::camera(scene.camera.position(), wl.lambda));
         }
 
         let max_len = self.settings.max_depth.min(crate::MAX_DEPTH) as usize + 3;
@@ -426,7 +465,7 @@ impl<'a> Bdpt<'a> {
                 }
                 match c.raster {
                     Some((x, y)) => {
-                        let xyz = cmf(wl.lambda) * (c.value * inv_y / pixels);
+                        let xyz = cmf(c.lambda) * (c.value * inv_y / pixels);
                         if film.splat(x, y, xyz) {
                             stats.splats += 1;
                         }
@@ -484,7 +523,7 @@ fn generate_camera_subpath(
     let u_lens = if camera.is_pinhole() { [0.5; 2] } else { [uniform(rng), uniform(rng)] };
     let camera_ray = camera.generate_ray(px, py, u_film, u_lens);
     let ray = Ray { origin: camera_ray.origin, direction: camera_ray.direction };
-    buffers.camera.push(Vertex::camera(ray.origin));
+    buffers.camera.push(Vertex::camera(ray.origin, wl.lambda));
     let pdf_dir = camera.pdf_we(&camera_ray).1;
     let first = bdpt.scene.world.intersect(&ray, f64::INFINITY);
     let max = bdpt.max_vertices().0;
@@ -495,7 +534,7 @@ fn generate_camera_subpath(
         1.0,
         pdf_dir,
         Transport::Radiance,
-        wl,
+        true,
         max,
         &mut buffers.camera,
         rng,
@@ -529,6 +568,9 @@ fn generate_light_subpath(
         delta: light.flags.delta_direction,
         pdf_fwd: if camera_strategies { light.pmf * pdf_pos } else { 1.0 },
         pdf_rev: 0.0,
+        lambda: wl.lambda,
+        reemitted: false,
+        fluoresced: false,
     });
     let ray = Ray { origin: beam.origin, direction: beam.direction };
     let first = scene.intersect_from_light(&ray, light.id, f64::INFINITY);
@@ -541,7 +583,7 @@ fn generate_light_subpath(
         beta,
         pdf_dir,
         Transport::Importance,
-        wl,
+        !camera_strategies,
         max,
         &mut buffers.light,
         rng,
@@ -561,7 +603,7 @@ fn random_walk(
     mut beta: f64,
     mut pdf_dir: f64,
     transport: Transport,
-    wl: &Wavelength,
+    reemit: bool,
     max: usize,
     path: &mut Vec<Vertex>,
     rng: &mut dyn rand::Rng,
@@ -573,17 +615,48 @@ fn random_walk(
     while let Some(hit) = next.take() {
         stats.hits += 1;
         let Some(prev) = path.last().copied() else { return };
-        let mut v = Vertex::surface(hit, beta);
+        let mut v = Vertex::surface(hit, beta, prev.lambda, prev.fluoresced);
         v.pdf_fwd = Bdpt::to_area(pdf_dir, prev.point, &v);
+        let Some(material) = scene.materials.get(hit.primitive as usize) else {
+            path.push(v);
+            return;
+        };
+        let mut material: &dyn Material = material.as_ref();
+        if reemit && let Some(fluorescent) = material.fluorescence() {
+            // Elastic or re-emitted, decided before any connection to this vertex; the
+            // branch's factor belongs to the vertex's scattering, so it enters `beta` here.
+            let (u_choice, u_lambda) = (uniform(rng), uniform(rng));
+            let (mut l, mut w) = ([v.lambda], [beta]);
+            let decision = if transport == Transport::Radiance {
+                fluorescent.choose_adjoint(&mut l, &mut w, u_choice, u_lambda)
+            } else {
+                fluorescent.choose_forward(&mut l, &mut w, u_choice, u_lambda)
+            };
+            match decision {
+                Reemission::Elastic => {}
+                Reemission::Reemitted { lambda } => {
+                    stats.reemissions += 1;
+                    material = reemission_lobe();
+                    v.lambda = lambda;
+                    v.reemitted = true;
+                    v.fluoresced = true;
+                }
+                Reemission::Absorbed => {
+                    path.push(v);
+                    return;
+                }
+            }
+            beta = w[0];
+            v.beta = beta;
+        }
         path.push(v);
         if path.len() >= max {
             stats.depth_limited += 1;
             return;
         }
-        let Some(material) = scene.materials.get(hit.primitive as usize) else { return };
         let u = [uniform(rng), uniform(rng), uniform(rng)];
         let incoming =
-            Incoming { direction: ray.direction, normal: hit.shading_normal, lambda: wl.lambda };
+            Incoming { direction: ray.direction, normal: hit.shading_normal, lambda: v.lambda };
         let Some(s) = material.scatter_with(&incoming, u, transport) else { return };
         let wp = -ray.direction;
         let mut weight = s.weight;
@@ -598,7 +671,7 @@ fn random_walk(
             0.0
         } else {
             pdf_dir = s.pdf;
-            material.pdf(s.direction, wp, hit.shading_normal, wl.lambda)
+            material.pdf(s.direction, wp, hit.shading_normal, v.lambda)
         };
         path[n - 2].pdf_rev = Bdpt::to_area(pdf_rev, hit.point, &prev);
         if (n - 1) as u32 > bdpt.settings.rr_depth {
@@ -622,6 +695,9 @@ fn random_walk(
 struct Contribution {
     value: f64,
     raster: Option<(u32, u32)>,
+    /// The wavelength a `t = 1` splat is recorded at (the light subpath's, which differs from
+    /// the sample's beyond a re-emission).
+    lambda: f64,
     /// The MIS weight applied (included in `value`).
     #[cfg_attr(not(test), allow(dead_code))]
     weight: f64,
@@ -632,19 +708,12 @@ struct Contribution {
 
 /// The BSDF at surface vertex `v` for light arriving from `from` and leaving towards `to`, with
 /// `transport`'s adjoint; 0 for other vertices.
-fn bsdf(
-    bdpt: &Bdpt<'_>,
-    v: &Vertex,
-    from: DVec3,
-    to: DVec3,
-    transport: Transport,
-    wl: &Wavelength,
-) -> f64 {
+fn bsdf(bdpt: &Bdpt<'_>, v: &Vertex, from: DVec3, to: DVec3, transport: Transport) -> f64 {
     let VertexKind::Surface(hit) = v.kind else { return 0.0 };
-    let Some(material) = bdpt.scene.materials.get(hit.primitive as usize) else { return 0.0 };
+    let Some(material) = bdpt.lobe(v, &hit) else { return 0.0 };
     let wi = (from - v.point).normalize();
     let wo = (to - v.point).normalize();
-    material.eval_with(wi, wo, hit.shading_normal, wl.lambda, transport)
+    material.eval_with(wi, wo, hit.shading_normal, v.lambda, transport)
 }
 
 /// Strategy `(s, t)` for the subpaths `light` and `camera` (pbrt's `ConnectBDPT`), weighted by
@@ -673,16 +742,24 @@ fn connect(
     let mut sampled: Option<Vertex> = None;
     let mut sampled_camera: Option<Vertex> = None;
     let mut end = *beam_light;
+    // The splat's wavelength, and whether the path fluoresced on its camera side (then only
+    // `s <= 1` strategies can make it). `wl_c` below is the wavelength at the connection: the
+    // sample's, or beyond a re-emission on the camera subpath the light's.
+    let mut splat_lambda = wl.lambda;
+    let mut fluoresced = false;
     let value;
     if s == 0 {
         // The camera subpath hits an emitter.
         let pt = &camera[t - 1];
         let VertexKind::Surface(hit) = pt.kind else { return None };
-        let wo = (camera[t - 2].point - pt.point).normalize();
+        let before = &camera[t - 2];
+        let wo = (before.point - pt.point).normalize();
         let (id, le) = scene.emitted(&hit, wo)?;
         let spd = scene.light_spd(id)?;
-        end = bdpt.light_end(id, wl)?;
-        value = pt.beta * le * spd.value(wl.lambda) / wl.density;
+        let wl_c = bdpt.wavelength_at(before.lambda, wl);
+        fluoresced = before.fluoresced;
+        end = bdpt.light_end(id, &wl_c)?;
+        value = pt.beta * le * spd.value(wl_c.lambda) / wl.density;
     } else if t == 1 {
         // A light vertex seen by the camera, through a point of the lens sampled towards it
         // (the pinhole for a pinhole camera: no uniforms drawn).
@@ -721,19 +798,22 @@ fn connect(
                     cs.to_camera.dot(hit.geometric_normal).abs() * wi.dot(hit.shading_normal).abs()
                         / cos_in
                 };
-                let f = bsdf(bdpt, qs, light[s - 2].point, cs.position, Transport::Importance, wl);
+                let f = bsdf(bdpt, qs, light[s - 2].point, cs.position, Transport::Importance);
                 value = qs.beta * f * cos * cs.importance;
+                splat_lambda = qs.lambda;
             }
             VertexKind::Camera => return None,
         }
         raster = Some((cs.x, cs.y));
-        sampled_camera = Some(Vertex::camera(cs.position));
+        sampled_camera = Some(Vertex::camera(cs.position, qs.lambda));
     } else if s == 1 {
         // Next-event estimation: a light chosen by pmf(l | lambda), a point on it.
         let pt = &camera[t - 1];
         let VertexKind::Surface(hit) = pt.kind else { return None };
-        let id = choose_light(bdpt, wl, uniform(rng))?;
-        end = bdpt.light_end(id, wl)?;
+        let wl_c = bdpt.wavelength_at(pt.lambda, wl);
+        fluoresced = pt.fluoresced;
+        let id = choose_light(bdpt, &wl_c, uniform(rng))?;
+        end = bdpt.light_end(id, &wl_c)?;
         let u = [uniform(rng), uniform(rng)];
         let source = scene.lights.light(id)?;
         let sample = source.sample_towards(pt.point, u)?;
@@ -742,7 +822,7 @@ fn connect(
             return None;
         }
         let wi = -sample.direction;
-        let f = bsdf(bdpt, pt, sample.position, camera[t - 2].point, Transport::Radiance, wl);
+        let f = bsdf(bdpt, pt, sample.position, camera[t - 2].point, Transport::Radiance);
         let cos = wi.dot(hit.shading_normal).abs();
         if !(f > 0.0 && cos > 0.0) {
             return None;
@@ -751,7 +831,10 @@ fn connect(
         if scene.world.occluded(&shadow, distance * (1.0 - 1e-9)) {
             return None;
         }
-        value = pt.beta * f * cos * sample.intensity / (sample.distance * sample.distance * pmf);
+        // The light was chosen by pmf(l | lambda_c); the sample's wavelength density is the
+        // film wavelength's (they differ beyond a re-emission).
+        value = pt.beta * f * cos * sample.intensity / (sample.distance * sample.distance * pmf)
+            * (wl_c.density / wl.density);
         let (pdf_pos, _) = bdpt.light_pdfs(id, sample.position, sample.direction);
         sampled = Some(Vertex {
             kind: VertexKind::Light(id),
@@ -761,6 +844,9 @@ fn connect(
             delta: end.flags.delta_direction,
             pdf_fwd: end.pmf * pdf_pos,
             pdf_rev: 0.0,
+            lambda: wl_c.lambda,
+            reemitted: false,
+            fluoresced: false,
         });
     } else {
         // Two surface vertices joined by a shadow ray.
@@ -768,11 +854,15 @@ fn connect(
         let (VertexKind::Surface(hq), VertexKind::Surface(hp)) = (qs.kind, pt.kind) else {
             return None;
         };
-        let f_light = bsdf(bdpt, qs, light[s - 2].point, pt.point, Transport::Importance, wl);
+        if qs.fluoresced || pt.fluoresced {
+            // The two subpaths travel at different wavelengths.
+            return None;
+        }
+        let f_light = bsdf(bdpt, qs, light[s - 2].point, pt.point, Transport::Importance);
         if !(f_light > 0.0) {
             return None;
         }
-        let f_camera = bsdf(bdpt, pt, qs.point, camera[t - 2].point, Transport::Radiance, wl);
+        let f_camera = bsdf(bdpt, pt, qs.point, camera[t - 2].point, Transport::Radiance);
         if !(f_camera > 0.0) {
             return None;
         }
@@ -802,12 +892,19 @@ fn connect(
     }
     let (weight, light_is_delta) = if camera_strategies {
         let sampled = Sampled { light: sampled.as_ref(), camera: sampled_camera.as_ref() };
-        let delta = build_mis_path(bdpt, light, camera, s, t, sampled, &end, wl, mis);
-        (mis_weight(mis, s, delta), delta)
+        let delta = build_mis_path(bdpt, light, camera, s, t, sampled, &end, mis);
+        let most_light_vertices = if fluoresced { 1 } else { usize::MAX };
+        (mis_weight_up_to(mis, s, delta, most_light_vertices), delta)
     } else {
         (1.0, true)
     };
-    Some(Contribution { value: value * weight, raster, weight, light_is_delta })
+    Some(Contribution {
+        value: value * weight,
+        raster,
+        lambda: splat_lambda,
+        weight,
+        light_is_delta,
+    })
 }
 
 /// Chooses a light with probability `pmf(l | lambda)` from a uniform `u`.
@@ -859,7 +956,6 @@ fn build_mis_path(
     t: usize,
     sampled: Sampled<'_>,
     end: &LightEnd,
-    wl: &Wavelength,
     mis: &mut Vec<MisVertex>,
 ) -> bool {
     mis.clear();
@@ -888,7 +984,7 @@ fn build_mis_path(
     let light_id = if s == 0 { Some(end.id) } else { None };
     // pt as sampled from the light side.
     mis[ip].from_light = match qs.as_ref() {
-        Some(q) => bdpt.pdf(q, qs_minus.as_ref(), &pt, None, wl),
+        Some(q) => bdpt.pdf(q, qs_minus.as_ref(), &pt, None),
         None => {
             let dir = pt_minus.map_or(DVec3::ZERO, |m| m.point - pt.point);
             end.pmf * bdpt.light_pdfs(end.id, pt.point, dir).0
@@ -897,15 +993,15 @@ fn build_mis_path(
     mis[ip].delta = if s == 0 { end.flags.delta_direction } else { false };
     if let Some(m) = pt_minus.as_ref() {
         mis[ip + 1].from_light = match qs.as_ref() {
-            Some(q) => bdpt.pdf(&pt, Some(q), m, None, wl),
-            None => bdpt.pdf(&pt, None, m, light_id, wl),
+            Some(q) => bdpt.pdf(&pt, Some(q), m, None),
+            None => bdpt.pdf(&pt, None, m, light_id),
         };
     }
     if let Some(q) = qs.as_ref() {
-        mis[s - 1].from_camera = bdpt.pdf(&pt, pt_minus.as_ref(), q, None, wl);
+        mis[s - 1].from_camera = bdpt.pdf(&pt, pt_minus.as_ref(), q, None);
         mis[s - 1].delta = if s == 1 { end.flags.delta_direction } else { false };
         if let Some(qm) = qs_minus.as_ref() {
-            mis[s - 2].from_camera = bdpt.pdf(q, Some(&pt), qm, None, wl);
+            mis[s - 2].from_camera = bdpt.pdf(q, Some(&pt), qm, None);
         }
     }
     let on_surface = match s {

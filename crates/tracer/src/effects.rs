@@ -7,6 +7,7 @@
 //! | dispersion | a material's index depends on wavelength | each beam carries one wavelength |
 //! | no dispersion | no such material (and every light colours all its beams by its one spectrum) | paths are wavelength-independent: one traced path carries a *bundle* of `BUNDLE` wavelengths (the same directions, a weight per wavelength), so the variance of the colour falls `BUNDLE` times faster per traced path |
 //! | specular surfaces | a mirror or glass exists | specular chains are followed (caustics) |
+//! | fluorescence | a material re-emits absorbed light at other wavelengths (`Fluorescent`) | at its vertices paths choose between elastic scattering and re-emission, and a bundle of wavelengths collapses to the re-emitted one; scenes without it skip the choice entirely |
 //! | diffuse interreflection | a second bounce can reach a non-specular surface: more than one non-specular shape, a non-flat one, or any specular shape | beams continue after a diffuse hit; otherwise they end there (the light of later bounces can never reach the film) |
 //!
 //! The decision is printed by the renderer and stored in its output metadata; a scene can
@@ -53,6 +54,11 @@ pub struct SceneFeatures {
     /// never hit a line).
     #[serde(default)]
     pub line_spectra: bool,
+    /// Some material fluoresces (re-emits absorbed light at other wavelengths): integrators
+    /// then decide at its vertices between elastic scattering and re-emission. Scenes without
+    /// one never draw the uniforms that decision takes.
+    #[serde(default)]
+    pub fluorescent: bool,
 }
 
 /// Which estimator renders the image: `settings.integrator` in a scene file, `--integrator` on
@@ -200,9 +206,10 @@ impl Effects {
     pub fn summary(&self) -> String {
         let f = &self.features;
         format!(
-            "effects ({mode}): dispersion {}, specular surfaces {}, {} non-specular shape(s){}; \
-             {} wavelength(s) per path, beams {} after a diffuse hit",
+            "effects ({mode}): dispersion {}, fluorescence {}, specular surfaces {}, {} \
+             non-specular shape(s){}; {} wavelength(s) per path, beams {} after a diffuse hit",
             if f.dispersive { "yes" } else { "no" },
+            if f.fluorescent { "yes" } else { "no" },
             if f.specular { "yes" } else { "no" },
             f.non_specular_shapes,
             if f.non_convex_non_specular { " (some can light themselves)" } else { "" },

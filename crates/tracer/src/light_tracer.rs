@@ -29,7 +29,7 @@ use rand_pcg::Pcg64;
 use serde::{Deserialize, Serialize};
 use spectrace_geometry::{Ray, World};
 use spectrace_lights::{LightId, LightSet, LightSource, uniform};
-use spectrace_materials::{Material, Transport};
+use spectrace_materials::{Material, Reemission, Transport, reemission_lobe};
 
 /// The factor that makes particle (importance) transport exact with shading normals:
 /// `|wi . n_s| |wo . n_g| / (|wi . n_g| |wo . n_s|)`, 1 where the normals agree (Veach 1997,
@@ -278,6 +278,7 @@ impl<'a> LightTracerScene<'a> {
         }
         for (i, m) in self.materials.iter().enumerate().take(self.object_shapes) {
             f.dispersive |= m.is_dispersive();
+            f.fluorescent |= m.fluorescence().is_some();
             if m.is_specular() {
                 f.specular = true;
             } else {
@@ -302,6 +303,9 @@ pub struct TraceStats {
     pub roulette_kills: u64,
     /// Beams that reached `max_depth`.
     pub depth_limited: u64,
+    /// Fluorescent re-emissions (a path continuing at a new wavelength).
+    #[serde(default)]
+    pub reemissions: u64,
 }
 
 impl TraceStats {
@@ -312,6 +316,7 @@ impl TraceStats {
         self.splats += o.splats;
         self.roulette_kills += o.roulette_kills;
         self.depth_limited += o.depth_limited;
+        self.reemissions += o.reemissions;
     }
 }
 
@@ -413,11 +418,30 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
         while let Some(hit) = next_hit.take() {
             stats.hits += 1;
             let Some(material) = scene.materials.get(hit.primitive as usize) else { break };
+            let mut material: &dyn Material = material.as_ref();
+            if let Some(fluorescent) = material.fluorescence() {
+                // Elastic or re-emitted, decided before the camera connection so that both use
+                // the same lobe; re-emission collapses the bundle to one new wavelength.
+                let (u_choice, u_lambda) = (uniform(&mut rng), uniform(&mut rng));
+                match fluorescent.choose_forward(
+                    &mut lambdas[..k],
+                    &mut weights[..k],
+                    u_choice,
+                    u_lambda,
+                ) {
+                    Reemission::Elastic => {}
+                    Reemission::Reemitted { .. } => {
+                        stats.reemissions += 1;
+                        material = reemission_lobe();
+                    }
+                    Reemission::Absorbed => break,
+                }
+            }
             let specular = material.is_specular();
             if !specular {
                 if let Some((x, y, value)) = connect_to_camera(
                     scene,
-                    material.as_ref(),
+                    material,
                     &hit,
                     ray.direction,
                     &lambdas[..k],

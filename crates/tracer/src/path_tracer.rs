@@ -40,7 +40,7 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use spectrace_geometry::{Hit, Ray};
 use spectrace_lights::{LightId, LightSource, uniform};
-use spectrace_materials::{Material, ScatterKind, Transport};
+use spectrace_materials::{Material, Reemission, ScatterKind, Transport, reemission_lobe};
 use spectrace_sampling::Discrete;
 use spectrace_spectrum::{CIE_Y_INTEGRAL, Xyz, cmf};
 
@@ -188,6 +188,9 @@ impl<'a> PathTracer<'a> {
         let mut depth = 0u32;
         let mut last_bounce = false;
         let mut collapsed = false;
+        // The wavelengths light travels at along the path; they differ from the film's
+        // `lambdas` beyond a fluorescent re-emission.
+        let mut transport = *lambdas;
         while let Some(hit) = scene.world.intersect(&ray, f64::INFINITY) {
             stats.hits += 1;
             let wo = -ray.direction;
@@ -210,7 +213,7 @@ impl<'a> PathTracer<'a> {
                 {
                     for j in 0..HERO {
                         if beta[j] != 0.0 {
-                            radiance[j] += beta[j] * le * spd.value(lambdas[j]) * weight;
+                            radiance[j] += beta[j] * le * spd.value(transport[j]) * weight;
                         }
                     }
                 }
@@ -219,7 +222,20 @@ impl<'a> PathTracer<'a> {
                 break;
             }
             let Some(material) = scene.materials.get(hit.primitive as usize) else { break };
-            let material: &dyn Material = material.as_ref();
+            let mut material: &dyn Material = material.as_ref();
+            if let Some(fluorescent) = material.fluorescence() {
+                // Elastic or re-emitted, decided before next-event estimation so that both it
+                // and the BSDF sample use the same lobe at the same wavelength.
+                let (u_choice, u_lambda) = (uniform(rng), uniform(rng));
+                match fluorescent.choose_adjoint(&mut transport, &mut beta, u_choice, u_lambda) {
+                    Reemission::Elastic => {}
+                    Reemission::Reemitted { .. } => {
+                        stats.reemissions += 1;
+                        material = reemission_lobe();
+                    }
+                    Reemission::Absorbed => break,
+                }
+            }
             if material.is_dispersive() && !collapsed {
                 // Directions now depend on the wavelength: the hero alone continues.
                 collapsed = true;
@@ -231,7 +247,7 @@ impl<'a> PathTracer<'a> {
             }
             let non_specular = !material.is_specular();
             if non_specular {
-                self.next_event(&hit, wo, material, lambdas, &beta, &mut radiance, rng, stats);
+                self.next_event(&hit, wo, material, &transport, &beta, &mut radiance, rng, stats);
                 if !self.effects.continue_after_diffuse {
                     // No light can come back to a non-specular surface by interreflection: only
                     // an emitter seen by the BSDF-sampled ray remains (for MIS).
@@ -248,7 +264,7 @@ impl<'a> PathTracer<'a> {
             let Some(scattered) = material.scatter_bundle(
                 ray.direction,
                 hit.shading_normal,
-                &lambdas[..],
+                &transport[..],
                 &mut beta,
                 u,
                 Transport::Radiance,
