@@ -12,7 +12,7 @@
 //! ```json
 //! {"type": "Fluorescent", "reflectance": 0.8,
 //!  "absorption": {"nm": [340, 400, 460, 500], "values": [0.0, 0.9, 0.6, 0.0]},
-//!  "emission": {"type": "Gaussian", "mean_nm": 520, "fwhm_nm": 40},
+//!  "emission": {"type": "Gaussian", "center_nm": 520, "fwhm_nm": 40},
 //!  "quantum_yield": 0.9}
 //! ```
 //!

@@ -583,6 +583,13 @@ fn integrator_warnings(scene: &Scene, choice: IntegratorChoice) -> Vec<String> {
                 .to_owned(),
         );
     }
+    if choice == IntegratorChoice::Bdpt && features.fluorescent && features.specular {
+        warnings.push(
+            "BDPT re-emits fluorescent light on light paths only: a fluorescent surface seen \
+             only through mirrors or glass is missing from this image (use --integrator path)"
+                .to_owned(),
+        );
+    }
     if choice != IntegratorChoice::Path {
         return warnings;
     }

@@ -60,6 +60,17 @@
 //! per-pixel density `1 / (A_pixel cos^3 theta)` of one camera sample compared with `pixels`
 //! light paths.
 //!
+//! # Fluorescence
+//! Only light subpaths re-emit ([`spectrace_materials::Fluorescent::choose_forward`], decided
+//! at the vertex before any connection, so connections from it use the re-emission lobe at the
+//! new wavelength). Camera subpaths scatter at fluorescent surfaces by the elastic part alone:
+//! the sample's wavelength comes from the lights' spectra, where a re-emission spectrum
+//! usually has no density. A path that re-emitted on its light subpath can then only be
+//! joined to the camera (`t = 1`, recorded at the re-emitted wavelength), which is the one
+//! strategy that makes it (MIS weight 1). So BDPT renders fluorescent light as the light
+//! tracer does: a fluorescent surface seen only through a mirror or glass is missing (the
+//! renderer warns; the path tracer re-emits on camera paths and sees it).
+//!
 //! # Limits
 //! `max_depth` counts bounces as the light tracer does: a path has at most `max_depth + 1`
 //! scattering vertices (its `max_depth = 0` is direct illumination of the first surface). Lights that do not report their [`LightSource::flags`]
@@ -129,19 +140,6 @@ pub struct MisVertex {
 /// lens, is not part of the scene: paths never hit it). Zero densities (delta vertices) count as 1, so deltas cancel. `s` must be a valid
 /// strategy; the result is in `[0, 1]`.
 pub fn mis_weight(path: &[MisVertex], s: usize, light_is_delta: bool) -> f64 {
-    mis_weight_up_to(path, s, light_is_delta, usize::MAX)
-}
-
-/// [`mis_weight`] over the strategies with at most `most_light_vertices` light vertices: the
-/// strategies that can make a path that fluoresced on its camera side (re-emission is sampled
-/// by camera subpaths only, and only next-event estimation and emission hits join them to a
-/// light at the new wavelength). `s` must be at most `most_light_vertices`.
-pub(crate) fn mis_weight_up_to(
-    path: &[MisVertex],
-    s: usize,
-    light_is_delta: bool,
-    most_light_vertices: usize,
-) -> f64 {
     let n = path.len();
     if n < 2 || s >= n {
         return 0.0;
@@ -159,7 +157,7 @@ pub(crate) fn mis_weight_up_to(
     }
     // More light vertices: strategy i + 1 takes vertex i from the light side.
     let mut r = 1.0;
-    for i in s..(n - 1).min(most_light_vertices) {
+    for i in s..n - 1 {
         r *= remap(path[i].from_light) / remap(path[i].from_camera);
         if !path[i].delta && !path[i + 1].delta {
             sum += r * r;
@@ -194,9 +192,8 @@ struct Vertex {
     pdf_fwd: f64,
     /// Area density of this vertex sampled from the other side.
     pdf_rev: f64,
-    /// The wavelength (nm) at which this vertex connects to the other subpath: the sample's
-    /// own, or, beyond a fluorescent re-emission, the new one (on a camera subpath the
-    /// wavelength the light had before it was absorbed; on a light subpath the re-emitted one).
+    /// The wavelength (nm) at which this vertex connects: the sample's own, or on a light
+    /// subpath beyond a fluorescent re-emission the re-emitted one.
     lambda: f64,
     /// This vertex re-emitted (scatters with [`reemission_lobe`] instead of its material).
     reemitted: bool,
@@ -376,17 +373,6 @@ impl<'a> Bdpt<'a> {
         self.scene.materials.get(hit.primitive as usize).map(|m| m.as_ref())
     }
 
-    /// The sample's wavelength record for the wavelength `lambda` a camera vertex connects at
-    /// (its film wavelength `wl`, or beyond a re-emission the light's wavelength, with the
-    /// light set's density there).
-    fn wavelength_at(&self, lambda: f64, wl: &Wavelength) -> Wavelength {
-        if lambda == wl.lambda {
-            *wl
-        } else {
-            Wavelength { lambda, density: self.set_spd.value(lambda) }
-        }
-    }
-
     /// A light's `(position, direction)` emission densities from `point` along `direction`
     /// (any length).
     fn light_pdfs(&self, id: LightId, point: DVec3, direction: DVec3) -> (f64, f64) {
@@ -534,7 +520,7 @@ fn generate_camera_subpath(
         1.0,
         pdf_dir,
         Transport::Radiance,
-        true,
+        false,
         max,
         &mut buffers.camera,
         rng,
@@ -583,7 +569,7 @@ fn generate_light_subpath(
         beta,
         pdf_dir,
         Transport::Importance,
-        !camera_strategies,
+        true,
         max,
         &mut buffers.light,
         rng,
@@ -623,16 +609,12 @@ fn random_walk(
         };
         let mut material: &dyn Material = material.as_ref();
         if reemit && let Some(fluorescent) = material.fluorescence() {
-            // Elastic or re-emitted, decided before any connection to this vertex; the
-            // branch's factor belongs to the vertex's scattering, so it enters `beta` here.
+            // Elastic or re-emitted (light subpaths only), decided before any connection to
+            // this vertex; the branch's factor belongs to the vertex's scattering, so it enters
+            // `beta` here.
             let (u_choice, u_lambda) = (uniform(rng), uniform(rng));
             let (mut l, mut w) = ([v.lambda], [beta]);
-            let decision = if transport == Transport::Radiance {
-                fluorescent.choose_adjoint(&mut l, &mut w, u_choice, u_lambda)
-            } else {
-                fluorescent.choose_forward(&mut l, &mut w, u_choice, u_lambda)
-            };
-            match decision {
+            match fluorescent.choose_forward(&mut l, &mut w, u_choice, u_lambda) {
                 Reemission::Elastic => {}
                 Reemission::Reemitted { lambda } => {
                     stats.reemissions += 1;
@@ -742,24 +724,19 @@ fn connect(
     let mut sampled: Option<Vertex> = None;
     let mut sampled_camera: Option<Vertex> = None;
     let mut end = *beam_light;
-    // The splat's wavelength, and whether the path fluoresced on its camera side (then only
-    // `s <= 1` strategies can make it). `wl_c` below is the wavelength at the connection: the
-    // sample's, or beyond a re-emission on the camera subpath the light's.
+    // The wavelength a `t = 1` splat is recorded at: the sample's, or beyond a re-emission
+    // on the light subpath the re-emitted one.
     let mut splat_lambda = wl.lambda;
-    let mut fluoresced = false;
     let value;
     if s == 0 {
         // The camera subpath hits an emitter.
         let pt = &camera[t - 1];
         let VertexKind::Surface(hit) = pt.kind else { return None };
-        let before = &camera[t - 2];
-        let wo = (before.point - pt.point).normalize();
+        let wo = (camera[t - 2].point - pt.point).normalize();
         let (id, le) = scene.emitted(&hit, wo)?;
         let spd = scene.light_spd(id)?;
-        let wl_c = bdpt.wavelength_at(before.lambda, wl);
-        fluoresced = before.fluoresced;
-        end = bdpt.light_end(id, &wl_c)?;
-        value = pt.beta * le * spd.value(wl_c.lambda) / wl.density;
+        end = bdpt.light_end(id, wl)?;
+        value = pt.beta * le * spd.value(wl.lambda) / wl.density;
     } else if t == 1 {
         // A light vertex seen by the camera, through a point of the lens sampled towards it
         // (the pinhole for a pinhole camera: no uniforms drawn).
@@ -810,10 +787,8 @@ fn connect(
         // Next-event estimation: a light chosen by pmf(l | lambda), a point on it.
         let pt = &camera[t - 1];
         let VertexKind::Surface(hit) = pt.kind else { return None };
-        let wl_c = bdpt.wavelength_at(pt.lambda, wl);
-        fluoresced = pt.fluoresced;
-        let id = choose_light(bdpt, &wl_c, uniform(rng))?;
-        end = bdpt.light_end(id, &wl_c)?;
+        let id = choose_light(bdpt, wl, uniform(rng))?;
+        end = bdpt.light_end(id, wl)?;
         let u = [uniform(rng), uniform(rng)];
         let source = scene.lights.light(id)?;
         let sample = source.sample_towards(pt.point, u)?;
@@ -831,10 +806,7 @@ fn connect(
         if scene.world.occluded(&shadow, distance * (1.0 - 1e-9)) {
             return None;
         }
-        // The light was chosen by pmf(l | lambda_c); the sample's wavelength density is the
-        // film wavelength's (they differ beyond a re-emission).
-        value = pt.beta * f * cos * sample.intensity / (sample.distance * sample.distance * pmf)
-            * (wl_c.density / wl.density);
+        value = pt.beta * f * cos * sample.intensity / (sample.distance * sample.distance * pmf);
         let (pdf_pos, _) = bdpt.light_pdfs(id, sample.position, sample.direction);
         sampled = Some(Vertex {
             kind: VertexKind::Light(id),
@@ -844,7 +816,7 @@ fn connect(
             delta: end.flags.delta_direction,
             pdf_fwd: end.pmf * pdf_pos,
             pdf_rev: 0.0,
-            lambda: wl_c.lambda,
+            lambda: wl.lambda,
             reemitted: false,
             fluoresced: false,
         });
@@ -854,8 +826,9 @@ fn connect(
         let (VertexKind::Surface(hq), VertexKind::Surface(hp)) = (qs.kind, pt.kind) else {
             return None;
         };
-        if qs.fluoresced || pt.fluoresced {
-            // The two subpaths travel at different wavelengths.
+        if qs.fluoresced {
+            // Beyond a re-emission the light subpath travels at another wavelength than the
+            // camera subpath: only its connection to the camera (`t = 1`) joins them.
             return None;
         }
         let f_light = bsdf(bdpt, qs, light[s - 2].point, pt.point, Transport::Importance);
@@ -890,12 +863,14 @@ fn connect(
     if !(value > 0.0 && value.is_finite()) {
         return None;
     }
-    let (weight, light_is_delta) = if camera_strategies {
+    let fluoresced = s > 0 && light[s - 1].fluoresced;
+    let (weight, light_is_delta) = if camera_strategies && !fluoresced {
         let sampled = Sampled { light: sampled.as_ref(), camera: sampled_camera.as_ref() };
         let delta = build_mis_path(bdpt, light, camera, s, t, sampled, &end, mis);
-        let most_light_vertices = if fluoresced { 1 } else { usize::MAX };
-        (mis_weight_up_to(mis, s, delta, most_light_vertices), delta)
+        (mis_weight(mis, s, delta), delta)
     } else {
+        // Without camera strategies, or for a path that fluoresced on its light subpath, the
+        // connection to the camera is the only strategy that makes the path.
         (1.0, true)
     };
     Some(Contribution {
