@@ -2,6 +2,7 @@
 #![allow(clippy::unwrap_used)]
 
 mod estimate;
+mod fluorescence;
 mod fuzz;
 mod hostile;
 mod integrators;
