@@ -9,6 +9,7 @@ mod bundles;
 mod dielectric;
 mod diffuse;
 mod dispersion;
+mod fluorescent;
 mod fresnel;
 mod harness;
 mod metal_data;
