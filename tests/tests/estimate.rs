@@ -14,7 +14,7 @@ use spectrace_spectrum::Xyz;
 use spectrace_tracer::{IntegratorChoice, MIN_BATCHES};
 
 /// A shipped scene at `width x height` pixels.
-fn small(name: &str, width: u32, height: u32) -> Scene {
+pub(crate) fn small(name: &str, width: u32, height: u32) -> Scene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes").join(name);
     let mut v: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
     v["camera"]["width"] = Value::from(width);

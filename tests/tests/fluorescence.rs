@@ -159,3 +159,15 @@ fn re_emission_turns_violet_light_green_and_an_ordinary_plane_does_not() {
     assert!(chroma(&violet) < 0.1, "plain plane: y = {}", chroma(&violet));
     assert!(chroma(&fluorescent) > 0.5, "fluorescent plane: y = {}", chroma(&fluorescent));
 }
+
+#[test]
+fn light_and_camera_estimators_agree_on_the_shipped_fluorescence_scene() {
+    // The shipped scene (white and UV lights, fluorescent and ordinary cards) at 48 x 24
+    // pixels: the light tracer against the path tracer and against BDPT, every 8x8 block and
+    // the image mean (see `assert_agree` for the tolerances).
+    let s = crate::estimate::small("fluorescence.json", 48, 24);
+    assert_eq!(spectrace_renderer::choose_integrator(&s, None).0, IntegratorChoice::Path);
+    let light = (IntegratorChoice::Light, 600_000);
+    crate::integrators::assert_agree(&s, light, (IntegratorChoice::Path, 48 * 24 * 64), 8);
+    crate::integrators::assert_agree(&s, light, (IntegratorChoice::Bdpt, 48 * 24 * 16), 8);
+}

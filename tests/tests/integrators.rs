@@ -86,7 +86,12 @@ const SPOT_OVER_PLANE: &str = r#"{
 /// Asserts that two estimators agree on `s`: image means within 4 combined standard errors, and
 /// every 8x8 block within 5 (Student's t with 7 degrees of freedom per side; with 16 blocks a
 /// correct renderer fails with probability below 1%).
-fn assert_agree(s: &Scene, a: (IntegratorChoice, u64), b: (IntegratorChoice, u64), seeds: u64) {
+pub(crate) fn assert_agree(
+    s: &Scene,
+    a: (IntegratorChoice, u64),
+    b: (IntegratorChoice, u64),
+    seeds: u64,
+) {
     let (w, h) = (s.camera.width() as usize, s.camera.height() as usize);
     let run = |(integrator, effort): (IntegratorChoice, u64)| -> Vec<_> {
         (0..seeds).map(|k| render_with(s, integrator, effort, 77 + k).image).collect::<Vec<_>>()
