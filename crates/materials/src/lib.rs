@@ -14,6 +14,7 @@
 //! | [`Diffuse`] | Lambertian, spectral reflectance, two-sided | one, cosine-sampled |
 //! | [`Mirror`] | perfect reflection, spectral reflectance, two-sided | one delta |
 //! | [`Dielectric`] | Fresnel reflection + Snell refraction, total internal reflection, dispersion | two deltas |
+| [`Fluorescent`] | absorbs and re-emits at other wavelengths (bispectral) over a Lambertian base | elastic Lambertian + re-emission ([`Material::fluorescence`]) |
 //!
 //! The key design decision is that every property is a function of wavelength, evaluated per
 //! beam: reflectances are [`Reflectance`](spectrace_spectrum::Reflectance) spectra and indices of
