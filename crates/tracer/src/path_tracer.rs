@@ -17,6 +17,12 @@
 //!   refraction scales radiance by `(n_i / n_t)^2`); specular chains are followed, so glass and
 //!   mirrors show what they reflect and refract.
 //! - After `rr_depth` bounces, Russian roulette with survival `min(1, max_j beta_j)`.
+//! - **Fluorescence**: at a fluorescent surface the path first chooses between the elastic part
+//!   and re-emission ([`spectrace_materials::Fluorescent::choose_adjoint`]). Re-emission draws the
+//!   wavelength the light had before it was absorbed from the absorption spectrum; every hero
+//!   wavelength then *travels* at it (the kernel is separable) while the film still records each
+//!   at its own wavelength, and next-event estimation and the next direction use the white
+//!   re-emission lobe. Scenes without fluorescent materials never draw the choice's uniforms.
 //!
 //! The film holds the sum of the samples' XYZ (`sum_j cmf(lambda_j) L_j / (HERO p(lambda_j))`,
 //! divided by the integral of `ybar`, as the light tracer's units) relative to the lights' total
