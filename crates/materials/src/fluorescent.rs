@@ -119,6 +119,18 @@ impl Serialize for Fluorescent {
     }
 }
 
+/// How a camera path draws the wavelength light had before it was re-emitted
+/// ([`Fluorescent::choose_adjoint`]): by default with density `a / A`; guided by the spectrum of
+/// the light that reaches the scene, with the mixture `q = (a / A + a s / B) / 2` (`s` the
+/// lights' spectrum, `B = integral a s`), which puts the samples where something both absorbs
+/// and is lit, and keeps a density wherever anything absorbs (light re-emitted by another
+/// fluorescent surface can arrive at wavelengths no light emits).
+#[derive(Debug, Clone)]
+pub struct ExcitationSampler {
+    /// `a s` tabulated at 1 nm over the absorption's range; `None` when it is zero everywhere.
+    guided: Option<PiecewiseLinear>,
+}
+
 /// What [`Fluorescent::choose_forward`] and [`Fluorescent::choose_adjoint`] decided.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Reemission {
@@ -277,6 +289,43 @@ impl Fluorescent {
         self.absorption.pdf(lambda)
     }
 
+    /// An [`ExcitationSampler`] guided by `light(lambda)`, the spectral density of the light
+    /// that reaches the scene (any positive scale; e.g. the light set's SPD): `a light` is
+    /// tabulated at 1 nm steps over the absorption table's range.
+    pub fn excitation_sampler(&self, light: &dyn Fn(f64) -> f64) -> ExcitationSampler {
+        let (lo, hi) = self.absorption.range();
+        let steps = ((hi - lo).ceil() as usize).clamp(1, 100_000);
+        let xs: Vec<f64> = (0..=steps).map(|i| lo + (hi - lo) * i as f64 / steps as f64).collect();
+        let ys: Vec<f64> = xs
+            .iter()
+            .map(|&l| {
+                let v = self.absorbed(l) * light(l);
+                if v.is_finite() && v > 0.0 { v } else { 0.0 }
+            })
+            .collect();
+        ExcitationSampler { guided: PiecewiseLinear::new(&xs, &ys).ok() }
+    }
+
+    /// A wavelength drawn by `sampler` (`None`: the density `a / A`) from one uniform, and its
+    /// density (nm^-1).
+    pub fn sample_excitation_with(
+        &self,
+        sampler: Option<&ExcitationSampler>,
+        u: f64,
+    ) -> (f64, f64) {
+        let u = clamp_uniform(u);
+        let Some(guided) = sampler.and_then(|s| s.guided.as_ref()) else {
+            let lambda = self.absorption.sample(u);
+            return (lambda, self.absorption.pdf(lambda));
+        };
+        let lambda = if u < 0.5 {
+            self.absorption.sample(2.0 * u)
+        } else {
+            guided.sample((2.0 * u - 1.0).min(spectrace_sampling::ONE_MINUS_EPSILON))
+        };
+        (lambda, 0.5 * (self.absorption.pdf(lambda) + guided.pdf(lambda)))
+    }
+
     /// The branch at a fluorescent vertex on a path from a light (flux), for a bundle of
     /// wavelengths `lambdas` with weights `weights` (live where `> 0`): re-emission with
     /// probability `p = sum w Y a / sum w (Y a + (1 - a) R)`, chosen by `u_choice`.
@@ -319,11 +368,13 @@ impl Fluorescent {
     /// `p = sum w Y e A / sum w (Y e A + (1 - a) R)` over the live wavelengths (`e` at each
     /// one's `lambda_o`).
     ///
-    /// * Re-emission: one excitation wavelength `lambda_i` is drawn from `a / A` with
-    ///   `u_lambda`, and *every* live wavelength continues at it (the kernel is separable, so
-    ///   the source wavelength is the same for all): `lambdas[j] = lambda_i`, and each weight is
-    ///   multiplied by `Y e(lambda_o_j) A / p`. The caller keeps the wavelengths the path's
-    ///   values are recorded at (its film wavelengths) separately.
+    /// * Re-emission: one excitation wavelength `lambda_i` is drawn by `sampler` (density `q`;
+    ///   `None`: `q = a / A`) with `u_lambda`, and *every* live wavelength continues at it (the
+    ///   kernel is separable, so the source wavelength is the same for all):
+    ///   `lambdas[j] = lambda_i`, and each weight is multiplied by
+    ///   `Y e(lambda_o_j) a(lambda_i) / (q(lambda_i) p)` (`Y e A / p` for the default). The
+    ///   caller keeps the wavelengths the path's values are recorded at (its film wavelengths)
+    ///   separately.
     /// * Elastic: every live weight is divided by `1 - p`.
     pub fn choose_adjoint(
         &self,
@@ -331,6 +382,7 @@ impl Fluorescent {
         weights: &mut [f64],
         u_choice: f64,
         u_lambda: f64,
+        sampler: Option<&ExcitationSampler>,
     ) -> Reemission {
         let (mut reemit, mut elastic) = (0.0, 0.0);
         for (&w, &l) in weights.iter().zip(lambdas.iter()) {
@@ -345,10 +397,20 @@ impl Fluorescent {
         if !(p > 0.0) {
             return Reemission::Absorbed;
         }
-        let lambda = self.sample_excitation(u_lambda);
+        let (lambda, q) = self.sample_excitation_with(sampler, u_lambda);
+        // Y e(lambda_o) a(lambda_i) / q(lambda_i): with q = a / A exactly Y e A.
+        let scale = if sampler.is_some() { self.absorbed(lambda) / q } else { f64::NAN };
+        if !(q > 0.0) || scale.is_infinite() {
+            weights.fill(0.0);
+            return Reemission::Absorbed;
+        }
         for (w, l) in weights.iter_mut().zip(lambdas.iter_mut()) {
             if *w > 0.0 {
-                *w *= self.adjoint_reemitted(*l) / p;
+                *w *= if scale.is_nan() {
+                    self.adjoint_reemitted(*l)
+                } else {
+                    self.quantum_yield * self.emission.value(*l) * scale
+                } / p;
                 *l = lambda;
             }
         }

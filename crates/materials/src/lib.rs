@@ -14,7 +14,7 @@
 //! | [`Diffuse`] | Lambertian, spectral reflectance, two-sided | one, cosine-sampled |
 //! | [`Mirror`] | perfect reflection, spectral reflectance, two-sided | one delta |
 //! | [`Dielectric`] | Fresnel reflection + Snell refraction, total internal reflection, dispersion | two deltas |
-| [`Fluorescent`] | absorbs and re-emits at other wavelengths (bispectral) over a Lambertian base | elastic Lambertian + re-emission ([`Material::fluorescence`]) |
+//! | [`Fluorescent`] | absorbs and re-emits at other wavelengths (bispectral) over a Lambertian base | elastic Lambertian + re-emission ([`Material::fluorescence`]) |
 //!
 //! The key design decision is that every property is a function of wavelength, evaluated per
 //! beam: reflectances are [`Reflectance`](spectrace_spectrum::Reflectance) spectra and indices of
@@ -55,7 +55,7 @@ mod vectors;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
 pub use error::MaterialError;
-pub use fluorescent::{Fluorescent, Reemission, reemission_lobe};
+pub use fluorescent::{ExcitationSampler, Fluorescent, Reemission, reemission_lobe};
 pub use fresnel::{Polarised, fresnel_dielectric, fresnel_dielectric_polarised, reflect, refract};
 pub use glass::{GLASSES, Glass, find_glass, known_glasses};
 pub use ior::{FRAUNHOFER_C_NM, FRAUNHOFER_D_NM, FRAUNHOFER_F_NM, Ior, VALID_MAX_NM, VALID_MIN_NM};

@@ -19,7 +19,9 @@
 //! - After `rr_depth` bounces, Russian roulette with survival `min(1, max_j beta_j)`.
 //! - **Fluorescence**: at a fluorescent surface the path first chooses between the elastic part
 //!   and re-emission ([`spectrace_materials::Fluorescent::choose_adjoint`]). Re-emission draws the
-//!   wavelength the light had before it was absorbed from the absorption spectrum; every hero
+//!   wavelength the light had before it was absorbed from the absorption spectrum, half the time
+//!   times the lights' spectrum ([`ExcitationSampler`]: where light is both absorbed and
+//!   emitted); every hero
 //!   wavelength then *travels* at it (the kernel is separable) while the film still records each
 //!   at its own wavelength, and next-event estimation and the next direction use the white
 //!   re-emission lobe. Scenes without fluorescent materials never draw the choice's uniforms.
@@ -46,7 +48,9 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use spectrace_geometry::{Hit, Ray};
 use spectrace_lights::{LightId, LightSource, uniform};
-use spectrace_materials::{Material, Reemission, ScatterKind, Transport, reemission_lobe};
+use spectrace_materials::{
+    ExcitationSampler, Material, Reemission, ScatterKind, Transport, reemission_lobe,
+};
 use spectrace_sampling::Discrete;
 use spectrace_spectrum::{CIE_Y_INTEGRAL, Xyz, cmf};
 
@@ -102,6 +106,9 @@ pub struct PathTracer<'a> {
     /// The light sampler for the other lights (area lights, glowing objects): chosen by power,
     /// `None` when there are none.
     area_lights: Option<(Discrete, Vec<LightId>)>,
+    /// Per material (by shape index), for fluorescent ones: the sampler of the wavelength light
+    /// had before re-emission, guided by the lights' spectrum (empty without fluorescence).
+    excitation: Vec<Option<ExcitationSampler>>,
 }
 
 impl<'a> PathTracer<'a> {
@@ -131,7 +138,18 @@ impl<'a> PathTracer<'a> {
             }
         }
         let area_lights = Discrete::new(&powers).ok().map(|d| (d, ids));
-        Self { scene, settings, effects, delta_lights, area_lights }
+        let excitation = if scene.materials.iter().any(|m| m.fluorescence().is_some()) {
+            let lights = LightSource::spd(scene.lights);
+            let spectrum = |l: f64| lights.value(l);
+            scene
+                .materials
+                .iter()
+                .map(|m| m.fluorescence().map(|f| f.excitation_sampler(&spectrum)))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        Self { scene, settings, effects, delta_lights, area_lights, excitation }
     }
 
     /// Probability with which next-event estimation chooses light `id` among the area lights.
@@ -233,7 +251,14 @@ impl<'a> PathTracer<'a> {
                 // Elastic or re-emitted, decided before next-event estimation so that both it
                 // and the BSDF sample use the same lobe at the same wavelength.
                 let (u_choice, u_lambda) = (uniform(rng), uniform(rng));
-                match fluorescent.choose_adjoint(&mut transport, &mut beta, u_choice, u_lambda) {
+                let guide = self.excitation.get(hit.primitive as usize).and_then(Option::as_ref);
+                match fluorescent.choose_adjoint(
+                    &mut transport,
+                    &mut beta,
+                    u_choice,
+                    u_lambda,
+                    guide,
+                ) {
                     Reemission::Elastic => {}
                     Reemission::Reemitted { .. } => {
                         stats.reemissions += 1;

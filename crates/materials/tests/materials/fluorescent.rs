@@ -93,7 +93,12 @@ fn excitation_wavelengths_follow_the_absorption_and_the_adjoint_matches_the_kern
     assert!(chi.p_value > ALPHA, "{chi:?}");
     // A = integral a = 80 * 0.8 / 2 + 70 * 0.7 + 50 * 0.6 / 2 = 32 + 49 + 15 = 96 nm.
     assert!((m.absorption_integral() - 96.0).abs() < 1e-9, "{}", m.absorption_integral());
-    for lambda_o in [490.0, 530.0, 570.0] {
+    // The guided sampler (absorption times a light spectrum peaking at 380 nm, mixed with the
+    // absorption alone) must give the same expected weight.
+    let guide = m.excitation_sampler(&|l: f64| (-(l - 380.0).powi(2) / 800.0).exp());
+    for (lambda_o, sampler) in
+        [(490.0, None), (530.0, None), (570.0, None), (490.0, Some(&guide)), (530.0, Some(&guide))]
+    {
         let quadrature: f64 = (0..2000)
             .map(|i| {
                 let l = 300.0 + 200.0 * (i as f64 + 0.5) / 2000.0;
@@ -110,7 +115,13 @@ fn excitation_wavelengths_follow_the_absorption_and_the_adjoint_matches_the_kern
         let k = 40_000;
         for _ in 0..k {
             let (mut l, mut w) = ([lambda_o], [1.0]);
-            let v = match m.choose_adjoint(&mut l, &mut w, uniform(&mut rng), uniform(&mut rng)) {
+            let v = match m.choose_adjoint(
+                &mut l,
+                &mut w,
+                uniform(&mut rng),
+                uniform(&mut rng),
+                sampler,
+            ) {
                 Reemission::Reemitted { lambda } => {
                     assert_eq!(l[0], lambda);
                     assert!(m.absorbed(lambda) > 0.0, "excited where nothing absorbs: {lambda}");
