@@ -15,6 +15,8 @@
 //! | [`Mirror`] | perfect reflection, spectral reflectance, two-sided | one delta |
 //! | [`Dielectric`] | Fresnel reflection + Snell refraction, total internal reflection, dispersion | two deltas |
 //! | [`Fluorescent`] | absorbs and re-emits at other wavelengths (bispectral) over a Lambertian base | elastic Lambertian + re-emission ([`Material::fluorescence`]) |
+//! | [`RoughDielectric`] | frosted glass: GGX microfacet reflection + refraction (Walter 2007), dispersion, anisotropy | two with densities (roughness 0: `Dielectric`'s deltas) |
+//! | [`Plastic`] | a smooth or GGX-rough dielectric coating over a Lambertian base, two-sided | a delta (smooth) or GGX reflection, plus a cosine-sampled diffuse |
 //!
 //! The key design decision is that every property is a function of wavelength, evaluated per
 //! beam: reflectances are [`Reflectance`](spectrace_spectrum::Reflectance) spectra and indices of
@@ -50,6 +52,8 @@ mod ior;
 mod material;
 mod microfacet;
 mod mirror;
+mod plastic;
+mod rough_dielectric;
 mod vectors;
 
 pub use dielectric::Dielectric;
@@ -65,6 +69,8 @@ pub use material::{
 };
 pub use microfacet::{Ggx, SMOOTH_ALPHA, fresnel_conductor};
 pub use mirror::Mirror;
+pub use plastic::Plastic;
+pub use rough_dielectric::RoughDielectric;
 
 /// Vectors (`DVec3`), re-exported so users need no direct dependency.
 pub use glam;

@@ -124,10 +124,13 @@ pub trait Material: Send + Sync + Debug {
     /// times the camera's importance.
     fn eval(&self, wi: DVec3, wo: DVec3, normal: DVec3, lambda: f64) -> f64;
 
-    /// [`eval`](Self::eval) for a path carrying `transport`: the BSDF as radiance sees it
-    /// ([`Transport::Radiance`], camera paths) or its adjoint ([`Transport::Importance`], light
-    /// paths). The two differ only for non-delta transmission (by `eta^2`); the default ignores
-    /// `transport`, which is right for every material that has none.
+    /// [`eval`](Self::eval) for a path carrying `transport`. Because `eval` always takes its
+    /// directions in the order light flows (`wi` towards the light, `wo` towards the viewer),
+    /// the value is the radiance BSDF `f(wi -> wo)` for both transports: the adjoint a light
+    /// path needs is this same value, read with the light's order rather than the path's (for
+    /// transmission `f(wi -> wo) / n_o^2 = f(wo -> wi) / n_i^2`, so swapping the arguments is
+    /// what would change it). Every material here returns `eval`; the parameter is kept for
+    /// materials whose value depends on what the path carries.
     fn eval_with(
         &self,
         wi: DVec3,

@@ -90,7 +90,25 @@ pub(crate) fn chi2_directions(
     seed: u64,
     grid: Grid,
 ) -> Chi2Result {
-    let frame = Frame::from_normal(normal);
+    chi2_directions_around(material, wi, normal, normal, lambda, n, seed, grid)
+}
+
+/// [`chi2_directions`] with the grid's pole along `axis` instead of the normal. A sharp lobe
+/// should lie on the grid's equator (pass an axis perpendicular to the lobe's centre, e.g.
+/// [`axis_across`]), where the bins are as fine in `theta` as in `cos theta`; near a pole the
+/// equal-area bins are wide in angle and a lobe narrower than one sub-cell is integrated wrongly.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn chi2_directions_around(
+    material: &dyn Material,
+    wi: DVec3,
+    normal: DVec3,
+    axis: DVec3,
+    lambda: f64,
+    n: u64,
+    seed: u64,
+    grid: Grid,
+) -> Chi2Result {
+    let frame = Frame::from_normal(axis);
     let mut rng = Pcg64::seed_from_u64(seed);
     let mut observed = vec![0u64; grid.cos_bins * grid.phi_bins];
     let mut deltas = 0u64;
@@ -111,6 +129,18 @@ pub(crate) fn chi2_directions(
     let pdf_integral = expected.iter().sum::<f64>() / n as f64;
     let chi = chi_square(&observed, &expected, 5.0);
     Chi2Result { p_value: chi.p_value, delta_fraction: deltas as f64 / n as f64, pdf_integral }
+}
+
+/// A unit axis perpendicular to both `normal` and `centre` (any tangent if they are parallel):
+/// the pole for a grid that puts a lobe around `centre` on its equator.
+pub(crate) fn axis_across(normal: DVec3, centre: DVec3) -> DVec3 {
+    let c = normal.cross(centre);
+    if c.length_squared() > 1e-12 { c.normalize() } else { Frame::from_normal(normal).t() }
+}
+
+/// The integral of `f` over the sphere on `grid` with its pole along `axis`.
+pub(crate) fn integrate_sphere(axis: DVec3, grid: Grid, f: impl Fn(DVec3) -> f64) -> f64 {
+    grid.integrate(&Frame::from_normal(axis), f).iter().sum()
 }
 
 /// Integral of `pdf(wi, ., normal, lambda)` over the sphere.

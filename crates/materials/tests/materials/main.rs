@@ -14,7 +14,9 @@ mod fresnel;
 mod harness;
 mod metal_data;
 mod mirror;
+mod plastic;
 mod properties;
+mod rough_dielectric;
 mod serde_forms;
 
 use glam::DVec3;
