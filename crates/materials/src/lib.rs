@@ -39,6 +39,7 @@
 //! assert!(glass.is_specular() && glass.is_dispersive());
 //! ```
 
+mod conductor;
 mod dielectric;
 mod diffuse;
 mod error;
@@ -46,10 +47,12 @@ mod fresnel;
 mod glass;
 mod ior;
 mod material;
+pub mod metals;
 mod microfacet;
 mod mirror;
 mod vectors;
 
+pub use conductor::{Conductor, RoughConductor};
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
 pub use error::MaterialError;
@@ -60,6 +63,7 @@ pub use material::{
     BundleScattered, Incoming, Material, ScatterKind, Scattered, Transport, scale_bundle,
     scatter_each,
 };
+pub use metals::{ComplexIor, Metal, find_metal, known_metals};
 pub use microfacet::{Ggx, SMOOTH_ALPHA, fresnel_conductor};
 pub use mirror::Mirror;
 
