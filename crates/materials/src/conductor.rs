@@ -31,9 +31,12 @@
 //! normals seen from `wi` (Heitz 2018, [`Ggx::sample_visible`]), so the weight is
 //! `F G(wi, wo) / G1(wi)` (at most `F`) and the density `D_wi(h) / (4 wi . h)`. Directions that
 //! this reflection sends below the surface are absorbed (`None`): `pdf` integrates to less than
-//! 1 by exactly their fraction, and the single-scattering model loses that energy (the known
-//! microfacet energy loss, several percent at alpha 0.5 and up to about a third at alpha 1 near
-//! grazing incidence for a perfect reflector). `roughness` is the GGX alpha itself, not
+//! 1 by exactly their fraction, and the single-scattering model loses that energy: the known
+//! microfacet energy loss (light that would scatter again between microfacets). For a perfect
+//! reflector the albedo measured at normal incidence is 0.997 / 0.877 / 0.592 / 0.307 for
+//! alpha 0.05 / 0.3 / 0.6 / 1, and 0.953 / 0.848 / 0.779 / 0.668 at 80 degrees from the
+//! normal; at normal incidence the facets steeper than 45 degrees, a fraction
+//! `alpha^2 / (1 + alpha^2)`, reflect below the surface. `roughness` is the GGX alpha itself, not
 //! remapped (Mitsuba 3's `alpha`, pbrt-v4's unremapped roughness). Below [`SMOOTH_ALPHA`] in
 //! both directions a `RoughConductor` behaves exactly as the [`Conductor`] with the same index
 //! (same results for the same uniforms, [`is_specular`](Material::is_specular) true).
