@@ -14,6 +14,12 @@
 //! | [`Diffuse`] | Lambertian, spectral reflectance, two-sided | one, cosine-sampled |
 //! | [`Mirror`] | perfect reflection, spectral reflectance, two-sided | one delta |
 //! | [`Dielectric`] | Fresnel reflection + Snell refraction, total internal reflection, dispersion | two deltas |
+//! | [`Conductor`] | smooth metal: exact Fresnel reflectance of a complex index `eta + i k` per wavelength, two-sided | one delta |
+//! | [`RoughConductor`] | rough metal: GGX microfacets, visible-normal sampling, Smith height-correlated shadowing, isotropic or anisotropic; roughness 0 is the [`Conductor`] | one with a density |
+//!
+//! Metals come from the [`metals`] catalog of measured `n, k` tables (`"metal": "Au"`; Ag Al Au Cr
+//! Cu Ni Pt Ti W, 350-850 nm, sources in `data/metals/README.md`) or from user `eta` / `k` tables
+//! ([`ComplexIor`]).
 //!
 //! The key design decision is that every property is a function of wavelength, evaluated per
 //! beam: reflectances are [`Reflectance`](spectrace_spectrum::Reflectance) spectra and indices of
