@@ -74,7 +74,7 @@ const ROUGH_FLOOR: &str = r#"{
 #[test]
 fn a_rough_metal_looks_the_same_to_every_integrator() {
     let s = scene(ROUGH_FLOOR);
-    let seeds = 6u64;
+    let seeds = 8u64;
     let mut results = Vec::new();
     for integrator in INTEGRATORS {
         let effort = if integrator == IntegratorChoice::Light { 400_000 } else { 16 * 12 * 32 };
@@ -109,7 +109,10 @@ fn a_rough_metal_looks_the_same_to_every_integrator() {
             let (a, sa) = stats[c];
             let (b, sb) = reference[c];
             let tolerance = 4.0 * (sa * sa + sb * sb).sqrt();
-            assert!((a - b).abs() < tolerance, "{integrator:?} channel {c}: {a} vs path {b} (+- {tolerance})");
+            assert!(
+                (a - b).abs() < tolerance,
+                "{integrator:?} channel {c}: {a} vs path {b} (+- {tolerance})"
+            );
         }
     }
 }
