@@ -30,6 +30,18 @@ pub enum MaterialError {
         /// The catalog's names and aliases, comma-separated.
         known: String,
     },
+    /// A metal symbol that the catalog does not know.
+    #[error("{}: unknown metal `{name}`; known: {known}", path(material, field))]
+    UnknownMetal {
+        /// The type at fault.
+        material: &'static str,
+        /// The field path, e.g. `"metal"`.
+        field: String,
+        /// The symbol given.
+        name: String,
+        /// The catalog's symbols, comma-separated.
+        known: String,
+    },
 }
 
 /// `material.field`, or `material` alone for an empty field.
@@ -66,6 +78,26 @@ impl MaterialError {
             Self::UnknownGlass { field: inner, name, known, .. } => {
                 Self::UnknownGlass { material, field: nest(inner), name, known }
             }
+            Self::UnknownMetal { field: inner, name, known, .. } => {
+                Self::UnknownMetal { material, field: nest(inner), name, known }
+            }
+        }
+    }
+
+    /// The same error attributed to `material`, field path unchanged: an error of a component
+    /// whose fields are written at the top level of the material (`ComplexIor.eta.values[3]`
+    /// becomes `RoughConductor.eta.values[3]`).
+    pub fn in_material(self, material: &'static str) -> Self {
+        match self {
+            Self::Parameter { field, value, reason, .. } => {
+                Self::Parameter { material, field, value, reason }
+            }
+            Self::UnknownGlass { field, name, known, .. } => {
+                Self::UnknownGlass { material, field, name, known }
+            }
+            Self::UnknownMetal { field, name, known, .. } => {
+                Self::UnknownMetal { material, field, name, known }
+            }
         }
     }
 
@@ -73,7 +105,8 @@ impl MaterialError {
     pub fn field_path(&self) -> String {
         match self {
             Self::Parameter { material, field, .. }
-            | Self::UnknownGlass { material, field, .. } => path(material, field),
+            | Self::UnknownGlass { material, field, .. }
+            | Self::UnknownMetal { material, field, .. } => path(material, field),
         }
     }
 }

@@ -293,7 +293,7 @@ fn sellmeier(b: &[f64], c: &[f64], lambda_nm: f64) -> f64 {
 }
 
 #[inline]
-fn interpolate(xs: &[f64], ys: &[f64], x: f64) -> f64 {
+pub(crate) fn interpolate(xs: &[f64], ys: &[f64], x: f64) -> f64 {
     let last = xs.len() - 1;
     if last == 0 || !(x > xs[0]) {
         return ys[0];

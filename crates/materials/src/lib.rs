@@ -17,6 +17,12 @@
 //! | [`Fluorescent`] | absorbs and re-emits at other wavelengths (bispectral) over a Lambertian base | elastic Lambertian + re-emission ([`Material::fluorescence`]) |
 //! | [`RoughDielectric`] | frosted glass: GGX microfacet reflection + refraction (Walter 2007), dispersion, anisotropy | two with densities (roughness 0: `Dielectric`'s deltas) |
 //! | [`Plastic`] | a smooth or GGX-rough dielectric coating over a Lambertian base, two-sided | a delta (smooth) or GGX reflection, plus a cosine-sampled diffuse |
+//! | [`Conductor`] | smooth metal: exact Fresnel reflectance of a complex index `eta + i k` per wavelength, two-sided | one delta |
+//! | [`RoughConductor`] | rough metal: GGX microfacets, visible-normal sampling, Smith height-correlated shadowing, isotropic or anisotropic; roughness 0 is the [`Conductor`] | one with a density |
+//!
+//! Metals come from the [`metals`] catalog of measured `n, k` tables (`"metal": "Au"`; Ag Al Au Cr
+//! Cu Ni Pt Ti W, 350-850 nm, sources in `data/metals/README.md`) or from user `eta` / `k` tables
+//! ([`ComplexIor`]).
 //!
 //! The key design decision is that every property is a function of wavelength, evaluated per
 //! beam: reflectances are [`Reflectance`](spectrace_spectrum::Reflectance) spectra and indices of
@@ -42,6 +48,7 @@
 //! assert!(glass.is_specular() && glass.is_dispersive());
 //! ```
 
+mod conductor;
 mod dielectric;
 mod diffuse;
 mod error;
@@ -50,12 +57,14 @@ mod fresnel;
 mod glass;
 mod ior;
 mod material;
+pub mod metals;
 mod microfacet;
 mod mirror;
 mod plastic;
 mod rough_dielectric;
 mod vectors;
 
+pub use conductor::{Conductor, RoughConductor};
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
 pub use error::MaterialError;
@@ -67,6 +76,7 @@ pub use material::{
     BundleScattered, Incoming, Material, ScatterKind, Scattered, Transport, scale_bundle,
     scatter_each,
 };
+pub use metals::{ComplexIor, Metal, find_metal, known_metals};
 pub use microfacet::{Ggx, SMOOTH_ALPHA, fresnel_conductor};
 pub use mirror::Mirror;
 pub use plastic::Plastic;

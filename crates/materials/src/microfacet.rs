@@ -38,7 +38,7 @@ pub struct Ggx {
 impl Ggx {
     /// A distribution with roughness `alpha_x` along the first tangent (`+x`) and `alpha_y`
     /// along the second (`+y`). Alphas below [`SMOOTH_ALPHA`] are raised to it, so every
-    /// function stays finite; callers check [`Ggx::is_smooth`] first to use a delta lobe.
+    /// function stays finite; callers check [`Ggx::is_smooth_alphas`] first to use a delta lobe.
     pub fn new(alpha_x: f64, alpha_y: f64) -> Self {
         Self { alpha_x: alpha_x.max(SMOOTH_ALPHA), alpha_y: alpha_y.max(SMOOTH_ALPHA) }
     }

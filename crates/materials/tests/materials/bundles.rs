@@ -6,7 +6,10 @@ use glam::DVec3;
 use rand::SeedableRng;
 use rand_pcg::Pcg64;
 use spectrace_materials::spectrum::{Reflectance, Transmittance};
-use spectrace_materials::{Dielectric, Diffuse, Ior, Material, Mirror, Transport, scatter_each};
+use spectrace_materials::{
+    ComplexIor, Conductor, Dielectric, Diffuse, Ior, Material, Mirror, RoughConductor, Transport,
+    scatter_each,
+};
 
 use crate::{random_unit, uniform};
 
@@ -18,11 +21,23 @@ fn materials() -> Vec<Box<dyn Material>> {
     vec![
         Box::new(Diffuse::new(ramp.clone())),
         Box::new(Diffuse::new(Reflectance::constant(0.7).unwrap())),
-        Box::new(Mirror::new(ramp)),
+        Box::new(Mirror::new(ramp.clone())),
         Box::new(Dielectric::new(Ior::constant(1.5).unwrap(), None)),
         Box::new(Dielectric::new(Ior::constant(1.7).unwrap(), Some(t.clone()))),
         // Dispersive: falls back to the general way, companions dropped on refraction.
         Box::new(Dielectric::new(Ior::glass("SF11").unwrap(), Some(t))),
+        Box::new(Conductor::metal("Au").unwrap()),
+        Box::new(Conductor::new(ComplexIor::metal("Cu").unwrap(), Some(ramp.clone()))),
+        Box::new(RoughConductor::metal("Ag", 0.0).unwrap()),
+        Box::new(RoughConductor::metal("Au", 0.3).unwrap()),
+        Box::new(
+            RoughConductor::isotropic(ComplexIor::metal("Cr").unwrap(), 0.8, Some(ramp.clone()))
+                .unwrap(),
+        ),
+        Box::new(
+            RoughConductor::new(ComplexIor::metal("Ti").unwrap(), 0.05, 0.5, Some(ramp.clone()))
+                .unwrap(),
+        ),
     ]
 }
 
@@ -51,7 +66,7 @@ fn scatter_bundle_matches_scattering_each_wavelength() {
         }
     }
     // The comparison is not vacuous: most bundles scatter.
-    assert!(scattered > 6 * 2 * 4000 / 2, "{scattered}");
+    assert!(scattered > 12 * 2 * 4000 / 2, "{scattered}");
 }
 
 #[test]

@@ -6,6 +6,7 @@
 #![allow(clippy::unwrap_used)]
 
 mod bundles;
+mod conductor;
 mod dielectric;
 mod diffuse;
 mod dispersion;
