@@ -1,13 +1,13 @@
 //! Cross-crate tests: contracts between the Spectrace crates that no single crate can check.
 #![allow(clippy::unwrap_used)]
 
-mod conductors;
 mod estimate;
 mod fluorescence;
 mod fuzz;
 mod hostile;
 mod integrators;
 mod rendering;
+mod rough_materials;
 mod variance;
 
 use rand::SeedableRng;

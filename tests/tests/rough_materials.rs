@@ -1,5 +1,6 @@
-//! Conductors in whole renders: a `RoughConductor` of roughness 0 (and 1e-4) gives the smooth
-//! `Conductor`'s image bit for bit in every integrator, and a rough metal looks the same to the
+//! The rough materials in whole renders: at roughness 0 (and 1e-4) `RoughConductor`,
+//! `RoughDielectric` and a rough `Plastic` give the smooth material's image bit for bit in every
+//! integrator, and a rough metal, frosted glass and a rough plastic each look the same to the
 //! light tracer, the path tracer and BDPT.
 
 use spectrace_renderer::Scene;
@@ -34,15 +35,14 @@ fn total_y(image: &[Xyz]) -> f64 {
     image.iter().map(|p| p.y).sum()
 }
 
-#[test]
-fn roughness_zero_renders_the_smooth_conductor_bit_for_bit() {
-    // Same uniforms, same results: the smooth branch of RoughConductor is the Conductor's code,
-    // and `is_specular` is true for both, so every integrator draws the same numbers.
-    let smooth = sphere_scene(r#"{"type": "Conductor", "metal": "Cu"}"#);
+/// Asserts that `rough(roughness)` renders `smooth`'s image bit for bit in every integrator
+/// for roughness 0 and 1e-4 (same uniforms, same results: below `SMOOTH_ALPHA` the rough
+/// materials run the smooth code, and `is_specular` agrees), and that roughness 0.01 does not
+/// (so the comparison can fail).
+fn assert_roughness_zero_is_smooth(smooth: &str, rough: impl Fn(&str) -> String) {
+    let smooth = sphere_scene(smooth);
     for roughness in ["0", "0.0001"] {
-        let rough = sphere_scene(&format!(
-            r#"{{"type": "RoughConductor", "metal": "Cu", "roughness": {roughness}}}"#
-        ));
+        let rough = sphere_scene(&rough(roughness));
         for integrator in INTEGRATORS {
             let effort = if integrator == IntegratorChoice::Light { 200_000 } else { 24 * 16 * 8 };
             let a = render_with(&smooth, integrator, effort, 3);
@@ -51,11 +51,28 @@ fn roughness_zero_renders_the_smooth_conductor_bit_for_bit() {
             assert_eq!(a.image, b.image, "{integrator:?}, roughness {roughness}");
         }
     }
-    // The comparison can fail: a rough copper sphere gives another image.
-    let rougher = sphere_scene(r#"{"type": "RoughConductor", "metal": "Cu", "roughness": 0.01}"#);
+    let rougher = sphere_scene(&rough("0.01"));
     let a = render_with(&smooth, IntegratorChoice::Path, 24 * 16 * 8, 3);
     let b = render_with(&rougher, IntegratorChoice::Path, 24 * 16 * 8, 3);
     assert_ne!(a.image, b.image);
+}
+
+#[test]
+fn roughness_zero_renders_the_smooth_conductor_bit_for_bit() {
+    assert_roughness_zero_is_smooth(r#"{"type": "Conductor", "metal": "Cu"}"#, |r| {
+        format!(r#"{{"type": "RoughConductor", "metal": "Cu", "roughness": {r}}}"#)
+    });
+}
+
+#[test]
+fn roughness_zero_renders_the_smooth_dielectric_and_plastic_bit_for_bit() {
+    assert_roughness_zero_is_smooth(r#"{"type": "Dielectric", "ior": {"glass": "BK7"}}"#, |r| {
+        format!(r#"{{"type": "RoughDielectric", "ior": {{"glass": "BK7"}}, "roughness": {r}}}"#)
+    });
+    assert_roughness_zero_is_smooth(
+        r#"{"type": "Plastic", "reflectance": 0.4, "ior": 1.5}"#,
+        |r| format!(r#"{{"type": "Plastic", "reflectance": 0.4, "ior": 1.5, "roughness": {r}}}"#),
+    );
 }
 
 /// A rough metal floor seen from above, lit by a rectangle light: all the light the camera sees
@@ -71,16 +88,18 @@ const ROUGH_FLOOR: &str = r#"{
               "edge_v": [0, 0, 0.4], "power": 30, "spd": {"type": "CieIlluminant", "name": "D65"}}]
 }"#;
 
-#[test]
-fn a_rough_metal_looks_the_same_to_every_integrator() {
-    let s = scene(ROUGH_FLOOR);
+/// Asserts that the light tracer, the path tracer and BDPT give the same image totals of X, Y
+/// and Z on `s`: each mean over 8 seeds known to 2%, and every pair within 4 combined standard
+/// errors of the path tracer's.
+fn assert_every_integrator_agrees(s: &Scene, light_beams: u64, camera_samples: u64) {
     let seeds = 8u64;
     let mut results = Vec::new();
     for integrator in INTEGRATORS {
-        let effort = if integrator == IntegratorChoice::Light { 400_000 } else { 16 * 12 * 32 };
+        let effort =
+            if integrator == IntegratorChoice::Light { light_beams } else { camera_samples };
         let totals: Vec<[f64; 3]> = (0..seeds)
             .map(|k| {
-                let r = render_with(&s, integrator, effort, 500 + k);
+                let r = render_with(s, integrator, effort, 500 + k);
                 let sum = r.image.iter().fold(Xyz::default(), |a, &p| a + p);
                 [sum.x, sum.y, sum.z]
             })
@@ -97,13 +116,11 @@ fn a_rough_metal_looks_the_same_to_every_integrator() {
         results.push((integrator, stats));
     }
     let (_, reference) = &results[1];
-    // Sharp: each mean known to 2 %.
     for (integrator, stats) in &results {
         for &(mean, se) in stats {
             assert!(mean > 0.0 && se < 0.02 * mean, "{integrator:?}: {mean} +- {se}");
         }
     }
-    // Agree within 4 combined standard errors, in X, Y and Z (gold's colour too).
     for (integrator, stats) in &results {
         for c in 0..3 {
             let (a, sa) = stats[c];
@@ -115,4 +132,31 @@ fn a_rough_metal_looks_the_same_to_every_integrator() {
             );
         }
     }
+}
+
+#[test]
+fn a_rough_metal_looks_the_same_to_every_integrator() {
+    assert_every_integrator_agrees(&scene(ROUGH_FLOOR), 400_000, 16 * 12 * 32);
+}
+
+#[test]
+fn frosted_glass_and_rough_plastic_look_the_same_to_every_integrator() {
+    // A frosted-glass pane between the light and a diffuse floor (light reaches the floor only
+    // through the rough transmission lobe, and the camera sees the pane), and a rough plastic
+    // floor (its GGX coating lobe and its diffuse base).
+    let pane = ROUGH_FLOOR
+        .replace(
+            r#""material": {"type": "RoughConductor", "metal": "Au", "roughness_u": 0.3, "roughness_v": 0.5}}"#,
+            r#""material": {"type": "Diffuse", "reflectance": 0.7}},
+    {"shape": {"type": "Rectangle", "corner": [-1, 0.6, -1.5], "edge_u": [2, 0, 0], "edge_v": [0, 0, 2]},
+     "material": {"type": "RoughDielectric", "ior": 1.5, "roughness": 0.3}}"#,
+        );
+    assert_ne!(pane, ROUGH_FLOOR);
+    assert_every_integrator_agrees(&scene(&pane), 400_000, 16 * 12 * 96);
+    let plastic = ROUGH_FLOOR.replace(
+        r#"{"type": "RoughConductor", "metal": "Au", "roughness_u": 0.3, "roughness_v": 0.5}"#,
+        r#"{"type": "Plastic", "reflectance": {"nm": [400, 700], "values": [0.1, 0.6]}, "ior": 1.5, "roughness": 0.2}"#,
+    );
+    assert_ne!(plastic, ROUGH_FLOOR);
+    assert_every_integrator_agrees(&scene(&plastic), 400_000, 16 * 12 * 32);
 }
