@@ -60,10 +60,11 @@ use spectrace_spectrum::Reflectance;
 
 use crate::fresnel::reflect;
 use crate::metals::ComplexIor;
+use crate::microfacet::{alphas_from_keys, alphas_to_keys, check_alpha};
 use crate::vectors::{facing, normalise};
 use crate::{
-    BundleScattered, Ggx, Incoming, Material, MaterialError, SMOOTH_ALPHA, ScatterKind, Scattered,
-    Transport, scale_bundle,
+    BundleScattered, Ggx, Incoming, Material, MaterialError, ScatterKind, Scattered, Transport,
+    scale_bundle,
 };
 
 /// The metal itself: its index and an optional reflectance factor (shared by both types).
@@ -267,8 +268,8 @@ impl RoughConductor {
         alpha_v: f64,
         specular_reflectance: Option<Reflectance>,
     ) -> Result<Self, MaterialError> {
-        check_alpha("roughness_u", alpha_u)?;
-        check_alpha("roughness_v", alpha_v)?;
+        check_alpha(ROUGH_CONDUCTOR, "roughness_u", alpha_u)?;
+        check_alpha(ROUGH_CONDUCTOR, "roughness_v", alpha_v)?;
         Ok(Self::unchecked(ior, alpha_u, alpha_v, specular_reflectance))
     }
 
@@ -281,7 +282,7 @@ impl RoughConductor {
         alpha: f64,
         specular_reflectance: Option<Reflectance>,
     ) -> Result<Self, MaterialError> {
-        check_alpha("roughness", alpha)?;
+        check_alpha(ROUGH_CONDUCTOR, "roughness", alpha)?;
         Ok(Self::unchecked(ior, alpha, alpha, specular_reflectance))
     }
 
@@ -478,22 +479,6 @@ impl Material for RoughConductor {
 const CONDUCTOR: &str = "Conductor";
 const ROUGH_CONDUCTOR: &str = "RoughConductor";
 
-/// Checks a GGX alpha (finite, `>= 0`), naming `field` of a `RoughConductor`.
-fn check_alpha(field: &'static str, alpha: f64) -> Result<(), MaterialError> {
-    if alpha.is_finite() && alpha >= 0.0 {
-        Ok(())
-    } else {
-        Err(MaterialError::parameter(
-            ROUGH_CONDUCTOR,
-            field,
-            alpha,
-            format!(
-                "a roughness (GGX alpha) must be finite and >= 0 (below {SMOOTH_ALPHA} the surface is smooth)"
-            ),
-        ))
-    }
-}
-
 /// A missing or conflicting key.
 fn key_error(material: &'static str, field: &str, value: &str, reason: &str) -> MaterialError {
     MaterialError::Parameter {
@@ -618,45 +603,21 @@ impl TryFrom<RoughConductorRepr> for RoughConductor {
     fn try_from(r: RoughConductorRepr) -> Result<Self, MaterialError> {
         let ior = ior_from(ROUGH_CONDUCTOR, r.metal, r.eta, r.k)?;
         let spec = r.specular_reflectance;
-        match (r.roughness, r.roughness_u, r.roughness_v) {
-            (Some(a), None, None) => Self::isotropic(ior, a, spec),
-            (Some(a), _, _) => Err(key_error(
-                ROUGH_CONDUCTOR,
-                "roughness",
-                &format!("{a:?}"),
-                "give either `roughness` or `roughness_u` and `roughness_v`, not both",
-            )),
-            (None, Some(u), Some(v)) => Self::new(ior, u, v, spec),
-            (None, Some(_), None) => Err(key_error(
-                ROUGH_CONDUCTOR,
-                "roughness_v",
-                "missing",
-                "`roughness_u` needs `roughness_v` (the GGX alpha along the second tangent)",
-            )),
-            (None, None, Some(_)) => Err(key_error(
-                ROUGH_CONDUCTOR,
-                "roughness_u",
-                "missing",
-                "`roughness_v` needs `roughness_u` (the GGX alpha along the first tangent)",
-            )),
-            (None, None, None) => Err(key_error(
-                ROUGH_CONDUCTOR,
-                "roughness",
-                "missing",
-                "give `roughness` (the GGX alpha, 0 for a smooth metal) or `roughness_u` and `roughness_v`",
-            )),
-        }
+        let (u, v) = alphas_from_keys(
+            ROUGH_CONDUCTOR,
+            r.roughness,
+            r.roughness_u,
+            r.roughness_v,
+            "0 for a smooth metal",
+        )?;
+        Self::new(ior, u, v, spec)
     }
 }
 
 impl From<RoughConductor> for RoughConductorRepr {
     fn from(c: RoughConductor) -> Self {
         let (metal, eta, k) = ior_to(&c.surface.ior);
-        let (roughness, roughness_u, roughness_v) = if c.alpha_u == c.alpha_v {
-            (Some(c.alpha_u), None, None)
-        } else {
-            (None, Some(c.alpha_u), Some(c.alpha_v))
-        };
+        let (roughness, roughness_u, roughness_v) = alphas_to_keys(c.alpha_u, c.alpha_v);
         Self {
             metal,
             eta,

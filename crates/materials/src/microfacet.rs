@@ -24,6 +24,8 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 
+use crate::MaterialError;
+
 /// Below this alpha (in both directions) a surface is rendered as perfectly smooth: the GGX
 /// lobe is then narrower than `1e-3` rad, where its `D` would overflow towards a delta.
 pub const SMOOTH_ALPHA: f64 = 1e-3;
@@ -124,6 +126,89 @@ impl Ggx {
         let m = DVec3::new(self.alpha_x * nh.x, self.alpha_y * nh.y, nh.z.max(1e-12));
         m.normalize()
     }
+}
+
+/// Checks one GGX alpha of `material`'s `field`: finite and `>= 0` (the scene-file rule of
+/// every rough material).
+pub(crate) fn check_alpha(
+    material: &'static str,
+    field: &'static str,
+    alpha: f64,
+) -> Result<(), MaterialError> {
+    if alpha.is_finite() && alpha >= 0.0 {
+        Ok(())
+    } else {
+        Err(MaterialError::parameter(
+            material,
+            field,
+            alpha,
+            format!(
+                "a roughness (GGX alpha) must be finite and >= 0 (below {SMOOTH_ALPHA} the surface is smooth)"
+            ),
+        ))
+    }
+}
+
+/// The `(alpha_u, alpha_v)` pair of `material` from the scene-file keys `roughness` or
+/// `roughness_u` + `roughness_v` (exactly one of the two forms, each alpha checked);
+/// `smooth` says what roughness 0 means for this material, for the message of a missing key.
+pub(crate) fn alphas_from_keys(
+    material: &'static str,
+    roughness: Option<f64>,
+    u: Option<f64>,
+    v: Option<f64>,
+    smooth: &str,
+) -> Result<(f64, f64), MaterialError> {
+    match (roughness, u, v) {
+        (Some(a), None, None) => {
+            check_alpha(material, "roughness", a)?;
+            Ok((a, a))
+        }
+        (None, Some(a), Some(b)) => {
+            check_alpha(material, "roughness_u", a)?;
+            check_alpha(material, "roughness_v", b)?;
+            Ok((a, b))
+        }
+        (Some(a), _, _) => Err(MaterialError::parameter(
+            material,
+            "roughness",
+            a,
+            "give either `roughness` or `roughness_u` and `roughness_v`, not both",
+        )),
+        (None, Some(_), None) => Err(missing(
+            material,
+            "roughness_v",
+            "`roughness_u` needs `roughness_v` (the GGX alpha along the second tangent)",
+        )),
+        (None, None, Some(_)) => Err(missing(
+            material,
+            "roughness_u",
+            "`roughness_v` needs `roughness_u` (the GGX alpha along the first tangent)",
+        )),
+        (None, None, None) => Err(missing(
+            material,
+            "roughness",
+            format!(
+                "give `roughness` (the GGX alpha, {smooth}) or `roughness_u` and `roughness_v`"
+            ),
+        )),
+    }
+}
+
+/// A required key of `material` that the scene file left out.
+fn missing(material: &'static str, field: &str, reason: impl Into<String>) -> MaterialError {
+    MaterialError::Parameter {
+        material,
+        field: field.to_owned(),
+        value: "missing".to_owned(),
+        reason: reason.into(),
+    }
+}
+
+/// The scene-file keys `(roughness, roughness_u, roughness_v)` of an alpha pair: `roughness`
+/// alone when isotropic.
+pub(crate) fn alphas_to_keys(u: f64, v: f64) -> (Option<f64>, Option<f64>, Option<f64>) {
+    if u == v { (Some(u), None, None) } else { (None, Some(u), Some(v)) }
 }
 
 /// Unpolarised Fresnel reflectance of a conductor with complex index `eta + i k` (relative to

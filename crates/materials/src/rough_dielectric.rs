@@ -64,10 +64,11 @@ use spectrace_sampling::{Frame, clamp_uniform};
 
 use crate::fresnel::{fresnel_dielectric, refract};
 use crate::ior::IorRepr;
+use crate::microfacet::{alphas_from_keys, alphas_to_keys, check_alpha};
 use crate::vectors::normalise;
 use crate::{
-    BundleScattered, Dielectric, Ggx, Incoming, Ior, Material, MaterialError, SMOOTH_ALPHA,
-    ScatterKind, Scattered, Transport, scale_bundle, scatter_each,
+    BundleScattered, Dielectric, Ggx, Incoming, Ior, Material, MaterialError, ScatterKind,
+    Scattered, Transport, scale_bundle, scatter_each,
 };
 
 const NAME: &str = "RoughDielectric";
@@ -98,87 +99,29 @@ struct RoughDielectricRepr {
     transmittance: Option<Transmittance>,
 }
 
-/// Checks one GGX alpha of `material`'s `field`: finite and `>= 0`.
-pub(crate) fn check_alpha(
-    material: &'static str,
-    field: &'static str,
-    alpha: f64,
-) -> Result<(), MaterialError> {
-    if alpha.is_finite() && alpha >= 0.0 {
-        Ok(())
-    } else {
-        Err(MaterialError::parameter(
-            material,
-            field,
-            alpha,
-            format!(
-                "a roughness (GGX alpha) must be finite and >= 0 (below {SMOOTH_ALPHA} the surface is smooth)"
-            ),
-        ))
-    }
-}
-
-/// The `(alpha_u, alpha_v)` pair from the scene-file keys `roughness` or
-/// `roughness_u` + `roughness_v` (exactly one of the two forms).
-fn alphas(
-    roughness: Option<f64>,
-    u: Option<f64>,
-    v: Option<f64>,
-) -> Result<(f64, f64), MaterialError> {
-    match (roughness, u, v) {
-        (Some(a), None, None) => {
-            check_alpha(NAME, "roughness", a)?;
-            Ok((a, a))
-        }
-        (None, Some(a), Some(b)) => {
-            check_alpha(NAME, "roughness_u", a)?;
-            check_alpha(NAME, "roughness_v", b)?;
-            Ok((a, b))
-        }
-        (Some(a), _, _) => Err(MaterialError::parameter(
-            NAME,
-            "roughness",
-            a,
-            "give either `roughness` or `roughness_u` and `roughness_v`, not both",
-        )),
-        (None, Some(a), None) => Err(MaterialError::parameter(
-            NAME,
-            "roughness_v",
-            a,
-            "`roughness_u` needs `roughness_v` (the GGX alpha along the second tangent)",
-        )),
-        (None, None, Some(b)) => Err(MaterialError::parameter(
-            NAME,
-            "roughness_u",
-            b,
-            "`roughness_v` needs `roughness_u` (the GGX alpha along the first tangent)",
-        )),
-        (None, None, None) => Err(MaterialError::parameter(
-            NAME,
-            "roughness",
-            "missing",
-            "required: the GGX alpha (0 for smooth glass), or `roughness_u` and `roughness_v`",
-        )),
-    }
-}
-
 impl TryFrom<RoughDielectricRepr> for RoughDielectric {
     type Error = MaterialError;
     fn try_from(r: RoughDielectricRepr) -> Result<Self, MaterialError> {
         let ior = Ior::try_from(r.ior).map_err(|e| e.within(NAME, "ior"))?;
-        let (u, v) = alphas(r.roughness, r.roughness_u, r.roughness_v)?;
+        let (u, v) = alphas_from_keys(
+            NAME,
+            r.roughness,
+            r.roughness_u,
+            r.roughness_v,
+            "0 for smooth glass",
+        )?;
         Self::new(ior, u, v, r.transmittance)
     }
 }
 
 impl From<RoughDielectric> for RoughDielectricRepr {
     fn from(d: RoughDielectric) -> Self {
-        let iso = d.alpha_u == d.alpha_v;
+        let (roughness, roughness_u, roughness_v) = alphas_to_keys(d.alpha_u, d.alpha_v);
         Self {
             ior: d.smooth.ior().clone().into(),
-            roughness: iso.then_some(d.alpha_u),
-            roughness_u: (!iso).then_some(d.alpha_u),
-            roughness_v: (!iso).then_some(d.alpha_v),
+            roughness,
+            roughness_u,
+            roughness_v,
             transmittance: d.smooth.transmittance().cloned(),
         }
     }
