@@ -142,7 +142,9 @@ def write(report, root):
     lines += ["", f"**Summary.** Agree with the expectation: {', '.join(agree) or 'none'}.", "",
               f"Differ: {', '.join(differ) or 'none'}. Of these, the diffuse control's",
               f"{100 * (c0 - 1):+.2f}% is the translation's own offset (the same for every scene, flat over the",
-              "image; the race, `docs/peer.md`, also finds its means within 0.2%), divided out of the",
+              "image; the race, `docs/peer.md`, also finds its means within 0.2%; not explained: the",
+              "colour matching functions are not it, Mitsuba's `cie1931_y` and Spectrace's 1 nm table give",
+              "the light's Y within 3e-5), divided out of the",
               "`Y / control` column; the `nonlinear false` rows, the swapped-alphas control and the rough",
               "plastic differ by model (below).", ""]
     for c, v in spheres:
