@@ -20,6 +20,8 @@
 //!   virtual environment under the target directory with a pinned Mitsuba, then runs
 //!   `xtask/peer/peer.py`. Needs python3 with venv and pip, network access for the first install,
 //!   and a libLLVM of version 16 or newer. Never run by CI.
+//! - `cargo xtask peer --materials [options]`: the materials cross-check against Mitsuba 3
+//!   (`docs/materials-peer.md`, `xtask/peer/materials.py`), with the same prerequisites.
 
 use std::process::{Command, ExitCode};
 
@@ -280,6 +282,8 @@ fn print_help() {
          fuzz [--cases N] [--seed S]  fuzz the scene and part-file loaders (release)\n  \
          peer [--scenes A,B] [--max-seconds S] [--reference-scale F] [--no-docs]\n           \
                   the race against Mitsuba 3 (docs/peer.md); needs python3, pip, libLLVM >= 16\n  \
+         peer --materials [--spp N] [--seeds K] [--cases A,B] [--no-docs]\n           \
+                  the materials cross-check against Mitsuba 3 (docs/materials-peer.md)\n  \
          bench    run every crate's benchmarks (release)\n  \
          ci       run the checks CI runs: tests, rustfmt, clippy -D warnings\n  \
          help     this text"
@@ -300,6 +304,7 @@ fn status() -> ExitCode {
          Predict the time to 5%:     cargo xtask estimate scenes/NAME.json --target-error 0.05\n\
          Accuracy against time:      cargo xtask accuracy [SCENES]\n\
          Race against Mitsuba 3:     cargo xtask peer (python3, pip, libLLVM >= 16; docs/peer.md)\n\
+         Materials vs Mitsuba 3:     cargo xtask peer --materials (docs/materials-peer.md)\n\
          Run every test:             cargo test --workspace\n\
          Run the benchmarks:         cargo xtask bench\n\n\
          Estimators: light tracer, path tracer, BDPT (--integrator auto|light|path|bdpt; auto by default).\n\

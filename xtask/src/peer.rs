@@ -1,4 +1,5 @@
-//! `cargo xtask peer`: the race against Mitsuba 3 (method and results in `docs/peer.md`).
+//! `cargo xtask peer`: the race against Mitsuba 3 (method and results in `docs/peer.md`), and
+//! `cargo xtask peer --materials`: the materials cross-check (`docs/materials-peer.md`).
 //!
 //! The Rust side checks the prerequisites and prepares the tools; the race itself (scene
 //! translation, renders, errors, report) is `xtask/peer/peer.py`, run in a virtual environment
@@ -25,14 +26,35 @@ const LLVM_DIRS: &[&str] = &[
     "/usr/local/lib",
 ];
 
-/// Runs the race; `args` go to `peer.py` (see `--help` there).
+/// Runs the race, or with `--materials` first the materials cross-check; the other `args` go to
+/// `peer.py` (see `--help` there) or `materials.py`.
 pub(crate) fn run(args: &[String]) -> ExitCode {
-    match prepare().and_then(|(python, llvm, binary)| race(&python, &llvm, &binary, args)) {
+    let (job, args) = job(args);
+    match prepare().and_then(|(python, llvm, binary)| race(&job, &python, &llvm, &binary, args)) {
         Ok(()) => ExitCode::SUCCESS,
         Err(message) => {
             eprintln!("cargo xtask peer: {message}");
             ExitCode::FAILURE
         }
+    }
+}
+
+/// What `cargo xtask peer` runs: its script in `xtask/peer` and its work folder in the target
+/// directory.
+#[derive(Debug, PartialEq, Eq)]
+struct Job {
+    script: &'static str,
+    work: &'static str,
+}
+
+/// The race (`peer.py`, `target/peer`), or the materials cross-check (`materials.py`,
+/// `target/peer-materials`) when the first argument is `--materials`; and the arguments left.
+fn job(args: &[String]) -> (Job, &[String]) {
+    match args.split_first() {
+        Some((first, rest)) if first == "--materials" => {
+            (Job { script: "materials.py", work: "peer-materials" }, rest)
+        }
+        _ => (Job { script: "peer.py", work: "peer" }, args),
     }
 }
 
@@ -46,11 +68,17 @@ fn prepare() -> Result<(PathBuf, PathBuf, PathBuf), String> {
     Ok((python, llvm, binary))
 }
 
-/// Runs `peer.py` with the environment's python.
-fn race(python: &Path, llvm: &Path, binary: &Path, args: &[String]) -> Result<(), String> {
+/// Runs the job's script with the environment's python.
+fn race(
+    job: &Job,
+    python: &Path,
+    llvm: &Path,
+    binary: &Path,
+    args: &[String],
+) -> Result<(), String> {
     let root = crate::workspace_root();
-    let script = root.join("xtask").join("peer").join("peer.py");
-    let work = absolute(&crate::target_dir().join("peer"));
+    let script = root.join("xtask").join("peer").join(job.script);
+    let work = absolute(&crate::target_dir().join(job.work));
     let status = Command::new(python)
         .arg(&script)
         .arg("--spectrace")
@@ -63,7 +91,7 @@ fn race(python: &Path, llvm: &Path, binary: &Path, args: &[String]) -> Result<()
         .env("DRJIT_LIBLLVM_PATH", llvm)
         .status()
         .map_err(|e| format!("could not run {}: {e}", python.display()))?;
-    if status.success() { Ok(()) } else { Err(format!("the race failed ({status})")) }
+    if status.success() { Ok(()) } else { Err(format!("{} failed ({status})", job.script)) }
 }
 
 /// `path` made absolute against the current directory (unchanged if that cannot be read).
@@ -196,7 +224,20 @@ fn venv() -> Result<PathBuf, String> {
 mod tests {
     #![allow(clippy::unwrap_used)]
 
-    use super::{find_llvm_in, llvm_major};
+    use super::{Job, find_llvm_in, job, llvm_major};
+
+    #[test]
+    fn materials_flag_selects_the_materials_script() {
+        let args: Vec<String> = ["--materials", "--spp", "64"].map(String::from).to_vec();
+        let (chosen, rest) = job(&args);
+        assert_eq!(chosen, Job { script: "materials.py", work: "peer-materials" });
+        assert_eq!(rest, &args[1..]);
+        let race: Vec<String> = ["--scenes", "cornell", "--materials"].map(String::from).to_vec();
+        let (chosen, rest) = job(&race);
+        assert_eq!(chosen, Job { script: "peer.py", work: "peer" });
+        assert_eq!(rest, &race[..]);
+        assert_eq!(job(&[]).0.script, "peer.py");
+    }
 
     #[test]
     fn llvm_versions_are_read_from_file_names() {
