@@ -308,7 +308,8 @@ fn status() -> ExitCode {
          Run every test:             cargo test --workspace\n\
          Run the benchmarks:         cargo xtask bench\n\n\
          Estimators: light tracer, path tracer, BDPT (--integrator auto|light|path|bdpt; auto by default).\n\
-         Not built yet: rough metals and glass, fluorescence, measured luminaires and sensors."
+         Materials: diffuse, mirror, glass, conductors (measured metals), rough glass, plastic, fluorescent.\n\
+         Not built yet: measured luminaires (IES, EULUMDAT), illuminance sensors."
     );
     ExitCode::SUCCESS
 }
