@@ -257,7 +257,7 @@ fn half_vector(a: DVec3, b: DVec3) -> Option<(DVec3, f64)> {
 impl RoughConductor {
     /// A rough conductor with GGX roughness `alpha_u` along the first tangent and `alpha_v`
     /// along the second (equal for an isotropic surface), index `ior` and an optional factor on
-    /// the reflectance. Both alphas below [`SMOOTH_ALPHA`] give the smooth [`Conductor`].
+    /// the reflectance. Both alphas below [`SMOOTH_ALPHA`](crate::SMOOTH_ALPHA) give the smooth [`Conductor`].
     ///
     /// # Errors
     /// [`MaterialError::Parameter`] naming `roughness_u` or `roughness_v` unless finite and
@@ -324,7 +324,7 @@ impl RoughConductor {
         (self.alpha_u, self.alpha_v)
     }
 
-    /// `true` when both alphas are below [`SMOOTH_ALPHA`]: the surface is the smooth
+    /// `true` when both alphas are below [`SMOOTH_ALPHA`](crate::SMOOTH_ALPHA): the surface is the smooth
     /// [`Conductor`].
     pub fn is_smooth(&self) -> bool {
         Ggx::is_smooth_alphas(self.alpha_u, self.alpha_v)

@@ -186,7 +186,7 @@ impl RoughDielectric {
         (self.alpha_u, self.alpha_v)
     }
 
-    /// `true` when both alphas are below [`SMOOTH_ALPHA`]: the material is then exactly the
+    /// `true` when both alphas are below [`SMOOTH_ALPHA`](crate::SMOOTH_ALPHA): the material is then exactly the
     /// smooth [`Dielectric`] with the same index and transmittance.
     pub fn is_smooth(&self) -> bool {
         Ggx::is_smooth_alphas(self.alpha_u, self.alpha_v)
