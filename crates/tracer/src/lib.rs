@@ -18,8 +18,9 @@
 //! exactly), and every estimator writes the same film units, so their images can be compared
 //! pixel by pixel; and an [`Effects`] analysis decides, before rendering, what the scene needs
 //! (which estimator, a bundle of wavelengths per path when nothing is dispersive, beams that stop
-//! at the first diffuse hit when no interreflection is possible), reports it, and can be
-//! overridden. Because chunks are independent, the render loop also estimates the image's error
+//! at the first diffuse hit when no interreflection is possible, and whether any surface
+//! fluoresces, which makes every estimator choose between elastic scattering and re-emission at
+//! a new wavelength before it connects a vertex), reports it, and can be overridden. Because chunks are independent, the render loop also estimates the image's error
 //! as it goes, from the spread between chunks ([`Moments`]), with no reference.
 
 mod bdpt;
