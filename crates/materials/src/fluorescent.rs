@@ -398,19 +398,19 @@ impl Fluorescent {
             return Reemission::Absorbed;
         }
         let (lambda, q) = self.sample_excitation_with(sampler, u_lambda);
-        // Y e(lambda_o) a(lambda_i) / q(lambda_i): with q = a / A exactly Y e A.
-        let scale = if sampler.is_some() { self.absorbed(lambda) / q } else { f64::NAN };
-        if !(q > 0.0) || scale.is_infinite() {
+        // The kernel over the density of lambda_i: Y e(lambda_o) a(lambda_i) / q(lambda_i),
+        // which for the default q = a / A is Y e(lambda_o) A exactly.
+        let per_emission = match sampler {
+            Some(_) => self.quantum_yield * self.absorbed(lambda) / q,
+            None => self.quantum_yield * self.absorption.integral(),
+        };
+        if !(q > 0.0 && per_emission.is_finite()) {
             weights.fill(0.0);
             return Reemission::Absorbed;
         }
         for (w, l) in weights.iter_mut().zip(lambdas.iter_mut()) {
             if *w > 0.0 {
-                *w *= if scale.is_nan() {
-                    self.adjoint_reemitted(*l)
-                } else {
-                    self.quantum_yield * self.emission.value(*l) * scale
-                } / p;
+                *w *= per_emission * self.emission.value(*l) / p;
                 *l = lambda;
             }
         }
