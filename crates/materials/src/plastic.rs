@@ -53,7 +53,9 @@
 //! through. The GGX frame is `Frame::from_normal(normal)` (isotropic here, so its tangent does
 //! not matter).
 
+use std::collections::HashMap;
 use std::f64::consts::FRAC_1_PI;
+use std::sync::{LazyLock, Mutex};
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
@@ -400,9 +402,7 @@ impl Node {
                 Self { lambda, transmission: 2.0 * sum / n as f64, albedo: Vec::new() }
             }
             Some(ggx) => {
-                let albedo: Vec<f64> = (0..=COS_STEPS)
-                    .map(|k| rough_albedo(&ggx, eta, (k as f64 / COS_STEPS as f64).max(1e-3)))
-                    .collect();
+                let albedo = rough_albedo_table(&ggx, eta);
                 // T = 2 integral (1 - S(c)) c dc, exact for the piecewise-linear S.
                 let h = 1.0 / COS_STEPS as f64;
                 let mut integral = 0.0;
@@ -426,6 +426,31 @@ impl Node {
             _ => 0.0,
         }
     }
+}
+
+/// Most `S(cos)` tables kept by [`rough_albedo_table`] (34 numbers each).
+const ALBEDO_CACHE_MAX: usize = 1 << 16;
+
+/// `S` at `cos = k / COS_STEPS` for the rough coating `ggx` of index `eta`, computed once per
+/// `(alpha, eta)` in a process: a scene whose objects share a plastic (each object has its own
+/// material in a scene file) builds its table once, not once per object. The cache stops
+/// growing at [`ALBEDO_CACHE_MAX`] entries (tables are then computed each time).
+fn rough_albedo_table(ggx: &Ggx, eta: f64) -> Vec<f64> {
+    type Key = (u64, u64, u64);
+    static CACHE: LazyLock<Mutex<HashMap<Key, Vec<f64>>>> = LazyLock::new(Default::default);
+    let key = (ggx.alpha_x().to_bits(), ggx.alpha_y().to_bits(), eta.to_bits());
+    if let Some(table) = CACHE.lock().ok().and_then(|c| c.get(&key).cloned()) {
+        return table;
+    }
+    let table: Vec<f64> = (0..=COS_STEPS)
+        .map(|k| rough_albedo(ggx, eta, (k as f64 / COS_STEPS as f64).max(1e-3)))
+        .collect();
+    if let Ok(mut cache) = CACHE.lock()
+        && cache.len() < ALBEDO_CACHE_MAX
+    {
+        cache.insert(key, table.clone());
+    }
+    table
 }
 
 /// The directional albedo of a rough dielectric's reflection lobe, `integral F D G / (4 cos_i)
