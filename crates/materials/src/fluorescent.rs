@@ -291,10 +291,10 @@ impl Fluorescent {
 
     /// An [`ExcitationSampler`] guided by `light(lambda)`, the spectral density of the light
     /// that reaches the scene (any positive scale; e.g. the light set's SPD): `a light` is
-    /// tabulated at 1 nm steps over the absorption table's range.
+    /// tabulated at 1 nm steps over the absorption table's range (at most 2048 steps).
     pub fn excitation_sampler(&self, light: &dyn Fn(f64) -> f64) -> ExcitationSampler {
         let (lo, hi) = self.absorption.range();
-        let steps = ((hi - lo).ceil() as usize).clamp(1, 100_000);
+        let steps = ((hi - lo).ceil() as usize).clamp(1, 2048);
         let xs: Vec<f64> = (0..=steps).map(|i| lo + (hi - lo) * i as f64 / steps as f64).collect();
         let ys: Vec<f64> = xs
             .iter()
