@@ -41,6 +41,7 @@ mod counter;
 mod error;
 mod geometry;
 mod laser;
+pub mod photometry;
 mod set;
 mod sky;
 mod source;

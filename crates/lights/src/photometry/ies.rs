@@ -1,0 +1,406 @@
+//! A small, strict reader of IES LM-63 photometric files (the 1991, 1995, 2002 and 2019
+//! variants, and the 1986 form without a first line): the candela table of a measured luminaire.
+//!
+//! The layout, after the format's documents (ANSI/IES LM-63-02 and LM-63-19):
+//!
+//! ```text
+//! IESNA:LM-63-2002                     first line: the version (absent in LM-63-1986)
+//! [TEST] ...                           keyword lines, [KEYWORD] text
+//! TILT=NONE | TILT=INCLUDE | TILT=<file>
+//! (TILT=INCLUDE only) <lamp-to-luminaire geometry> <n tilt angles> <angles...> <factors...>
+//! <lamps> <lumens per lamp> <candela multiplier> <n vertical> <n horizontal>
+//!     <photometric type> <units type> <width> <length> <height>
+//! <ballast factor> <future use / ballast-lamp factor> <input watts>
+//! <n vertical angles>  <n horizontal angles>
+//! <candela: n vertical values for each horizontal angle>
+//! ```
+//!
+//! Numbers after the `TILT` line may be split over lines at will and separated by blanks or
+//! commas. Lumens per lamp of `-1` mean *absolute photometry* (the candela values are the
+//! luminaire's own, no lamp rating). Only photometry type C (1) is read: types A (3) and B (2)
+//! are refused with a message saying so. A `TILT=<file>` naming another file is refused (the
+//! reader opens nothing); `TILT=INCLUDE` is read and kept.
+//!
+//! Checks, each an error naming the file, the line and the cause: a `TILT` line is required;
+//! counts are whole numbers from 1 to [`MAX_ANGLES`] (vertical) and [`MAX_ANGLES`]
+//! (horizontal); every number is finite; candela values and the multiplier are `>= 0`; type C
+//! vertical angles lie in `[0, 180]` and horizontal ones in `[0, 360]`, both strictly
+//! increasing; the horizontal angles start at 0 (or 90 for the quadrant form 90..270 some
+//! files use) and end where the symmetry the format defines allows (0: axial symmetry, 90:
+//! quadrant, 180: bilateral, 360: none); nothing follows the last candela value but blanks.
+
+use std::fmt;
+
+/// Most angles along either axis of a candela table.
+pub const MAX_ANGLES: usize = 4096;
+
+/// Where an IES file went wrong: the file's name as given, the line (1-based) and the cause.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct IesError {
+    /// The file name, as passed to [`IesFile::parse`].
+    pub file: String,
+    /// Line number, 1-based (the last line for a file that ends too early).
+    pub line: usize,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for IesError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}:{}: {}", self.file, self.line, self.message)
+    }
+}
+
+impl std::error::Error for IesError {}
+
+/// The version an IES file declares on its first line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum IesVersion {
+    /// LM-63-1986: no version line.
+    Lm63_1986,
+    /// `IESNA91`.
+    Lm63_1991,
+    /// `IESNA:LM-63-1995`.
+    Lm63_1995,
+    /// `IESNA:LM-63-2002`.
+    Lm63_2002,
+    /// `IES:LM-63-2019`.
+    Lm63_2019,
+}
+
+/// The lamp tilt data of `TILT=INCLUDE`: how the lamp output varies with the luminaire's tilt.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tilt {
+    /// Lamp-to-luminaire geometry code (1, 2 or 3).
+    pub geometry: u32,
+    /// Tilt angles (degrees).
+    pub angles: Vec<f64>,
+    /// Multiplying factors, one per angle.
+    pub factors: Vec<f64>,
+}
+
+/// The luminous dimensions' unit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Units {
+    /// Feet (units type 1).
+    Feet,
+    /// Metres (units type 2).
+    Metres,
+}
+
+/// A parsed IES LM-63 file (photometry type C).
+#[derive(Debug, Clone, PartialEq)]
+pub struct IesFile {
+    /// The declared version.
+    pub version: IesVersion,
+    /// Keyword lines (`[TEST]`, `[MANUFAC]`, ...), in order, without brackets.
+    pub keywords: Vec<(String, String)>,
+    /// `TILT=INCLUDE` data; `None` for `TILT=NONE`.
+    pub tilt: Option<Tilt>,
+    /// Number of lamps.
+    pub lamps: u32,
+    /// Rated lumens per lamp; `None` for absolute photometry (`-1` in the file).
+    pub lumens_per_lamp: Option<f64>,
+    /// Multiplier applied to every candela value.
+    pub multiplier: f64,
+    /// Unit of the luminous dimensions.
+    pub units: Units,
+    /// Width, length and height of the luminous opening (in `units`; negative values describe
+    /// round shapes, as the format defines).
+    pub dimensions: [f64; 3],
+    /// Ballast factor.
+    pub ballast_factor: f64,
+    /// Input power (W).
+    pub input_watts: f64,
+    /// Vertical angles (degrees from nadir, type C), strictly increasing.
+    pub vertical: Vec<f64>,
+    /// Horizontal angles (degrees, the C-planes), strictly increasing.
+    pub horizontal: Vec<f64>,
+    /// Candela values, `candela[h][v]` for `horizontal[h]` and `vertical[v]`, multiplier
+    /// applied.
+    pub candela: Vec<Vec<f64>>,
+}
+
+/// Numbers after the `TILT` line, with the line each starts on.
+struct Tokens<'a> {
+    file: &'a str,
+    items: Vec<(usize, &'a str)>,
+    next: usize,
+    last_line: usize,
+}
+
+impl<'a> Tokens<'a> {
+    fn error(&self, line: usize, message: impl Into<String>) -> IesError {
+        IesError { file: self.file.to_owned(), line, message: message.into() }
+    }
+
+    /// The next number, named `what` in errors.
+    fn number(&mut self, what: &str) -> Result<(f64, usize), IesError> {
+        let Some(&(line, text)) = self.items.get(self.next) else {
+            return Err(
+                self.error(self.last_line, format!("the file ends before {what} (truncated?)"))
+            );
+        };
+        self.next += 1;
+        match text.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok((v, line)),
+            _ => Err(self.error(line, format!("{what}: expected a number, found `{text}`"))),
+        }
+    }
+
+    /// The next number as a count in `1..=max`.
+    fn count(&mut self, what: &str, max: usize) -> Result<usize, IesError> {
+        let (v, line) = self.number(what)?;
+        if v.fract() != 0.0 || v < 1.0 || v > max as f64 {
+            return Err(
+                self.error(line, format!("{what} = {v}: must be a whole number from 1 to {max}"))
+            );
+        }
+        Ok(v as usize)
+    }
+
+    /// `n` numbers named `what[i]`.
+    fn numbers(&mut self, what: &str, n: usize) -> Result<Vec<(f64, usize)>, IesError> {
+        (0..n).map(|i| self.number(&format!("{what}[{i}]"))).collect()
+    }
+}
+
+impl IesFile {
+    /// Parses the text of an IES file; `file` names it in errors.
+    ///
+    /// # Errors
+    /// [`IesError`] with the line and cause for anything the module documentation lists.
+    pub fn parse(text: &str, file: &str) -> Result<Self, IesError> {
+        let err = |line: usize, message: String| IesError { file: file.to_owned(), line, message };
+        let lines: Vec<&str> = text.lines().collect();
+        let mut i = 0;
+        let first = lines.first().map_or("", |l| l.trim());
+        let version = match first.to_ascii_uppercase().as_str() {
+            "IESNA:LM-63-1995" => Some(IesVersion::Lm63_1995),
+            "IESNA:LM-63-2002" => Some(IesVersion::Lm63_2002),
+            "IES:LM-63-2019" => Some(IesVersion::Lm63_2019),
+            "IESNA91" => Some(IesVersion::Lm63_1991),
+            _ => None,
+        };
+        let version = match version {
+            Some(v) => {
+                i = 1;
+                v
+            }
+            None if first.to_ascii_uppercase().starts_with("IES") => {
+                return Err(err(
+                    1,
+                    format!(
+                        "unknown IES version line `{first}` (known: IESNA91, IESNA:LM-63-1995, IESNA:LM-63-2002, IES:LM-63-2019)"
+                    ),
+                ));
+            }
+            None => IesVersion::Lm63_1986,
+        };
+        let mut keywords = Vec::new();
+        let tilt_line;
+        loop {
+            let Some(line) = lines.get(i) else {
+                return Err(err(
+                    lines.len().max(1),
+                    "no TILT= line: the file ends in its header (is it an IES file?)".to_owned(),
+                ));
+            };
+            let trimmed = line.trim();
+            if let Some(rest) =
+                trimmed.strip_prefix("TILT=").or_else(|| trimmed.strip_prefix("TILT ="))
+            {
+                tilt_line = (i + 1, rest.trim().to_owned());
+                i += 1;
+                break;
+            }
+            if let Some((key, value)) = trimmed.strip_prefix('[').and_then(|b| b.split_once(']')) {
+                keywords.push((key.to_owned(), value.trim().to_owned()));
+            }
+            i += 1;
+        }
+        let mut tokens = Tokens { file, items: Vec::new(), next: 0, last_line: lines.len().max(1) };
+        for (k, line) in lines.iter().enumerate().skip(i) {
+            for t in line.split(|c: char| c.is_whitespace() || c == ',').filter(|t| !t.is_empty()) {
+                tokens.items.push((k + 1, t));
+            }
+        }
+        let tilt = match tilt_line.1.to_ascii_uppercase().as_str() {
+            "NONE" => None,
+            "INCLUDE" => {
+                let (g, line) = tokens.number("the tilt's lamp-to-luminaire geometry")?;
+                if !(g == 1.0 || g == 2.0 || g == 3.0) {
+                    return Err(err(
+                        line,
+                        format!("lamp-to-luminaire geometry = {g}: must be 1, 2 or 3"),
+                    ));
+                }
+                let n = tokens.count("the number of tilt angles", MAX_ANGLES)?;
+                let angles = tokens.numbers("tilt angle", n)?;
+                let factors = tokens.numbers("tilt factor", n)?;
+                increasing(&angles, "tilt angles", &err)?;
+                for &(f, line) in &factors {
+                    if f < 0.0 {
+                        return Err(err(line, format!("tilt factor {f}: must be >= 0")));
+                    }
+                }
+                Some(Tilt {
+                    geometry: g as u32,
+                    angles: angles.iter().map(|a| a.0).collect(),
+                    factors: factors.iter().map(|a| a.0).collect(),
+                })
+            }
+            other => {
+                return Err(err(
+                    tilt_line.0,
+                    format!(
+                        "TILT={other}: tilt data in another file is not read (use TILT=NONE or TILT=INCLUDE)"
+                    ),
+                ));
+            }
+        };
+        let lamps = tokens.count("the number of lamps", 1_000_000)? as u32;
+        let (lumens, lumens_line) = tokens.number("the lumens per lamp")?;
+        let lumens_per_lamp = if lumens == -1.0 {
+            None
+        } else if lumens > 0.0 {
+            Some(lumens)
+        } else {
+            return Err(err(
+                lumens_line,
+                format!("lumens per lamp = {lumens}: must be > 0, or -1 for absolute photometry"),
+            ));
+        };
+        let (multiplier, line) = tokens.number("the candela multiplier")?;
+        if multiplier < 0.0 {
+            return Err(err(line, format!("candela multiplier = {multiplier}: must be >= 0")));
+        }
+        let n_vertical = tokens.count("the number of vertical angles", MAX_ANGLES)?;
+        let n_horizontal = tokens.count("the number of horizontal angles", MAX_ANGLES)?;
+        let (kind, line) = tokens.number("the photometric type")?;
+        match kind {
+            1.0 => {}
+            2.0 | 3.0 => {
+                let name = if kind == 2.0 { "B" } else { "A" };
+                return Err(err(
+                    line,
+                    format!(
+                        "photometric type {kind} (type {name}): only type C (1, the goniometer of building luminaires) is supported"
+                    ),
+                ));
+            }
+            _ => {
+                return Err(err(
+                    line,
+                    format!("photometric type = {kind}: must be 1 (C), 2 (B) or 3 (A)"),
+                ));
+            }
+        }
+        let (u, line) = tokens.number("the units type")?;
+        let units = match u {
+            1.0 => Units::Feet,
+            2.0 => Units::Metres,
+            _ => {
+                return Err(err(line, format!("units type = {u}: must be 1 (feet) or 2 (metres)")));
+            }
+        };
+        let width = tokens.number("the width")?.0;
+        let length = tokens.number("the length")?.0;
+        let height = tokens.number("the height")?.0;
+        let (ballast_factor, line) = tokens.number("the ballast factor")?;
+        if ballast_factor < 0.0 {
+            return Err(err(line, format!("ballast factor = {ballast_factor}: must be >= 0")));
+        }
+        tokens.number("the ballast-lamp photometric factor (future use)")?;
+        let input_watts = tokens.number("the input watts")?.0;
+        let vertical = tokens.numbers("vertical angle", n_vertical)?;
+        let horizontal = tokens.numbers("horizontal angle", n_horizontal)?;
+        increasing(&vertical, "vertical angles", &err)?;
+        increasing(&horizontal, "horizontal angles", &err)?;
+        for &(v, line) in &vertical {
+            if !(0.0..=180.0).contains(&v) {
+                return Err(err(
+                    line,
+                    format!("vertical angle {v}: type C vertical angles lie in [0, 180]"),
+                ));
+            }
+        }
+        for &(h, line) in &horizontal {
+            if !(0.0..=360.0).contains(&h) {
+                return Err(err(
+                    line,
+                    format!("horizontal angle {h}: type C horizontal angles lie in [0, 360]"),
+                ));
+            }
+        }
+        let (h0, h0_line) = horizontal[0];
+        let (hn, hn_line) = horizontal[n_horizontal - 1];
+        if !(h0 == 0.0 || (h0 == 90.0 && hn == 270.0)) {
+            return Err(err(
+                h0_line,
+                format!("first horizontal angle {h0}: must be 0 (or 90 for the range 90-270)"),
+            ));
+        }
+        if h0 == 0.0 && ![0.0, 90.0, 180.0, 360.0].contains(&hn) {
+            return Err(err(
+                hn_line,
+                format!(
+                    "last horizontal angle {hn}: must be 0 (axial symmetry), 90 (quadrants), 180 (bilateral) or 360 (none)"
+                ),
+            ));
+        }
+        let mut candela = Vec::with_capacity(n_horizontal);
+        for (h, &(angle, _)) in horizontal.iter().enumerate() {
+            let row = tokens.numbers(&format!("candela[{h}]"), n_vertical)?;
+            let mut values = Vec::with_capacity(n_vertical);
+            for (v, line) in row {
+                if v < 0.0 {
+                    return Err(err(
+                        line,
+                        format!("candela value {v} (horizontal angle {angle}): must be >= 0"),
+                    ));
+                }
+                values.push(v * multiplier);
+            }
+            candela.push(values);
+        }
+        if let Some(&(line, t)) = tokens.items.get(tokens.next) {
+            return Err(err(
+                line,
+                format!("`{t}` after the last candela value: the counts do not match the table"),
+            ));
+        }
+        Ok(Self {
+            version,
+            keywords,
+            tilt,
+            lamps,
+            lumens_per_lamp,
+            multiplier,
+            units,
+            dimensions: [width, length, height],
+            ballast_factor,
+            input_watts,
+            vertical: vertical.iter().map(|v| v.0).collect(),
+            horizontal: horizontal.iter().map(|v| v.0).collect(),
+            candela,
+        })
+    }
+}
+
+/// Checks that `values` strictly increase, naming the first that does not.
+fn increasing(
+    values: &[(f64, usize)],
+    what: &str,
+    err: &impl Fn(usize, String) -> IesError,
+) -> Result<(), IesError> {
+    for w in values.windows(2) {
+        if !(w[1].0 > w[0].0) {
+            return Err(err(
+                w[1].1,
+                format!("{what} must increase strictly: {} after {}", w[1].0, w[0].0),
+            ));
+        }
+    }
+    Ok(())
+}
