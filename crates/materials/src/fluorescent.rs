@@ -60,14 +60,6 @@ pub struct Fluorescent {
     absorption: PiecewiseLinear,
     emission: Box<dyn SpectralPowerDistribution>,
     quantum_yield: f64,
-    /// `(1 - a) R` as a Lambertian, the elastic part.
-    elastic: ElasticPart,
-}
-
-/// The elastic part's Lambertian lobe, evaluated with `(1 - a(lambda)) R(lambda)`.
-#[derive(Debug, Clone)]
-struct ElasticPart {
-    lobe: Diffuse,
 }
 
 /// Scene-file form of [`Fluorescent`].
@@ -222,8 +214,7 @@ impl Fluorescent {
                 "the fraction of absorbed power re-emitted must be in [0, 1]",
             ));
         }
-        let elastic = ElasticPart { lobe: Diffuse::new(Reflectance::white()) };
-        Ok(Self { reflectance, absorption, emission, quantum_yield, elastic })
+        Ok(Self { reflectance, absorption, emission, quantum_yield })
     }
 
     /// `a(lambda)`: the absorbed fraction at `lambda` (nm), 0 outside the table.
@@ -453,7 +444,7 @@ impl Material for Fluorescent {
         if !(albedo > 0.0) {
             return None;
         }
-        let mut s = self.elastic.lobe.scatter(incoming, u)?;
+        let mut s = reemission_lobe().scatter(incoming, u)?;
         s.weight = albedo;
         Some(s)
     }
@@ -471,7 +462,7 @@ impl Material for Fluorescent {
             return None;
         }
         let mut ones = [1.0];
-        self.elastic.lobe.scatter_bundle(direction, normal, &[lambdas[0]], &mut ones, u, transport)
+        reemission_lobe().scatter_bundle(direction, normal, &[lambdas[0]], &mut ones, u, transport)
     }
 
     fn eval(&self, wi: DVec3, wo: DVec3, normal: DVec3, lambda: f64) -> f64 {
@@ -483,7 +474,7 @@ impl Material for Fluorescent {
     }
 
     fn pdf(&self, wi: DVec3, wo: DVec3, normal: DVec3, lambda: f64) -> f64 {
-        self.elastic.lobe.pdf(wi, wo, normal, lambda)
+        reemission_lobe().pdf(wi, wo, normal, lambda)
     }
 
     fn is_specular(&self) -> bool {
