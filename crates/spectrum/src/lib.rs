@@ -46,6 +46,7 @@ mod error;
 mod illuminant;
 mod inverse;
 mod mixture;
+mod photometric;
 mod reflectance;
 mod spd;
 mod tabulated;
@@ -59,6 +60,9 @@ pub use cie::{
 pub use error::SpectrumError;
 pub use illuminant::{CieIlluminant, KNOWN_ILLUMINANTS, daylight};
 pub use mixture::{Component, MAX_TABLE_PANELS, Mixture};
+pub use photometric::{
+    PEAK_LUMINOUS_EFFICACY, lumens_per_watt, luminous_efficacy, watts_from_lumens,
+};
 pub use reflectance::{Reflectance, Transmittance};
 pub use spd::{SpectralPowerDistribution, integrate_panels};
 pub use tabulated::{Binned, Tabulated};
