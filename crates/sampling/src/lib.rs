@@ -4,7 +4,7 @@
 //! This crate is the bottom layer of Spectrace and depends on nothing else of ours. Spectra
 //! (`spectrace-spectrum`) use it to draw wavelengths in proportion to a spectral power distribution,
 //! lights (`spectrace-lights`) to draw emission directions from angular profiles, and the renderer
-//! to pick lights by power. It offers four generators, each built once from a table by a
+//! to pick lights by power. It offers five generators, each built once from a table by a
 //! constructor that validates the table and returns a [`Result`], then immutable and shared:
 //!
 //! | type | what it samples | cost per sample |
@@ -13,6 +13,7 @@
 //! | [`AliasTable`] | an index, by Walker/Vose alias tables | `O(1)` |
 //! | [`PiecewiseConstant`] | a real in bins of constant density (the seed's "choppy" generator) | `O(log n)` |
 //! | [`PiecewiseLinear`] | a real under a piecewise-linear density (seed 2.2.1) | `O(log n)` |
+//! | [`PiecewiseBilinear`] | a point under a density bilinear in each cell of a 2-D grid | `O(log n + log m)` |
 //!
 //! Samplers take an explicit uniform `u` in `[0, 1)` (`sample(&self, u)`), so stratified and
 //! low-discrepancy sequences can drive them and results are reproducible; each also implements
@@ -45,6 +46,7 @@ mod alias;
 mod discrete;
 mod error;
 mod frame;
+mod piecewise_bilinear;
 mod piecewise_constant;
 mod piecewise_linear;
 mod sobol;
@@ -57,6 +59,7 @@ pub use alias::AliasTable;
 pub use discrete::Discrete;
 pub use error::SamplingError;
 pub use frame::Frame;
+pub use piecewise_bilinear::PiecewiseBilinear;
 pub use piecewise_constant::PiecewiseConstant;
 pub use piecewise_linear::{PiecewiseLinear, linear_segment_inverse};
 pub use sobol::{SOBOL_BLOCK, SOBOL_DIMENSIONS, SobolSampler};
