@@ -32,7 +32,6 @@ mod bvh;
 mod cylinder;
 mod disk;
 mod error;
-mod files;
 mod float;
 mod mesh;
 mod prism;
@@ -48,12 +47,14 @@ pub use bounds::Bounds;
 pub use cylinder::Cylinder;
 pub use disk::Disk;
 pub use error::GeometryError;
-pub use files::{human_bytes, read_bounded};
 pub use mesh::{MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_OBJ_BYTES, Mesh};
 pub use prism::Prism;
 pub use ray::{Hit, Ray};
 pub use rectangle::Rectangle;
 pub use shape::{Shape, SurfacePoint};
+/// Bounded file reading, shared with every crate that reads input files (it lives in the lowest
+/// one, `spectrace-sampling`).
+pub use spectrace_sampling::files::{human_bytes, read_bounded};
 pub use sphere::Sphere;
 pub use torus::Torus;
 pub use transform::Transform;

@@ -27,6 +27,17 @@ pub enum LightError {
         /// What is wrong with the spectrum.
         source: SpectrumError,
     },
+    /// A file the light reads (a measured luminaire's photometric file) cannot be read or is
+    /// malformed; the message names the file and, for a malformed one, the line.
+    #[error("{light}.{field}: {message}")]
+    File {
+        /// The light type, e.g. `"IesLight"`.
+        light: &'static str,
+        /// The field naming the file, e.g. `"file"`.
+        field: &'static str,
+        /// What is wrong, naming the file (and line).
+        message: String,
+    },
     /// An experiment hook (e.g. [`crate::LightSource::set_wavelength_sampling`]) that this light
     /// type does not offer.
     #[error("{field}: this light type cannot change it once built")]

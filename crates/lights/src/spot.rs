@@ -62,7 +62,7 @@ fn cone(light: &'static str, cone_angle: f64) -> Result<f64, LightError> {
 
 /// A delta-position sample towards `receiver` with the given intensity function of the cosine to
 /// the axis.
-fn point_sample(
+pub(crate) fn point_sample(
     position: DVec3,
     axis: DVec3,
     receiver: DVec3,
@@ -87,7 +87,11 @@ fn point_sample(
 /// The emission ray of a light at the point `position` along `direction`, whose directions have
 /// solid-angle density `pdf_direction` there; `None` when that density is 0 (a direction drawn
 /// exactly on a fading spot's rim).
-fn point_emission(position: DVec3, direction: DVec3, pdf_direction: f64) -> Option<EmissionSample> {
+pub(crate) fn point_emission(
+    position: DVec3,
+    direction: DVec3,
+    pdf_direction: f64,
+) -> Option<EmissionSample> {
     (pdf_direction > 0.0).then_some(EmissionSample {
         position,
         normal: DVec3::ZERO,

@@ -1,20 +1,20 @@
 //! Files the renderer reads and writes, handled so that hostile or careless input cannot hurt.
 //!
-//! - Every file read goes through [`read_bounded`] (from `spectrace-geometry`, which reads OBJ
-//!   files the same way): it must be a regular file (not a device, FIFO or directory) no larger
+//! - Every file read goes through [`read_bounded`] (from `spectrace-sampling`, the lowest crate,
+//!   through which OBJ meshes and measured luminaires are read the same way): it must be a regular file (not a device, FIFO or directory) no larger
 //!   than a documented limit, checked before and while reading, so `/dev/zero` or a 100 GB file
 //!   is refused at once instead of filling memory.
 //! - Every output name is checked by [`check_output_name`] before any work starts: a plain file
 //!   name, never a path, so nothing lands outside the output folder.
 //! - [`check_no_input_replaced`] refuses, before rendering, any output that is the same file as an
-//!   input (the scene, an OBJ mesh, a part file), symlinks and hard links included.
+//!   input (the scene, an OBJ mesh, a luminaire file, a part file), symlinks and hard links included.
 //! - [`write_atomically`] writes each output to a temporary name in the output folder and renames
 //!   it into place, so a failed write never leaves a partial file under the final name.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-pub use spectrace_geometry::read_bounded;
+pub use spectrace_sampling::files::read_bounded;
 
 /// Largest scene file read (256 MiB): inline meshes of a few million triangles fit.
 pub const MAX_SCENE_BYTES: u64 = 256 << 20;

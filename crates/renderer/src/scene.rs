@@ -19,6 +19,7 @@ use spectrace_tracer::{
 };
 
 use crate::files::{MAX_SCENE_BYTES, check_output_name, read_bounded};
+use spectrace_sampling::files::{check_inside, with_scene_folder};
 
 /// A scene file, as written (see `scenes/README.md` for every field).
 #[derive(Debug, Serialize, Deserialize)]
@@ -241,7 +242,7 @@ pub struct Scene {
 /// How a scene file may refer to other files.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct LoadOptions {
-    /// Refuse any file (OBJ mesh) outside the scene file's folder, symlinks resolved: for
+    /// Refuse any file (OBJ mesh, luminaire file) outside the scene file's folder, symlinks resolved: for
     /// render farms that accept scenes from others (`--restrict-paths`).
     pub restrict_paths: bool,
 }
@@ -279,7 +280,7 @@ impl Scene {
     }
 
     /// Validates a scene given as JSON text; `path` names it in errors and resolves relative
-    /// files (OBJ meshes).
+    /// files (OBJ meshes, luminaire files).
     ///
     /// # Errors
     /// [`SceneError`] with the line, column and field of the first problem.
@@ -307,8 +308,14 @@ impl Scene {
                 column: e.column(),
                 message: strip_position(&e.to_string()),
             })?;
-        let mut de = serde_json::Deserializer::from_str(text);
-        let file: SceneFile = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+        // Files named inside the scene (measured luminaires) resolve against its folder while it
+        // is deserialised, under the same path policy as OBJ meshes.
+        let base = path.parent().unwrap_or_else(|| Path::new("."));
+        let (file, light_inputs) = with_scene_folder(base, options.restrict_paths, || {
+            let mut de = serde_json::Deserializer::from_str(text);
+            serde_path_to_error::deserialize::<_, SceneFile>(&mut de)
+        });
+        let file: SceneFile = file.map_err(|e| {
             let field = e.path().to_string();
             let inner = e.into_inner();
             SceneError::Invalid {
@@ -370,8 +377,7 @@ impl Scene {
         let mut shapes = Vec::with_capacity(file.objects.len());
         let mut materials = Vec::with_capacity(file.objects.len());
         let mut non_convex = Vec::with_capacity(file.objects.len());
-        let mut inputs = Vec::new();
-        let base = path.parent().unwrap_or_else(|| Path::new("."));
+        let mut inputs = light_inputs;
         let mut object_lights: Vec<(usize, ObjectLight)> = Vec::new();
         for (index, mut object) in file.objects.into_iter().enumerate() {
             if let Shape::Mesh(mesh) = &object.shape
@@ -552,25 +558,6 @@ fn apply_transform(shape: Shape, t: &Transform) -> Result<Shape, String> {
         map.insert("transform".to_owned(), serde_json::json!({ "matrix": rows }));
     }
     serde_json::from_value(value).map_err(|e| e.to_string())
-}
-
-/// Refuses `file` unless it resolves (symlinks followed) to a place inside `base`.
-fn check_inside(base: &Path, file: &Path) -> Result<(), String> {
-    let base_dir = if base.as_os_str().is_empty() { Path::new(".") } else { base };
-    let root = std::fs::canonicalize(base_dir)
-        .map_err(|e| format!("cannot resolve the scene's folder {}: {e}", base_dir.display()))?;
-    let real = std::fs::canonicalize(file)
-        .map_err(|e| format!("{}: cannot resolve: {e}", file.display()))?;
-    if real.starts_with(&root) {
-        Ok(())
-    } else {
-        Err(format!(
-            "{} resolves to {}, outside the scene's folder {} (refused by --restrict-paths)",
-            file.display(),
-            real.display(),
-            root.display()
-        ))
-    }
 }
 
 /// serde_json appends " at line L column C"; the position is reported separately.

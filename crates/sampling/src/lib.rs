@@ -39,12 +39,16 @@
 //! [`rand::Rng`], one dimension per draw of a path, for renderers that want low-discrepancy
 //! sampling without changing the code that draws the uniforms.
 //!
+//! The [`files`] module holds the bounded reading of input files that every crate reading one
+//! shares (it is here because this is the lowest crate).
+//!
 //! The [`stats`] module holds the chi-square and Kolmogorov-Smirnov harness that every Spectrace
 //! crate uses in its statistical tests.
 
 mod alias;
 mod discrete;
 mod error;
+pub mod files;
 mod frame;
 mod piecewise_bilinear;
 mod piecewise_constant;

@@ -4,5 +4,7 @@
 //! names the file and line of anything wrong.
 
 mod ies;
+mod luminaire;
 
 pub use ies::{IesError, IesFile, IesVersion, MAX_ANGLES, Tilt, Units};
+pub use luminaire::{CandelaDistribution, IesLight, MAX_PHOTOMETRIC_BYTES};

@@ -1,0 +1,375 @@
+//! Measured luminaires as lights: the unfolding of the formats' symmetries, the handedness of the
+//! C-planes, the sampled directions against the candela table (chi-square), the flux carried by
+//! the beams against the table's, and scene-file errors naming the file and line.
+#![allow(clippy::unwrap_used)]
+
+use std::f64::consts::{PI, TAU};
+use std::path::{Path, PathBuf};
+
+use rand::SeedableRng;
+use spectrace_lights::LightSource;
+use spectrace_lights::glam::DVec3;
+use spectrace_lights::photometry::{CandelaDistribution, IesLight};
+use spectrace_lights::sampling::files::with_scene_folder;
+use spectrace_lights::sampling::stats::chi_square;
+use spectrace_lights::spectrum::SpectralPowerDistribution;
+use spectrace_lights::spectrum::{lumens_per_watt, luminous_efficacy};
+
+/// An LM-63-2002 type C file with the given angles and `candela[h][v]` (multiplier 1,
+/// relative photometry with 1000 lm lamps).
+fn ies_text(vertical: &[f64], horizontal: &[f64], candela: &[Vec<f64>]) -> String {
+    let join = |v: &[f64]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(" ");
+    let mut s = format!(
+        "IESNA:LM-63-2002\n[TEST] spectrace test\nTILT=NONE\n1 1000 1 {} {} 1 2 0.1 0.1 0\n1 1 10\n{}\n{}\n",
+        vertical.len(),
+        horizontal.len(),
+        join(vertical),
+        join(horizontal)
+    );
+    for row in candela {
+        s += &join(row);
+        s += "\n";
+    }
+    s
+}
+
+/// A folder of its own for a test's files.
+fn folder(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("spectrace-luminaire-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// An `IesLight` read from a scene-file fragment with the file `lum.ies` in `dir`.
+fn load(dir: &Path, json: &str) -> Result<Box<dyn LightSource>, String> {
+    with_scene_folder(dir, false, || serde_json::from_str::<Box<dyn LightSource>>(json))
+        .0
+        .map_err(|e| e.to_string())
+}
+
+/// An asymmetric table over the whole circle: bright towards C = 90, dim towards C = 270,
+/// fading with the vertical angle (0..90 only).
+fn asymmetric() -> (Vec<f64>, Vec<f64>, Vec<Vec<f64>>) {
+    let vertical = vec![0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 90.0];
+    let horizontal: Vec<f64> = (0..=12).map(|k| k as f64 * 30.0).collect();
+    let candela = horizontal
+        .iter()
+        .map(|&c: &f64| {
+            vertical
+                .iter()
+                .map(|&g: &f64| {
+                    let toward_90 = 1.0 + 0.9 * c.to_radians().sin();
+                    (500.0 * toward_90 * (1.0 - g / 100.0)).round()
+                })
+                .collect()
+        })
+        .collect();
+    (vertical, horizontal, candela)
+}
+
+/// The exact flux of a table under bilinear interpolation in `(C, cos gamma)`: trapezoids in
+/// both coordinates, written here from the definition (independently of the sampler).
+fn flux_of(horizontal_rad: &[f64], cos_vertical: &[f64], candela: &[Vec<f64>]) -> f64 {
+    let mut total = 0.0;
+    for h in 0..horizontal_rad.len() - 1 {
+        for v in 0..cos_vertical.len() - 1 {
+            let mean =
+                (candela[h][v] + candela[h][v + 1] + candela[h + 1][v] + candela[h + 1][v + 1])
+                    / 4.0;
+            total += mean
+                * (horizontal_rad[h + 1] - horizontal_rad[h])
+                * (cos_vertical[v] - cos_vertical[v + 1]).abs();
+        }
+    }
+    total
+}
+
+#[test]
+fn the_table_reads_back_at_every_measured_angle_and_the_flux_is_its_integral() {
+    let (vertical, horizontal, candela) = asymmetric();
+    let d = CandelaDistribution::new(&horizontal, &vertical, &candela).unwrap();
+    for (h, &c) in horizontal.iter().enumerate() {
+        for (v, &g) in vertical.iter().enumerate() {
+            let got = d.candela(c.to_radians(), g.to_radians().cos());
+            assert!((got - candela[h][v]).abs() < 1e-9 * candela[h][v].max(1.0), "C{c} g{g}");
+        }
+    }
+    // Nothing above the horizon (the table stops at 90 degrees).
+    assert_eq!(d.candela(1.0, -0.2), 0.0);
+    let h: Vec<f64> = horizontal.iter().map(|c| c.to_radians()).collect();
+    let v: Vec<f64> = vertical.iter().map(|g| g.to_radians().cos()).collect();
+    let expected = flux_of(&h, &v, &candela);
+    assert!((d.lumens() - expected).abs() < 1e-9 * expected, "{} vs {expected}", d.lumens());
+    // An isotropic 100 cd table over the whole sphere has 400 pi lm.
+    let iso = CandelaDistribution::new(&[0.0], &[0.0, 90.0, 180.0], &[vec![100.0; 3]]).unwrap();
+    assert!((iso.lumens() - 400.0 * PI).abs() < 1e-9);
+}
+
+#[test]
+fn symmetric_tables_unfold_by_the_mirrors_the_formats_define() {
+    let vertical = [0.0, 45.0, 90.0];
+    let row = |k: f64| vec![100.0 + k, 50.0 + k, k];
+    // Quadrant (0..90): C 120 is C 60 mirrored about C 90, C 240 is C 60 turned by 180,
+    // C 300 is C 60 mirrored about C 0.
+    let q =
+        CandelaDistribution::new(&[0.0, 60.0, 90.0], &vertical, &[row(0.0), row(7.0), row(20.0)])
+            .unwrap();
+    for c in [60.0_f64, 120.0, 240.0, 300.0] {
+        assert!((q.candela(c.to_radians(), 1.0) - 107.0).abs() < 1e-9, "quadrant C{c}");
+    }
+    assert!((q.candela(270.0_f64.to_radians(), 1.0) - 120.0).abs() < 1e-9);
+    // Bilateral about C0-C180 (0..180): C 300 is C 60.
+    let b =
+        CandelaDistribution::new(&[0.0, 60.0, 180.0], &vertical, &[row(0.0), row(7.0), row(20.0)])
+            .unwrap();
+    assert!((b.candela(300.0_f64.to_radians(), 1.0) - 107.0).abs() < 1e-9);
+    assert!((b.candela(60.0_f64.to_radians(), 1.0) - 107.0).abs() < 1e-9);
+    // Bilateral about C90-C270 (90..270): C 30 is C 150, C 330 is C 210.
+    let c = CandelaDistribution::new(
+        &[90.0, 150.0, 210.0, 270.0],
+        &vertical,
+        &[row(0.0), row(7.0), row(20.0), row(30.0)],
+    )
+    .unwrap();
+    assert!((c.candela(30.0_f64.to_radians(), 1.0) - 107.0).abs() < 1e-9);
+    assert!((c.candela(330.0_f64.to_radians(), 1.0) - 120.0).abs() < 1e-9);
+    // No symmetry, ending before 360: wraps from the last plane to C 0.
+    let n = CandelaDistribution::new(
+        &[0.0, 120.0, 240.0],
+        &vertical,
+        &[row(0.0), row(30.0), row(60.0)],
+    )
+    .unwrap();
+    assert!((n.candela(300.0_f64.to_radians(), 1.0) - 130.0).abs() < 1e-9);
+    // A range that declares no symmetry is refused.
+    let e = CandelaDistribution::new(&[0.0, 45.0], &vertical, &[row(0.0), row(1.0)]).unwrap_err();
+    assert!(e.contains("declare no symmetry"), "{e}");
+}
+
+#[test]
+fn c_plane_90_lies_counter_clockwise_from_c0_seen_from_above() {
+    // Light only around C 90 (asymmetric, no symmetry): with nadir -y and c0 +x, C 90 is
+    // c0 x nadir = -z; turning the luminaire's c0 to +z moves it to +x.
+    let vertical = [0.0, 30.0, 60.0, 90.0];
+    let horizontal: Vec<f64> = (0..=8).map(|k| k as f64 * 45.0).collect();
+    let candela: Vec<Vec<f64>> = horizontal
+        .iter()
+        .map(|&c| {
+            let k = if c == 90.0 { 1000.0 } else { 0.0 };
+            vec![0.0, k, k, 0.0]
+        })
+        .collect();
+    let dir = folder("handedness");
+    std::fs::write(dir.join("lum.ies"), ies_text(&vertical, &horizontal, &candela)).unwrap();
+    for (c0, towards) in [([1.0, 0.0, 0.0], DVec3::NEG_Z), ([0.0, 0.0, 1.0], DVec3::X)] {
+        let json = format!(
+            r#"{{"type": "IesLight", "file": "lum.ies", "position": [0, 3, 0],
+               "nadir": [0, -1, 0], "c0": {c0:?}, "cct": 3000}}"#
+        );
+        let light = load(&dir, &json).unwrap();
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(1);
+        let mut mean = DVec3::ZERO;
+        for _ in 0..2000 {
+            let b = light.next_beam(&mut rng);
+            assert!(b.direction.y < 0.0, "below the luminaire only");
+            mean += b.direction;
+        }
+        let horizontal_mean = (mean - DVec3::Y * mean.y).normalize();
+        assert!(horizontal_mean.dot(towards) > 0.99, "{c0:?}: {horizontal_mean}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn emitted_directions_follow_the_candela_table() {
+    let (vertical, horizontal, candela) = asymmetric();
+    let dir = folder("chi2");
+    std::fs::write(dir.join("lum.ies"), ies_text(&vertical, &horizontal, &candela)).unwrap();
+    // A tilted luminaire, so the test also covers the frame.
+    let nadir = DVec3::new(0.3, -1.0, 0.2).normalize();
+    let json = r#"{"type": "IesLight", "file": "lum.ies", "position": [1, 2, 3],
+                   "nadir": [0.3, -1, 0.2], "c0": [1, 0, 0.5], "cct": 4000}"#;
+    let light = load(&dir, json).unwrap();
+    let c0 = {
+        let c = DVec3::new(1.0, 0.0, 0.5).normalize();
+        (c - nadir * c.dot(nadir)).normalize()
+    };
+    let c90 = c0.cross(nadir);
+    // Bins in (C, cos gamma): 24 x 10 over C in [0, 2 pi), cos gamma in [0, 1].
+    let (nc, nm) = (24usize, 10usize);
+    let n = 300_000u64;
+    let mut counts = vec![0u64; nc * nm];
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(2);
+    for _ in 0..n {
+        let b = light.next_beam(&mut rng);
+        assert_eq!(b.origin, DVec3::new(1.0, 2.0, 3.0));
+        let cos_g = b.direction.dot(nadir);
+        assert!(cos_g >= -1e-12, "a beam above the horizon: {cos_g}");
+        let c = b.direction.dot(c90).atan2(b.direction.dot(c0)).rem_euclid(TAU);
+        let i = ((c / TAU * nc as f64) as usize).min(nc - 1);
+        let j = ((cos_g.max(0.0) * nm as f64) as usize).min(nm - 1);
+        counts[i * nm + j] += 1;
+    }
+    // Expected: the candela table interpolated from its definition (linear in C between planes,
+    // linear in cos gamma between vertical angles), integrated over each bin by 8x8 midpoints,
+    // over the flux.
+    let h: Vec<f64> = horizontal.iter().map(|c| c.to_radians()).collect();
+    let v: Vec<f64> = vertical.iter().map(|g| g.to_radians().cos()).collect();
+    let interpolate = |c: f64, mu: f64| {
+        let a = (h.partition_point(|&x| x <= c).max(1) - 1).min(h.len() - 2);
+        let t = (c - h[a]) / (h[a + 1] - h[a]);
+        // v decreases with the index.
+        let b = (v.partition_point(|&x| x >= mu).max(1) - 1).min(v.len() - 2);
+        let s = (mu - v[b]) / (v[b + 1] - v[b]);
+        let row = |k: usize| candela[k][b] * (1.0 - s) + candela[k][b + 1] * s;
+        row(a) * (1.0 - t) + row(a + 1) * t
+    };
+    let flux = flux_of(&h, &v, &candela);
+    let k = 8;
+    let expected: Vec<f64> = (0..nc * nm)
+        .map(|cell| {
+            let (i, j) = (cell / nm, cell % nm);
+            let (dc, dm) = (TAU / nc as f64, 1.0 / nm as f64);
+            let mut sum = 0.0;
+            for p in 0..k {
+                for q in 0..k {
+                    let c = (i as f64 + (p as f64 + 0.5) / k as f64) * dc;
+                    let mu = (j as f64 + (q as f64 + 0.5) / k as f64) * dm;
+                    sum += interpolate(c, mu);
+                }
+            }
+            sum / (k * k) as f64 * dc * dm / flux * n as f64
+        })
+        .collect();
+    let result = chi_square(&counts, &expected, 5.0);
+    assert!(result.p_value > 1e-3, "{result:?}");
+    // The density the light reports is the same table's.
+    let d = (nadir * 0.8 + c90 * 0.6).normalize();
+    let pdf = light.emission_density(DVec3::ZERO, d);
+    let (c, mu) = (d.dot(c90).atan2(d.dot(c0)).rem_euclid(TAU), d.dot(nadir));
+    assert!((pdf - interpolate(c, mu) / flux).abs() < 1e-9 * pdf, "{pdf}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_beams_carry_the_tables_lumens() {
+    let (vertical, horizontal, candela) = asymmetric();
+    let dir = folder("lumens");
+    std::fs::write(dir.join("lum.ies"), ies_text(&vertical, &horizontal, &candela)).unwrap();
+    let json = r#"{"type": "IesLight", "file": "lum.ies", "position": [0, 3, 0], "multiplier": 2,
+                   "spd": {"type": "CieIlluminant", "name": "D65"}}"#;
+    let light = load(&dir, json).unwrap();
+    let h: Vec<f64> = horizontal.iter().map(|c| c.to_radians()).collect();
+    let v: Vec<f64> = vertical.iter().map(|g| g.to_radians().cos()).collect();
+    let expected = 2.0 * flux_of(&h, &v, &candela);
+    // The power is the flux over the spectrum's efficacy.
+    let k = luminous_efficacy(light.spd().as_ref());
+    assert!((light.power() * k - expected).abs() < 1e-9 * expected);
+    // Sum the beams' luminous power: P / N * scale * 683 ybar(lambda).
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(3);
+    let n = 200_000;
+    let (mut sum, mut sum2) = (0.0, 0.0);
+    for _ in 0..n {
+        let b = light.next_beam(&mut rng);
+        let lm = b.scale * lumens_per_watt(b.lambda);
+        sum += lm;
+        sum2 += lm * lm;
+    }
+    let mean = sum / n as f64;
+    let se = ((sum2 / n as f64 - mean * mean) / n as f64).sqrt();
+    let lumens = light.power() * mean;
+    // Four standard errors (the wavelength draw is the only randomness).
+    assert!(
+        (lumens - expected).abs() < 4.0 * light.power() * se,
+        "{lumens} vs {expected} (se {})",
+        light.power() * se
+    );
+    assert!(light.power() * se < 0.005 * expected, "the check is sharp to 0.5%");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn next_event_samples_give_the_intensity_towards_the_receiver() {
+    let (vertical, horizontal, candela) = asymmetric();
+    let dir = folder("towards");
+    std::fs::write(dir.join("lum.ies"), ies_text(&vertical, &horizontal, &candela)).unwrap();
+    let json = r#"{"type": "IesLight", "file": "lum.ies", "position": [0, 3, 0], "cct": 5000}"#;
+    let light = load(&dir, json).unwrap();
+    let ies = IesLight::new(
+        spectrace_lights::photometry::IesFile::parse(
+            &ies_text(&vertical, &horizontal, &candela),
+            "lum.ies",
+        )
+        .unwrap(),
+        DVec3::new(0.0, 3.0, 0.0),
+        DVec3::NEG_Y,
+        DVec3::X,
+        light.spd(),
+        1.0,
+        Default::default(),
+    )
+    .unwrap();
+    // Straight below, and 45 degrees towards C 90 (= -z): the file's values, in W/sr.
+    let k = luminous_efficacy(light.spd().as_ref());
+    let below = light.sample_towards(DVec3::ZERO, [0.5, 0.5]).unwrap();
+    assert!(below.delta && (below.distance - 3.0).abs() < 1e-12);
+    assert!((below.intensity * k - candela[0][0]).abs() < 1e-6 * candela[0][0]);
+    let s = light.sample_towards(DVec3::new(0.0, 0.0, -3.0), [0.5, 0.5]).unwrap();
+    assert!((s.intensity * k - candela[3][3]).abs() < 1e-6 * candela[3][3], "{}", s.intensity * k);
+    assert!((ies.candela_towards(s.direction) - candela[3][3]).abs() < 1e-9);
+    let e = light.sample_emission([0.3, 0.6, 0.5, 0.5]).unwrap();
+    let (pa, pd) = light.pdf_emission(e.position, e.direction).unwrap();
+    assert_eq!(pa, 1.0);
+    assert!((pd - e.pdf_direction).abs() < 1e-12 * pd);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn scene_file_errors_name_the_file_the_line_and_the_field() {
+    let dir = folder("errors");
+    let missing = load(&dir, r#"{"type": "IesLight", "file": "none.ies", "position": [0, 1, 0]}"#)
+        .unwrap_err();
+    assert!(missing.contains("IesLight.file") && missing.contains("none.ies"), "{missing}");
+    // Truncated: the candela values stop early.
+    let (vertical, horizontal, candela) = asymmetric();
+    let text = ies_text(&vertical, &horizontal, &candela);
+    let cut: String = text.lines().take(9).collect::<Vec<_>>().join("\n");
+    std::fs::write(dir.join("cut.ies"), cut).unwrap();
+    let e = load(&dir, r#"{"type": "IesLight", "file": "cut.ies", "position": [0, 1, 0]}"#)
+        .unwrap_err();
+    assert!(e.contains("cut.ies:9:"), "{e}");
+    std::fs::write(dir.join("lum.ies"), &text).unwrap();
+    let e = load(
+        &dir,
+        r#"{"type": "IesLight", "file": "lum.ies", "position": [0, 1, 0], "c0": [0, 2, 0]}"#,
+    )
+    .unwrap_err();
+    assert!(e.contains("IesLight.c0") && e.contains("parallel"), "{e}");
+    let e = load(
+        &dir,
+        r#"{"type": "IesLight", "file": "lum.ies", "position": [0, 1, 0],
+            "spd": {"type": "Monochromatic", "lambda_nm": 300}}"#,
+    )
+    .unwrap_err();
+    assert!(e.contains("no visible light"), "{e}");
+    let e = load(
+        &dir,
+        r#"{"type": "IesLight", "file": "lum.ies", "position": [0, 1, 0], "multiplier": -1}"#,
+    )
+    .unwrap_err();
+    assert!(e.contains("IesLight.multiplier"), "{e}");
+    let e = load(
+        &dir,
+        r#"{"type": "IesLight", "file": "lum.ies", "position": [0, 1, 0], "cct": 3000,
+            "spd": {"type": "Blackbody", "kelvin": 3000}}"#,
+    )
+    .unwrap_err();
+    assert!(e.contains("either"), "{e}");
+    // Without `spd` or `cct`: CIE illuminant A.
+    let a =
+        load(&dir, r#"{"type": "IesLight", "file": "lum.ies", "position": [0, 1, 0]}"#).unwrap();
+    let illuminant_a = spectrace_lights::spectrum::CieIlluminant::new("A").unwrap();
+    assert_eq!(luminous_efficacy(a.spd().as_ref()), luminous_efficacy(&illuminant_a));
+    assert_eq!(a.spd().value(560.0), illuminant_a.value(560.0));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
