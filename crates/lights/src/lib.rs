@@ -20,7 +20,7 @@
 //! | [`FadingSpotLight`] | the seed's fading spot, intensity per solid angle fading to 0 at the cone |
 //! | [`PointLight`] | isotropic |
 //! | [`RectangleLight`], [`DiskLight`] | Lambertian area lights, one- or two-sided |
-//! | [`IesLight`] | a measured luminaire: intensity from an IES LM-63 file's candela table |
+//! | [`IesLight`], [`EulumdatLight`] | measured luminaires: intensity from an IES LM-63 or EULUMDAT candela table |
 //! | [`LightSet`] | the seed's LightSourceManager: picks a light by power, itself a light |
 //!
 //! Beyond beams, every built-in light answers what path tracing and bidirectional methods ask of
@@ -53,7 +53,7 @@ pub use beam::{Beam, LightId};
 pub use counter::BeamCounter;
 pub use error::LightError;
 pub use laser::Laser;
-pub use photometry::IesLight;
+pub use photometry::{EulumdatLight, IesLight};
 pub use set::LightSet;
 pub use sky::Sky;
 pub use source::{

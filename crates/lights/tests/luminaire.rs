@@ -373,3 +373,85 @@ fn scene_file_errors_name_the_file_the_line_and_the_field() {
     assert_eq!(a.spd().value(560.0), illuminant_a.value(560.0));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A EULUMDAT file without symmetry (Isym 0): 8 C-planes every 45 degrees, gammas 0..90 every
+/// 30, one set of 2 lamps of 1000 lm at "3000 K"; `cd_per_klm[c][g]`.
+fn ldt_text(cd_per_klm: &[[f64; 4]; 8]) -> String {
+    let mut lines: Vec<String> = [
+        "Spectrace tests",
+        "1",
+        "0",
+        "8",
+        "45",
+        "4",
+        "30",
+        "report",
+        "asymmetric",
+        "A-1",
+        "a.ldt",
+        "2026",
+        "600",
+        "100",
+        "50",
+        "600",
+        "100",
+        "50",
+        "50",
+        "50",
+        "50",
+        "100",
+        "80",
+        "1",
+        "0",
+        "1",
+        "2",
+        "LED",
+        "2000",
+        "3000 K",
+        "80",
+        "20",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    lines.extend((0..10).map(|k| format!("0.{}", k + 1)));
+    lines.extend((0..8).map(|k| (k * 45).to_string()));
+    lines.extend((0..4).map(|k| (k * 30).to_string()));
+    for plane in cd_per_klm {
+        lines.extend(plane.iter().map(|v| v.to_string()));
+    }
+    lines.join("\n") + "\n"
+}
+
+#[test]
+fn a_eulumdat_luminaire_is_absolute_oriented_and_lit_by_its_lamps_colour() {
+    let mut table = [[0.0; 4]; 8];
+    table[2] = [0.0, 400.0, 400.0, 0.0]; // C 90 only
+    let dir = folder("ldt");
+    std::fs::write(dir.join("a.ldt"), ldt_text(&table)).unwrap();
+    let light =
+        load(&dir, r#"{"type": "EulumdatLight", "file": "a.ldt", "position": [0, 3, 0]}"#).unwrap();
+    // Absolute: cd/klm x 2000 lm / 1000, so 800 cd at (C 90, gamma 30).
+    let k = luminous_efficacy(light.spd().as_ref());
+    // 60 degrees from nadir towards -z is (C 90, gamma 60): 400 cd/klm x 2.
+    let towards = DVec3::new(0.0, -0.5, -(0.75_f64.sqrt()));
+    let at = light.sample_towards(DVec3::new(0.0, 3.0, 0.0) + towards * 2.0, [0.5, 0.5]).unwrap();
+    assert!((at.intensity * k - 800.0).abs() < 1e-6, "{}", at.intensity * k);
+    // C 90 is -z with the default orientation: every beam heads that way.
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(4);
+    for _ in 0..500 {
+        let b = light.next_beam(&mut rng);
+        assert!(b.direction.z < 0.0 && b.direction.y < 0.0, "{}", b.direction);
+    }
+    // The lamps' "3000 K" gives the default spectrum.
+    let bb = spectrace_lights::spectrum::Blackbody::new(3000.0).unwrap();
+    assert_eq!(light.spd().value(555.0), bb.value(555.0));
+    // Beyond the table, and an error names the line.
+    let text = ldt_text(&table);
+    let cut: String = text.lines().take(30).collect::<Vec<_>>().join("\n");
+    std::fs::write(dir.join("cut.ldt"), cut).unwrap();
+    let e = load(&dir, r#"{"type": "EulumdatLight", "file": "cut.ldt", "position": [0, 3, 0]}"#)
+        .unwrap_err();
+    assert!(e.contains("EulumdatLight.file") && e.contains("cut.ldt:"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

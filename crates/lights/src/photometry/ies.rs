@@ -29,29 +29,10 @@
 //! files use) and end where the symmetry the format defines allows (0: axial symmetry, 90:
 //! quadrant, 180: bilateral, 360: none); nothing follows the last candela value but blanks.
 
-use std::fmt;
+use super::{CandelaPlanes, PhotometryError};
 
 /// Most angles along either axis of a candela table.
 pub const MAX_ANGLES: usize = 4096;
-
-/// Where an IES file went wrong: the file's name as given, the line (1-based) and the cause.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct IesError {
-    /// The file name, as passed to [`IesFile::parse`].
-    pub file: String,
-    /// Line number, 1-based (the last line for a file that ends too early).
-    pub line: usize,
-    /// What is wrong.
-    pub message: String,
-}
-
-impl fmt::Display for IesError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:{}: {}", self.file, self.line, self.message)
-    }
-}
-
-impl std::error::Error for IesError {}
 
 /// The version an IES file declares on its first line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -130,12 +111,12 @@ struct Tokens<'a> {
 }
 
 impl<'a> Tokens<'a> {
-    fn error(&self, line: usize, message: impl Into<String>) -> IesError {
-        IesError { file: self.file.to_owned(), line, message: message.into() }
+    fn error(&self, line: usize, message: impl Into<String>) -> PhotometryError {
+        PhotometryError { file: self.file.to_owned(), line, message: message.into() }
     }
 
     /// The next number, named `what` in errors.
-    fn number(&mut self, what: &str) -> Result<(f64, usize), IesError> {
+    fn number(&mut self, what: &str) -> Result<(f64, usize), PhotometryError> {
         let Some(&(line, text)) = self.items.get(self.next) else {
             return Err(
                 self.error(self.last_line, format!("the file ends before {what} (truncated?)"))
@@ -149,7 +130,7 @@ impl<'a> Tokens<'a> {
     }
 
     /// The next number as a count in `1..=max`.
-    fn count(&mut self, what: &str, max: usize) -> Result<usize, IesError> {
+    fn count(&mut self, what: &str, max: usize) -> Result<usize, PhotometryError> {
         let (v, line) = self.number(what)?;
         if v.fract() != 0.0 || v < 1.0 || v > max as f64 {
             return Err(
@@ -160,7 +141,7 @@ impl<'a> Tokens<'a> {
     }
 
     /// `n` numbers named `what[i]`.
-    fn numbers(&mut self, what: &str, n: usize) -> Result<Vec<(f64, usize)>, IesError> {
+    fn numbers(&mut self, what: &str, n: usize) -> Result<Vec<(f64, usize)>, PhotometryError> {
         (0..n).map(|i| self.number(&format!("{what}[{i}]"))).collect()
     }
 }
@@ -169,9 +150,10 @@ impl IesFile {
     /// Parses the text of an IES file; `file` names it in errors.
     ///
     /// # Errors
-    /// [`IesError`] with the line and cause for anything the module documentation lists.
-    pub fn parse(text: &str, file: &str) -> Result<Self, IesError> {
-        let err = |line: usize, message: String| IesError { file: file.to_owned(), line, message };
+    /// [`PhotometryError`] with the line and cause for anything the module documentation lists.
+    pub fn parse(text: &str, file: &str) -> Result<Self, PhotometryError> {
+        let err =
+            |line: usize, message: String| PhotometryError { file: file.to_owned(), line, message };
         let lines: Vec<&str> = text.lines().collect();
         let mut i = 0;
         let first = lines.first().map_or("", |l| l.trim());
@@ -388,12 +370,25 @@ impl IesFile {
     }
 }
 
+impl IesFile {
+    /// The table as [`CandelaPlanes`]: the angles and candela as stored (multiplier applied),
+    /// `lamp_lumens` the lamps times their rated lumens (`None` for absolute photometry).
+    pub fn candela_planes(&self) -> CandelaPlanes {
+        CandelaPlanes {
+            horizontal: self.horizontal.clone(),
+            vertical: self.vertical.clone(),
+            candela: self.candela.clone(),
+            lamp_lumens: self.lumens_per_lamp.map(|l| l * f64::from(self.lamps)),
+        }
+    }
+}
+
 /// Checks that `values` strictly increase, naming the first that does not.
 fn increasing(
     values: &[(f64, usize)],
     what: &str,
-    err: &impl Fn(usize, String) -> IesError,
-) -> Result<(), IesError> {
+    err: &impl Fn(usize, String) -> PhotometryError,
+) -> Result<(), PhotometryError> {
     for w in values.windows(2) {
         if !(w[1].0 > w[0].0) {
             return Err(err(

@@ -1,6 +1,6 @@
 //! Measured luminaires as beam generators: [`CandelaDistribution`] (a type C candela table over
-//! the whole sphere, sampled exactly) and [`IesLight`], a point light whose intensity follows an
-//! IES LM-63 file.
+//! the whole sphere, sampled exactly), and [`IesLight`] and [`EulumdatLight`], point lights whose
+//! intensity follows an IES LM-63 or a EULUMDAT file. Both take the same keys.
 //!
 //! | field | unit | default | meaning |
 //! |---|---|---|---|
@@ -16,6 +16,7 @@
 //! ```json
 //! {"type": "IesLight", "file": "downlight.ies", "position": [0, 2.8, 0],
 //!  "nadir": [0, -1, 0], "c0": [1, 0, 0], "cct": 4000, "multiplier": 1}
+//! {"type": "EulumdatLight", "file": "linear.ldt", "position": [0, 2.8, 0]}
 //! ```
 //!
 //! # Angles and handedness
@@ -73,7 +74,7 @@ use crate::{
     WavelengthSampling,
 };
 
-use super::IesFile;
+use super::{CandelaPlanes, IesFile, LdtFile};
 
 /// Largest photometric file read (4 MiB; a 1-degree table over the whole sphere is under 1 MiB).
 pub const MAX_PHOTOMETRIC_BYTES: u64 = 4 << 20;
@@ -406,17 +407,17 @@ macro_rules! luminaire_light_source {
 
 /// A luminaire whose intensity follows an IES LM-63 file (type C photometry).
 #[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(try_from = "IesRepr", into = "IesRepr")]
+#[serde(try_from = "LuminaireRepr", into = "LuminaireRepr")]
 pub struct IesLight {
     luminaire: Luminaire,
-    repr: Arc<IesRepr>,
+    repr: Arc<LuminaireRepr>,
     file: Arc<IesFile>,
 }
 
-/// Scene-file form of [`IesLight`].
+/// Scene-file form of [`IesLight`] and [`EulumdatLight`].
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct IesRepr {
+struct LuminaireRepr {
     file: PathBuf,
     position: DVec3,
     #[serde(default = "default_nadir")]
@@ -464,9 +465,9 @@ pub(crate) fn read_photometric_file(
         .map_err(|message| LightError::File { light, field: "file", message })
 }
 
-impl TryFrom<IesRepr> for IesLight {
+impl TryFrom<LuminaireRepr> for IesLight {
     type Error = LightError;
-    fn try_from(r: IesRepr) -> Result<Self, LightError> {
+    fn try_from(r: LuminaireRepr) -> Result<Self, LightError> {
         const LIGHT: &str = "IesLight";
         let (path, text) = read_photometric_file(LIGHT, &r.file, "IES file")?;
         let ies = IesFile::parse(&text, &path.display().to_string()).map_err(|e| {
@@ -479,7 +480,7 @@ impl TryFrom<IesRepr> for IesLight {
     }
 }
 
-impl From<IesLight> for IesRepr {
+impl From<IesLight> for LuminaireRepr {
     fn from(l: IesLight) -> Self {
         Arc::unwrap_or_clone(l.repr)
     }
@@ -505,14 +506,11 @@ impl IesLight {
         const LIGHT: &str = "IesLight";
         let multiplier = check_multiplier(LIGHT, multiplier)?;
         let orientation = Orientation::new(LIGHT, nadir, c0)?;
-        let factor = multiplier * ies.ballast_factor;
-        let candela: Vec<Vec<f64>> =
-            ies.candela.iter().map(|row| row.iter().map(|c| c * factor).collect()).collect();
-        let distribution = CandelaDistribution::new(&ies.horizontal, &ies.vertical, &candela)
-            .map_err(|message| LightError::File { light: LIGHT, field: "file", message })?;
+        let distribution =
+            distribution_of(LIGHT, &ies.candela_planes(), multiplier * ies.ballast_factor)?;
         let luminaire =
             Luminaire::new(LIGHT, position, orientation, distribution, spd.clone(), sampling)?;
-        let repr = IesRepr {
+        let repr = LuminaireRepr {
             file: PathBuf::new(),
             position,
             nadir,
@@ -550,4 +548,135 @@ impl IesLight {
 #[typetag::serde]
 impl LightSource for IesLight {
     luminaire_light_source!();
+}
+
+/// The distribution of a stored table with every value times `factor`.
+fn distribution_of(
+    light: &'static str,
+    planes: &CandelaPlanes,
+    factor: f64,
+) -> Result<CandelaDistribution, LightError> {
+    let candela: Vec<Vec<f64>> =
+        planes.candela.iter().map(|row| row.iter().map(|c| c * factor).collect()).collect();
+    CandelaDistribution::new(&planes.horizontal, &planes.vertical, &candela)
+        .map_err(|message| LightError::File { light, field: "file", message })
+}
+
+// ---------------------------------------------------------------------------------------------
+
+/// A luminaire whose intensity follows a EULUMDAT (`.ldt`) file: its cd/klm table times the
+/// lamps' total flux over 1000.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(try_from = "LuminaireRepr", into = "LuminaireRepr")]
+pub struct EulumdatLight {
+    luminaire: Luminaire,
+    repr: Arc<LuminaireRepr>,
+    file: Arc<LdtFile>,
+}
+
+/// The colour temperature (K) of a EULUMDAT lamp set, when its text is a number of kelvin
+/// between 1000 and 25000 (`"3000"`, `"3000K"`, `"3000 K"`); `None` for anything else
+/// (`"830"`, `"ww"`, empty).
+fn lamp_cct(text: &str) -> Option<f64> {
+    let t = text.trim();
+    let t = t.strip_suffix(['K', 'k']).unwrap_or(t).trim();
+    t.replace(',', ".").parse::<f64>().ok().filter(|k| (1000.0..=25000.0).contains(k))
+}
+
+impl TryFrom<LuminaireRepr> for EulumdatLight {
+    type Error = LightError;
+    fn try_from(r: LuminaireRepr) -> Result<Self, LightError> {
+        const LIGHT: &str = "EulumdatLight";
+        let (path, text) = read_photometric_file(LIGHT, &r.file, "EULUMDAT file")?;
+        let ldt = LdtFile::parse(&text, &path.display().to_string()).map_err(|e| {
+            LightError::File { light: LIGHT, field: "file", message: e.to_string() }
+        })?;
+        let default_cct = ldt.lamp_sets.first().and_then(|l| lamp_cct(&l.colour_temperature));
+        let spd = Luminaire::spectrum(LIGHT, r.spd.clone(), r.cct, default_cct)?;
+        let light =
+            Self::new(ldt, r.position, r.nadir, r.c0, spd, r.multiplier, r.wavelength_sampling)?;
+        Ok(Self { repr: Arc::new(r), ..light })
+    }
+}
+
+impl From<EulumdatLight> for LuminaireRepr {
+    fn from(l: EulumdatLight) -> Self {
+        Arc::unwrap_or_clone(l.repr)
+    }
+}
+
+impl EulumdatLight {
+    /// A luminaire with the table of `ldt` (absolute: cd/klm times the lamp flux / 1000, times
+    /// `multiplier`) at `position`, oriented by `nadir` and `c0`, emitting `spd`.
+    ///
+    /// # Errors
+    /// As [`IesLight::new`].
+    pub fn new(
+        ldt: LdtFile,
+        position: DVec3,
+        nadir: DVec3,
+        c0: DVec3,
+        spd: Arc<dyn SpectralPowerDistribution>,
+        multiplier: f64,
+        sampling: WavelengthSampling,
+    ) -> Result<Self, LightError> {
+        const LIGHT: &str = "EulumdatLight";
+        let multiplier = check_multiplier(LIGHT, multiplier)?;
+        let orientation = Orientation::new(LIGHT, nadir, c0)?;
+        let distribution = distribution_of(LIGHT, &ldt.candela_planes(), multiplier)?;
+        let luminaire =
+            Luminaire::new(LIGHT, position, orientation, distribution, spd.clone(), sampling)?;
+        let repr = LuminaireRepr {
+            file: PathBuf::new(),
+            position,
+            nadir,
+            c0,
+            spd: Some(spd),
+            cct: None,
+            multiplier,
+            wavelength_sampling: sampling,
+        };
+        Ok(Self { luminaire, repr: Arc::new(repr), file: Arc::new(ldt) })
+    }
+
+    /// The candela distribution (absolute, scaled by `multiplier`).
+    pub fn distribution(&self) -> &CandelaDistribution {
+        &self.luminaire.distribution
+    }
+
+    /// The parsed file.
+    pub fn file(&self) -> &LdtFile {
+        &self.file
+    }
+
+    /// The luminous flux (lm) the light emits.
+    pub fn lumens(&self) -> f64 {
+        self.luminaire.distribution.lumens()
+    }
+
+    /// Luminous intensity (cd) along the unit world direction `d`.
+    pub fn candela_towards(&self, d: DVec3) -> f64 {
+        let (c, cos_gamma) = self.luminaire.orientation.angles(d);
+        self.luminaire.distribution.candela(c, cos_gamma)
+    }
+}
+
+#[typetag::serde]
+impl LightSource for EulumdatLight {
+    luminaire_light_source!();
+}
+
+#[cfg(test)]
+mod tests {
+    use super::lamp_cct;
+
+    #[test]
+    fn lamp_colour_temperatures_are_read_only_when_they_are_kelvin() {
+        assert_eq!(lamp_cct("3000"), Some(3000.0));
+        assert_eq!(lamp_cct(" 4000 K"), Some(4000.0));
+        assert_eq!(lamp_cct("2700k"), Some(2700.0));
+        assert_eq!(lamp_cct("830"), None);
+        assert_eq!(lamp_cct("warm white"), None);
+        assert_eq!(lamp_cct(""), None);
+    }
 }

@@ -2,9 +2,56 @@
 //! Small and strict, written from the formats' documents (no dependency: the crates that read
 //! them today are AGPL-3.0 or unlicensed). Each reader turns a file into its candela table and
 //! names the file and line of anything wrong.
+//!
+//! Two readers, one view: [`IesFile`] (IES LM-63) and [`LdtFile`] (EULUMDAT) both give
+//! [`CandelaPlanes`], the stored part of their type C table in absolute candela, with the
+//! horizontal range declaring the symmetry as IES LM-63 does.
+
+use std::fmt;
 
 mod ies;
+mod ldt;
 mod luminaire;
 
-pub use ies::{IesError, IesFile, IesVersion, MAX_ANGLES, Tilt, Units};
-pub use luminaire::{CandelaDistribution, IesLight, MAX_PHOTOMETRIC_BYTES};
+pub use ies::{IesFile, IesVersion, MAX_ANGLES, Tilt, Units};
+pub use ldt::{LampSet, LdtFile, LdtSymmetry, MAX_LAMP_SETS};
+pub use luminaire::{CandelaDistribution, EulumdatLight, IesLight, MAX_PHOTOMETRIC_BYTES};
+
+/// Where a photometric file went wrong: the file's name as given, the line (1-based) and the
+/// cause.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PhotometryError {
+    /// The file name, as passed to the reader's `parse` ([`IesFile::parse`], [`LdtFile::parse`]).
+    pub file: String,
+    /// Line number, 1-based (the last line for a file that ends too early).
+    pub line: usize,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for PhotometryError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}:{}: {}", self.file, self.line, self.message)
+    }
+}
+
+impl std::error::Error for PhotometryError {}
+
+/// The former name of [`PhotometryError`], from when the IES reader was the only one.
+pub type IesError = PhotometryError;
+
+/// The stored part of a type C candela table, absolute.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CandelaPlanes {
+    /// Horizontal (C-plane) angles in degrees, strictly increasing, in the stored range that
+    /// declares the symmetry exactly as IES LM-63 does: [0] (rotational), 0..=90 (quadrant),
+    /// 0..=180 (bilateral about C0-C180), 90..=270 (bilateral about C90-C270), 0..<=360 (none).
+    pub horizontal: Vec<f64>,
+    /// Vertical (gamma) angles in degrees from nadir, strictly increasing, within [0, 180].
+    pub vertical: Vec<f64>,
+    /// Absolute candela, `candela[h][v]`.
+    pub candela: Vec<Vec<f64>>,
+    /// Rated lamp lumens the table was scaled for (sum over lamps), `None` for absolute
+    /// photometry.
+    pub lamp_lumens: Option<f64>,
+}
