@@ -26,6 +26,8 @@ mod output;
 mod part;
 pub mod pilot;
 mod scene;
+mod sensor_output;
+mod sensors;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -47,6 +49,13 @@ pub use part::{PARTIAL_VERSION, PartialFilm};
 pub use scene::{
     DEFAULT_SPP, EffectsSettings, LoadOptions, Object, OutputSettings, Scene, SceneError,
     SceneFile, Settings, check_target_error,
+};
+pub use sensor_output::{
+    MAX_SENSOR_CELLS, SensorGrid, SensorSummary, sensor_colour, write_sensor_files,
+};
+pub use sensors::{
+    SensorReport, SensorSource, check_sensor_names, planned_sensor_outputs, sensor_grid,
+    sensor_pass, sensor_plan, sensor_summary, write_sensors,
 };
 
 /// Command-line overrides of a scene's settings.
@@ -151,6 +160,9 @@ pub struct RenderReport {
     pub light_power: f64,
     /// Files written.
     pub outputs: Vec<String>,
+    /// The illuminance sensors' figures (empty for a scene without sensors).
+    #[serde(default)]
+    pub sensors: Vec<SensorReport>,
     /// Spectrace version.
     pub version: String,
 }
@@ -285,6 +297,7 @@ pub fn tracer_scene(scene: &Scene) -> LightTracerScene<'_> {
     LightTracerScene::new(&scene.world, &scene.materials, &scene.lights, &scene.camera)
         .with_emitters(scene.emitters.clone(), scene.object_shapes)
         .with_sampler(scene.settings.sampler)
+        .with_sensors(&scene.sensors)
 }
 
 /// The estimator for a scene (with an optional override) and the reason, in words.
@@ -634,6 +647,7 @@ fn planned_outputs(
     settings: &OutputSettings,
     shard: Option<(u64, u64)>,
     inputs: &[PathBuf],
+    sensor_outputs: Vec<PathBuf>,
 ) -> Result<(), RenderError> {
     check_output_name(name).map_err(|e| RenderError::Options(format!("output name: {e}")))?;
     prepare_out_dir(out_dir).map_err(RenderError::Options)?;
@@ -651,6 +665,7 @@ fn planned_outputs(
                 v.push(out_dir.join(format!("{name}.error.exr")));
             }
             v.push(out_dir.join(format!("{name}.json")));
+            v.extend(sensor_outputs);
             v
         }
     };
@@ -665,7 +680,15 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
     let (choice, reason) = choose_integrator(scene, options.integrator);
     let plan = plan_with(scene, options, choice)?;
     let name = scene.output_name();
-    planned_outputs(&options.out_dir, &name, &scene.output, plan.shard, &scene.inputs)?;
+    check_sensor_names(scene, &name)?;
+    planned_outputs(
+        &options.out_dir,
+        &name,
+        &scene.output,
+        plan.shard,
+        &scene.inputs,
+        planned_sensor_outputs(scene, &options.out_dir),
+    )?;
     let (plan, estimate_warning) = fit_estimate(scene, plan)?;
     let effects = decide_effects(scene, options.effects);
     if options.verbose {
@@ -793,6 +816,13 @@ fn render_with(
     let Setup { choice, reason, effects, plan, name } = *setup;
     let name = name.to_owned();
     warnings.extend(integrator_warnings(scene, choice));
+    if !scene.sensors.is_empty() && plan.shard.is_some() {
+        warnings.push(
+            "sensors are written by unsharded renders only (merge-parts writes the image): \
+             render without --shard for the sensors' files"
+                .to_owned(),
+        );
+    }
     // The light tracer's probe checks that light can reach the camera (for camera integrators a
     // black image is reported after the render).
     let probed = probe_with(scene, &plan, tracer)?;
@@ -870,7 +900,31 @@ fn render_with(
             probed.beams, output.beams
         ));
     }
-    let report = make_report(&output, written);
+    let sensors = if scene.sensors.is_empty() {
+        Vec::new()
+    } else if tracer.sensor_cells() > 0 {
+        let source = SensorSource {
+            film: &output.film,
+            beams: output.beams,
+            seconds: output.seconds,
+            filled_by: "image beams (light tracer)",
+        };
+        write_sensors(scene, &options.out_dir, source)?
+    } else {
+        let (film, beams, seconds) =
+            sensor_pass(scene, &sensor_plan(scene, plan.threads), effects)?;
+        let source =
+            SensorSource { film: &film, beams, seconds, filled_by: "sensor pass (light tracer)" };
+        write_sensors(scene, &options.out_dir, source)?
+    };
+    for r in &sensors {
+        written.files.extend(r.files.iter().cloned());
+        if options.verbose {
+            eprintln!("{}", sensor_summary(r));
+        }
+    }
+    let mut report = make_report(&output, written);
+    report.sensors = sensors;
     write_sidecar(&options.out_dir, &name, &report)?;
     Ok(report)
 }
@@ -927,6 +981,7 @@ fn report(
         exr_scale_log2: written.exr_scale_log2,
         out_of_range_values: written.out_of_range_values,
         warnings,
+        sensors: Vec::new(),
         version: env!("CARGO_PKG_VERSION").to_owned(),
     }
 }
@@ -1092,7 +1147,7 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
             limit.source
         )));
     }
-    planned_outputs(out_dir, &first.name, &first.output_settings, None, parts)?;
+    planned_outputs(out_dir, &first.name, &first.output_settings, None, parts, Vec::new())?;
     let placeholder = RenderOutput {
         film: Film::new(1, 1).map_err(|e| RenderError::Options(e.to_string()))?,
         stats: TraceStats::default(),

@@ -45,7 +45,7 @@ pub struct PartialFilm {
 }
 
 /// Current [`PartialFilm::version`].
-pub const PARTIAL_VERSION: u32 = 5;
+pub const PARTIAL_VERSION: u32 = 6;
 
 /// bincode's configuration for part files: the standard encoding, with every claimed length
 /// bounded by the file-size limit so a forged length cannot make the decoder reserve memory.

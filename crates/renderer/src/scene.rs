@@ -17,6 +17,7 @@ use spectrace_tracer::{
     LightTracerSettings, MAX_DEPTH, ObjectEmission, ObjectLight, PathTracerSettings, PinholeCamera,
     RenderPlan, SamplerKind,
 };
+use spectrace_tracer::{IrradianceSensor, SensorSet};
 
 use crate::files::{MAX_SCENE_BYTES, check_output_name, read_bounded};
 use spectrace_sampling::files::{check_inside, with_scene_folder};
@@ -42,6 +43,9 @@ pub struct SceneFile {
     /// What to write.
     #[serde(default)]
     pub output: OutputSettings,
+    /// Illuminance sensors beside the camera (`{"type": "IrradianceSensor", ...}`).
+    #[serde(default)]
+    pub sensors: Vec<IrradianceSensor>,
 }
 
 /// One object: a shape and what its surface does.
@@ -83,6 +87,9 @@ pub struct Settings {
     pub rr_depth: u32,
     /// Beams per work chunk (the unit of random streams and of sharding).
     pub chunk_beams: u64,
+    /// Beams of the sensor pass that fills the sensors when a camera integrator renders the
+    /// image (default: `beams`); the light tracer fills them with the image's own beams.
+    pub sensor_beams: Option<u64>,
     /// The estimator: `"auto"` (the effects analysis chooses), `"light"`, `"path"` or `"bdpt"`.
     pub integrator: IntegratorChoice,
     /// Camera samples per pixel for the camera integrators (`path`, `bdpt`); the upper limit
@@ -110,6 +117,7 @@ impl Default for Settings {
             max_depth: 64,
             rr_depth: 4,
             chunk_beams: DEFAULT_CHUNK_BEAMS,
+            sensor_beams: None,
             integrator: IntegratorChoice::Auto,
             spp: DEFAULT_SPP,
             camera_wavelengths: CameraWavelengths::Visible,
@@ -234,9 +242,11 @@ pub struct Scene {
     pub effects: EffectsSettings,
     /// Output settings.
     pub output: OutputSettings,
-    /// Every file the scene was read from: the scene file (when loaded from one) and its OBJ
-    /// meshes. Outputs may never replace any of them.
+    /// Every file the scene was read from: the scene file (when loaded from one), its OBJ
+    /// meshes and luminaire files. Outputs may never replace any of them.
     pub inputs: Vec<PathBuf>,
+    /// The illuminance sensors.
+    pub sensors: SensorSet,
 }
 
 /// How a scene file may refer to other files.
@@ -354,6 +364,9 @@ impl Scene {
         if s.spp == 0 {
             return Err(scene_error("settings.spp", "must be at least 1".to_owned()));
         }
+        if s.sensor_beams == Some(0) {
+            return Err(scene_error("settings.sensor_beams", "must be at least 1".to_owned()));
+        }
         if s.chunk_beams == 0 {
             return Err(scene_error("settings.chunk_beams", "must be at least 1".to_owned()));
         }
@@ -456,6 +469,11 @@ impl Scene {
             non_convex.push(false);
             emitters.push(Some(Emitter::Light(LightId(index as u32))));
         }
+        for (i, sensor) in file.sensors.iter().enumerate() {
+            check_output_name(sensor.name())
+                .map_err(|e| scene_error(&format!("sensors[{i}].name"), e))?;
+        }
+        let sensors = SensorSet::new(file.sensors).map_err(|e| scene_error("sensors", e))?;
         let world = World::with_base_dir(shapes, base)
             .map_err(|e| scene_error("objects", e.to_string()))?;
         let canonical_json = serde_json::to_string(&value).unwrap_or_default();
@@ -473,6 +491,7 @@ impl Scene {
             effects: file.effects,
             output: file.output,
             inputs,
+            sensors,
         })
     }
 

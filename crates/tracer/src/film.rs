@@ -136,14 +136,24 @@ pub trait Splat {
     /// if the pixel is outside the film or a component is NaN, infinite or larger than 2^62
     /// (films and writers then count a rejection and add nothing).
     fn splat(&mut self, x: u32, y: u32, xyz: Xyz) -> bool;
+
+    /// Adds `[radiant, luminous, luminous^2]` to sensor cell `cell` (numbered over all the
+    /// scene's sensors, see [`crate::SensorSet`]); same rejections as `splat`. The default, for
+    /// targets without sensors, rejects.
+    fn splat_sensor(&mut self, cell: u32, sums: crate::SensorSums) -> bool {
+        let _ = (cell, sums);
+        false
+    }
 }
 
-/// A film of `width x height` pixels, each accumulating X, Y, Z exactly.
+/// A film of `width x height` pixels, each accumulating X, Y, Z exactly, followed by the cells
+/// of the scene's sensors (if any), each accumulating `[radiant, luminous, luminous^2]` the same
+/// way (see [`crate::SensorSums`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Film {
     width: u32,
     height: u32,
-    /// `[X, Y, Z]` per pixel, row-major from the top-left pixel.
+    /// `[X, Y, Z]` per pixel, row-major from the top-left pixel, then the sensor cells.
     sums: Vec<[ExactSum; 3]>,
     /// Contributions that were not finite or out of range (never added).
     rejected: u64,
@@ -158,14 +168,53 @@ impl Film {
     /// [`FilmError::InvalidSize`] for a zero dimension or more than [`MAX_PIXELS`] pixels (each
     /// pixel takes 48 bytes; see [`Film::bytes_for`]).
     pub fn new(width: u32, height: u32) -> Result<Self, FilmError> {
+        Self::with_sensor_cells(width, height, 0)
+    }
+
+    /// An empty film with `cells` sensor cells after its pixels.
+    ///
+    /// # Errors
+    /// As [`Film::new`].
+    pub fn with_sensor_cells(width: u32, height: u32, cells: u32) -> Result<Self, FilmError> {
         let n = film_pixels(width, height)?;
         Ok(Self {
             width,
             height,
-            sums: vec![[ExactSum::default(); 3]; n],
+            sums: vec![[ExactSum::default(); 3]; n + cells as usize],
             rejected: 0,
             accepted: 0,
         })
+    }
+
+    /// The number of sensor cells after the pixels.
+    pub fn sensor_cells(&self) -> u32 {
+        (self.sums.len() - self.pixels()) as u32
+    }
+
+    fn pixels(&self) -> usize {
+        self.width as usize * self.height as usize
+    }
+
+    /// The sensor cells' sums, `[radiant, luminous, luminous^2]` each, multiplied by `scale`
+    /// (the first two) and `scale^2` (the squares).
+    pub fn sensor_sums(&self, scale: f64) -> Vec<crate::SensorSums> {
+        self.sums[self.pixels()..]
+            .iter()
+            .map(|c| [c[0].value() * scale, c[1].value() * scale, c[2].value() * scale * scale])
+            .collect()
+    }
+
+    /// Adds `[radiant, luminous, luminous^2]` to sensor cell `cell`; `false` (and a rejection)
+    /// for a cell beyond the film's or values out of range.
+    pub fn add_sensor(&mut self, cell: u32, sums: crate::SensorSums) -> bool {
+        let index = self.pixels() + cell as usize;
+        match (index < self.sums.len(), xyz_to_fixed(Xyz::new(sums[0], sums[1], sums[2]))) {
+            (true, Some(fixed)) => self.add_fixed(index, fixed),
+            _ => {
+                self.rejected += 1;
+                false
+            }
+        }
     }
 
     /// Bytes a `width x height` film occupies: 48 per pixel (three `i128` sums) plus the struct.
@@ -230,7 +279,9 @@ impl Film {
     /// # Errors
     /// [`FilmError::SizeMismatch`] if the sizes differ.
     pub fn merge(&mut self, other: &Film) -> Result<(), FilmError> {
-        if (self.width, self.height) != (other.width, other.height) {
+        if (self.width, self.height, self.sums.len())
+            != (other.width, other.height, other.sums.len())
+        {
             return Err(FilmError::SizeMismatch(
                 self.width,
                 self.height,
@@ -253,7 +304,7 @@ impl Film {
     /// The accumulated XYZ of every pixel, row-major, multiplied by `scale` (the estimator's
     /// normalisation, e.g. `1 / beams`).
     pub fn to_xyz(&self, scale: f64) -> Vec<Xyz> {
-        self.sums
+        self.sums[..self.pixels()]
             .iter()
             .map(|p| Xyz::new(p[0].value() * scale, p[1].value() * scale, p[2].value() * scale))
             .collect()
@@ -295,6 +346,10 @@ impl Splat for Film {
     fn splat(&mut self, x: u32, y: u32, xyz: Xyz) -> bool {
         self.add(x, y, xyz)
     }
+
+    fn splat_sensor(&mut self, cell: u32, sums: crate::SensorSums) -> bool {
+        self.add_sensor(cell, sums)
+    }
 }
 
 /// One buffered contribution: pixel index and fixed-point XYZ.
@@ -315,6 +370,8 @@ pub struct FilmWriter<'a> {
     film: &'a Mutex<Film>,
     width: u32,
     height: u32,
+    /// Sensor cells after the pixels.
+    sensor_cells: u32,
     entries: Vec<Entry>,
     rejected: u64,
     /// The current chunk's sums for the error estimate, if the render keeps one.
@@ -332,14 +389,15 @@ impl<'a> FilmWriter<'a> {
 
     /// A writer into `film`.
     pub fn new(film: &'a Mutex<Film>) -> Self {
-        let (width, height) = {
+        let (width, height, sensor_cells) = {
             let f = film.lock().unwrap_or_else(PoisonError::into_inner);
-            (f.width, f.height)
+            (f.width, f.height, f.sensor_cells())
         };
         Self {
             film,
             width,
             height,
+            sensor_cells,
             entries: Vec::with_capacity(Self::CAPACITY),
             rejected: 0,
             tally: None,
@@ -405,6 +463,23 @@ impl Splat for FilmWriter<'_> {
                     self.flush();
                 }
                 self.entries.push((index as u32, fixed));
+                true
+            }
+            _ => {
+                self.rejected += 1;
+                false
+            }
+        }
+    }
+
+    fn splat_sensor(&mut self, cell: u32, sums: crate::SensorSums) -> bool {
+        match (cell < self.sensor_cells, xyz_to_fixed(Xyz::new(sums[0], sums[1], sums[2]))) {
+            (true, Some(fixed)) => {
+                if self.entries.len() >= Self::CAPACITY {
+                    self.flush();
+                }
+                // Sensor cells follow the pixels (at most 2^25 + 2^22 entries: fits u32).
+                self.entries.push((self.width * self.height + cell, fixed));
                 true
             }
             _ => {

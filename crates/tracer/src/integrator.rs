@@ -56,6 +56,13 @@ pub trait Integrator: Send + Sync {
     /// The factor that turns the film's exact sums into the image after `samples_done` work
     /// items over the whole render (all chunks, all shards); 0 for none.
     fn image_scale(&self, samples_done: u64) -> f64;
+
+    /// Sensor cells this integrator fills after the film's pixels (see
+    /// [`crate::Film::with_sensor_cells`]); 0 (the default) when it fills none. Their sums
+    /// are normalised by the same [`image_scale`](Self::image_scale).
+    fn sensor_cells(&self) -> u32 {
+        0
+    }
 }
 
 /// The light tracer as an [`Integrator`]: beams from the lights, every non-specular hit
@@ -127,6 +134,10 @@ impl Integrator for LightTracer<'_> {
 
     fn image_scale(&self, samples_done: u64) -> f64 {
         image_scale(self.scene.lights.power(), samples_done)
+    }
+
+    fn sensor_cells(&self) -> u32 {
+        self.scene.sensors().map_or(0, crate::SensorSet::total_cells)
     }
 }
 

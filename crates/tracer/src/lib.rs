@@ -34,6 +34,7 @@ mod object_light;
 mod path_tracer;
 mod render;
 mod sampler;
+mod sensor;
 mod wavelengths;
 
 pub use bdpt::{Bdpt, BdptSettings, MisVertex, mis_weight};
@@ -55,4 +56,7 @@ pub use render::{
     render, render_observed,
 };
 pub use sampler::{ChunkSampler, SamplerKind};
+pub use sensor::{
+    IrradianceSensor, MAX_SENSOR_CELLS, MAX_SENSOR_CELLS_PER_EDGE, SensorSet, SensorSums,
+};
 pub use wavelengths::{CAMERA_LAMBDA_MAX, CAMERA_LAMBDA_MIN, CameraWavelengths, HERO};

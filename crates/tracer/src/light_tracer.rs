@@ -44,7 +44,8 @@ pub(crate) fn shading_correction(hit: &spectrace_geometry::Hit, wi: DVec3, wo: D
 }
 use spectrace_spectrum::{CIE_Y_INTEGRAL, SpectralPowerDistribution, cmf};
 
-use crate::{ChunkSampler, Effects, PinholeCamera, SamplerKind, SceneFeatures, Splat};
+use crate::{ChunkSampler, Effects, PinholeCamera, SamplerKind, SceneFeatures, SensorSet, Splat};
+use spectrace_spectrum::lumens_per_watt;
 
 /// Largest `max_depth` a scene may ask for (the renderer refuses more; the tracer clamps
 /// nothing). Russian roulette ends almost every beam long before: only a lossless closed scene
@@ -98,6 +99,11 @@ pub struct LightTracerScene<'a> {
     object_shapes: usize,
     /// Where the integrators' random numbers come from.
     sampler: SamplerKind,
+    /// The illuminance sensors the light paths fill (see [`crate::IrradianceSensor`]).
+    sensors: Option<&'a SensorSet>,
+    /// Fill only the sensors: no connections to the camera (a sensor pass beside a camera
+    /// integrator's image).
+    sensors_only: bool,
 }
 
 /// Light leaving a shape's surface: which light of the set it belongs to, so that camera paths
@@ -151,7 +157,29 @@ impl<'a> LightTracerScene<'a> {
             light_shapes: Vec::new(),
             object_shapes: materials.len(),
             sampler: SamplerKind::Independent,
+            sensors: None,
+            sensors_only: false,
         }
+    }
+
+    /// The same scene with illuminance sensors, which the light tracer fills (through
+    /// [`Splat::splat_sensor`], into cells after the film's pixels: see
+    /// [`crate::Film::with_sensor_cells`]).
+    pub fn with_sensors(mut self, sensors: &'a SensorSet) -> Self {
+        self.sensors = (!sensors.is_empty()).then_some(sensors);
+        self
+    }
+
+    /// The same scene traced for its sensors only: beams are not connected to the camera, so
+    /// the image stays black and the sensors fill at less cost.
+    pub fn sensors_only(mut self) -> Self {
+        self.sensors_only = true;
+        self
+    }
+
+    /// The scene's sensors (none if it has none).
+    pub fn sensors(&self) -> Option<&'a SensorSet> {
+        self.sensors
     }
 
     /// The same scene, rendered with random numbers from `sampler`.
@@ -402,7 +430,9 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
             }
         }
         // Lights seen directly: connect the emission point to the camera.
-        if let Some((x, y, value)) = connect_emission(scene, &beam, lens_uniforms(scene, &mut rng))
+        if !scene.sensors_only
+            && let Some((x, y, value)) =
+                connect_emission(scene, &beam, lens_uniforms(scene, &mut rng))
         {
             let mut xyz = spectrace_spectrum::Xyz::default();
             for j in 0..k {
@@ -415,6 +445,10 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
         let mut ray = Ray { origin: beam.origin, direction: beam.direction };
         let mut depth = 0u32;
         let mut next_hit = scene.intersect_from_light(&ray, beam.parent, f64::INFINITY);
+        if let Some(sensors) = scene.sensors {
+            let reach = next_hit.as_ref().map_or(f64::INFINITY, |h| h.t);
+            fill_sensors(sensors, &ray, reach, &lambdas[..k], &weights[..k], film);
+        }
         while let Some(hit) = next_hit.take() {
             stats.hits += 1;
             let Some(material) = scene.materials.get(hit.primitive as usize) else { break };
@@ -439,14 +473,16 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
             }
             let specular = material.is_specular();
             if !specular {
-                if let Some((x, y, value)) = connect_to_camera(
-                    scene,
-                    material,
-                    &hit,
-                    ray.direction,
-                    &lambdas[..k],
-                    lens_uniforms(scene, &mut rng),
-                ) {
+                if !scene.sensors_only
+                    && let Some((x, y, value)) = connect_to_camera(
+                        scene,
+                        material,
+                        &hit,
+                        ray.direction,
+                        &lambdas[..k],
+                        lens_uniforms(scene, &mut rng),
+                    )
+                {
                     let mut xyz = spectrace_spectrum::Xyz::default();
                     for j in 0..k {
                         xyz += cmf(lambdas[j]) * (weights[j] * value[j] * inv_y);
@@ -455,7 +491,11 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
                         stats.splats += 1;
                     }
                 }
-                if !effects.continue_after_diffuse {
+                // With sensors, light leaving the only diffuse surface may still cross one
+                // (unless the user asked for direct light only).
+                if !effects.continue_after_diffuse
+                    && (scene.sensors.is_none() || effects.mode == crate::EffectsMode::DirectOnly)
+                {
                     break;
                 }
             }
@@ -500,9 +540,32 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
             }
             ray = hit.spawn_ray(new_direction);
             next_hit = scene.world.intersect(&ray, f64::INFINITY);
+            if let Some(sensors) = scene.sensors {
+                let reach = next_hit.as_ref().map_or(f64::INFINITY, |h| h.t);
+                fill_sensors(sensors, &ray, reach, &lambdas[..k], &weights[..k], film);
+            }
         }
     }
     stats
+}
+
+/// Adds a path segment's bundle to every sensor cell it crosses on the front side: the radiant
+/// weight, the luminous weight (times `683 ybar`) and its square.
+#[inline]
+fn fill_sensors<S: Splat + ?Sized>(
+    sensors: &SensorSet,
+    ray: &Ray,
+    reach: f64,
+    lambdas: &[f64],
+    weights: &[f64],
+    film: &mut S,
+) {
+    sensors.crossings(ray.origin, ray.direction, reach, |cell| {
+        let radiant: f64 = weights.iter().sum();
+        let luminous: f64 =
+            lambdas.iter().zip(weights).map(|(&l, &w)| w * lumens_per_watt(l)).sum();
+        film.splat_sensor(cell, [radiant, luminous, luminous * luminous]);
+    });
 }
 
 /// Uniforms for a point on the camera's lens: none are drawn for a pinhole (so pinhole images do

@@ -307,7 +307,7 @@ pub fn render_observed(
     let started = Instant::now();
     let (w, h) = integrator.resolution();
     plan.check_memory(w, h, &MemoryLimit::system())?;
-    let film = Mutex::new(Film::new(w, h)?);
+    let film = Mutex::new(Film::with_sensor_cells(w, h, integrator.sensor_cells())?);
     let moments = if plan.keeps_estimate() { Some(Mutex::new(Moments::new(w, h)?)) } else { None };
     let next = AtomicU64::new(0);
     let done = AtomicU64::new(0);

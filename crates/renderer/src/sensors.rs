@@ -1,0 +1,221 @@
+//! Illuminance sensors in a render: where their values come from, how accurate they are, and
+//! the files and sidecar figures they become.
+//!
+//! Light paths fill sensors (see `spectrace_tracer::IrradianceSensor`). When the light tracer
+//! renders the image, the image's own beams fill them at no extra tracing. When a camera
+//! integrator (path tracer, BDPT) renders the image, a *sensor pass* follows: the light tracer
+//! again, with `settings.sensor_beams` beams (default: `settings.beams`), connected to no camera.
+//! Either way the sums become irradiance and illuminance per cell, with the relative standard
+//! error of the sensor's average from the spread of the beams' contributions, and a prediction
+//! of the beams and time a 1% average would take.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+use spectrace_lights::LightSource;
+use spectrace_tracer::{
+    Effects, Film, LightTracer, RenderPlan, SensorSet, SensorSums, render as render_plan,
+};
+
+use crate::sensor_output::{SensorGrid, write_sensor_files};
+use crate::{RenderError, Scene, tracer_scene};
+
+/// One sensor's figures in the sidecar.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SensorReport {
+    /// The sensor's name.
+    pub name: String,
+    /// `[nu, nv]`.
+    pub cells: [u32; 2],
+    /// Average illuminance over the cells (lux).
+    pub average_lux: f64,
+    /// Smallest cell's illuminance (lux).
+    pub minimum_lux: f64,
+    /// Largest cell's illuminance (lux).
+    pub maximum_lux: f64,
+    /// Uniformity `U0 = minimum / average` (EN 12464-1); 0 when the average is 0.
+    pub uniformity: f64,
+    /// Average irradiance (W/m^2).
+    pub average_w_m2: f64,
+    /// Estimated relative standard error of `average_lux` (one sigma), from the spread of the
+    /// beams' contributions; `null` when no light arrived.
+    pub average_relative_error: Option<f64>,
+    /// Median over the lit cells of each cell's estimated relative standard error.
+    pub median_cell_relative_error: Option<f64>,
+    /// Beams that filled the sensor.
+    pub beams: u64,
+    /// How: `"image beams (light tracer)"` or `"sensor pass (light tracer)"`.
+    pub filled_by: String,
+    /// Seconds of tracing that filled it (the whole render's for image beams).
+    pub seconds: f64,
+    /// Predicted tracing time (s) for a 1% `average_relative_error` at this speed (error falls
+    /// as one over the square root of the beams).
+    pub predicted_seconds_for_1_percent: Option<f64>,
+    /// Files written.
+    pub files: Vec<String>,
+}
+
+/// The output files every sensor of `scene` will write into `dir`.
+pub fn planned_sensor_outputs(scene: &Scene, dir: &Path) -> Vec<PathBuf> {
+    scene
+        .sensors
+        .sensors()
+        .iter()
+        .flat_map(|s| ["csv", "exr", "png"].map(|e| dir.join(format!("{}.{e}", s.name()))))
+        .collect()
+}
+
+/// Checks that no sensor's files would take the image's name.
+///
+/// # Errors
+/// [`RenderError::Options`] naming the sensor.
+pub fn check_sensor_names(scene: &Scene, image_name: &str) -> Result<(), RenderError> {
+    for (i, s) in scene.sensors.sensors().iter().enumerate() {
+        if s.name() == image_name {
+            return Err(RenderError::Options(format!(
+                "sensors[{i}].name \"{}\": the image's files have that name; give the sensor \
+                 another",
+                s.name()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Runs a sensor pass: the light tracer, connected to no camera, filling `scene`'s sensors with
+/// `plan`'s beams. Returns the film (its sensor cells) and the seconds it took.
+///
+/// # Errors
+/// [`RenderError::Options`] if the film cannot be made.
+pub fn sensor_pass(
+    scene: &Scene,
+    plan: &RenderPlan,
+    effects: Effects,
+) -> Result<(Film, u64, f64), RenderError> {
+    let started = Instant::now();
+    let traced = tracer_scene(scene).sensors_only();
+    let tracer = LightTracer::new(&traced, scene.tracer_settings(), effects);
+    let plan = RenderPlan { error_estimate: false, target_error: None, shard: None, ..*plan };
+    let output =
+        render_plan(&tracer, &plan, &|_| {}).map_err(|e| RenderError::Options(e.to_string()))?;
+    scene.lights.reset_count();
+    Ok((output.film, output.beams, started.elapsed().as_secs_f64()))
+}
+
+/// The plan of a sensor pass: `settings.sensor_beams` beams (default `settings.beams`), the
+/// scene's seed, chunking and threads, no time budget.
+pub fn sensor_plan(scene: &Scene, threads: usize) -> RenderPlan {
+    let s = &scene.settings;
+    RenderPlan {
+        beams: s.sensor_beams.unwrap_or(s.beams),
+        chunk_beams: s.chunk_beams,
+        seed: s.seed,
+        threads,
+        shard: None,
+        time_budget: None,
+        error_estimate: false,
+        target_error: None,
+    }
+}
+
+/// A sensor's grid and its estimated errors from the film's sums, given the beams traced and
+/// the light power: each cell's `radiant x P / N / area` and `luminous x P / N / area`.
+pub fn sensor_grid(
+    set: &SensorSet,
+    index: usize,
+    sums: &[SensorSums],
+    light_power: f64,
+    beams: u64,
+) -> (SensorGrid, Option<f64>, Option<f64>) {
+    let sensor = &set.sensors()[index];
+    let offset = set.offset(index) as usize;
+    let n = sensor.cell_count() as usize;
+    let cells = &sums[offset..offset + n];
+    let per_beam = if beams > 0 { light_power / beams as f64 } else { 0.0 };
+    let area = sensor.cell_area();
+    let irradiance: Vec<f64> = cells.iter().map(|c| c[0] * per_beam / area).collect();
+    let illuminance: Vec<f64> = cells.iter().map(|c| c[1] * per_beam / area).collect();
+    // Variance of a sum of N independent beams' contributions: sum x^2 - (sum x)^2 / N.
+    let variance = |sum: f64, squares: f64| (squares - sum * sum / beams.max(1) as f64).max(0.0);
+    let total: f64 = cells.iter().map(|c| c[1]).sum();
+    let total_variance: f64 = cells.iter().map(|c| variance(c[1], c[2])).sum();
+    let average_error = (total > 0.0).then(|| total_variance.sqrt() / total);
+    let mut cell_errors: Vec<f64> =
+        cells.iter().filter(|c| c[1] > 0.0).map(|c| variance(c[1], c[2]).sqrt() / c[1]).collect();
+    cell_errors.sort_by(f64::total_cmp);
+    let median = (!cell_errors.is_empty()).then(|| cell_errors[cell_errors.len() / 2]);
+    let grid = SensorGrid {
+        name: sensor.name().to_owned(),
+        corner: sensor.corner(),
+        edge_u: sensor.edge_u(),
+        edge_v: sensor.edge_v(),
+        cells: sensor.cells(),
+        irradiance,
+        illuminance,
+    };
+    (grid, average_error, median)
+}
+
+/// How a sensor was filled, for [`write_sensors`].
+#[derive(Debug, Clone, Copy)]
+pub struct SensorSource<'a> {
+    /// The film whose sensor cells hold the sums.
+    pub film: &'a Film,
+    /// Beams traced into it.
+    pub beams: u64,
+    /// Seconds of tracing.
+    pub seconds: f64,
+    /// `"image beams (light tracer)"` or `"sensor pass (light tracer)"`.
+    pub filled_by: &'a str,
+}
+
+/// Writes every sensor's files into `dir` and returns their sidecar figures.
+///
+/// # Errors
+/// [`RenderError::File`] when a file cannot be written (or would replace an input).
+pub fn write_sensors(
+    scene: &Scene,
+    dir: &Path,
+    source: SensorSource<'_>,
+) -> Result<Vec<SensorReport>, RenderError> {
+    let sums = source.film.sensor_sums(1.0);
+    let mut reports = Vec::new();
+    for index in 0..scene.sensors.sensors().len() {
+        let (grid, average_error, median) =
+            sensor_grid(&scene.sensors, index, &sums, scene.lights.power(), source.beams);
+        let files = write_sensor_files(dir, &grid, &scene.inputs).map_err(|message| {
+            RenderError::File { path: dir.join(format!("{}.*", grid.name)), message }
+        })?;
+        let summary = grid.summary();
+        let predicted = average_error.map(|e| source.seconds * (e / 0.01).powi(2));
+        reports.push(SensorReport {
+            name: grid.name.clone(),
+            cells: grid.cells,
+            average_lux: summary.average_lux,
+            minimum_lux: summary.minimum_lux,
+            maximum_lux: summary.maximum_lux,
+            uniformity: summary.uniformity,
+            average_w_m2: summary.average_w_m2,
+            average_relative_error: average_error,
+            median_cell_relative_error: median,
+            beams: source.beams,
+            filled_by: source.filled_by.to_owned(),
+            seconds: source.seconds,
+            predicted_seconds_for_1_percent: predicted,
+            files: files.iter().map(|p| p.display().to_string()).collect(),
+        });
+    }
+    Ok(reports)
+}
+
+/// The sensors' figures in words, one line each, for the terminal.
+pub fn sensor_summary(r: &SensorReport) -> String {
+    let error = r
+        .average_relative_error
+        .map_or("no light arrived".to_owned(), |e| format!("average +/- {:.2}%", e * 100.0));
+    format!(
+        "sensor {}: average {:.1} lx, min {:.1} lx, max {:.1} lx, U0 {:.2} ({error}, {} by {} beams)",
+        r.name, r.average_lux, r.minimum_lux, r.maximum_lux, r.uniformity, r.filled_by, r.beams
+    )
+}

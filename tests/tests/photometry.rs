@@ -1,0 +1,225 @@
+//! Illuminance sensors against closed forms: a point light and an asymmetric IES luminaire over
+//! a sensor plane (`E = I(theta, C) cos(theta) / d^2`, averaged over each cell), and a sensor in
+//! a closed white sphere (the integrating-sphere formula); and the sensor pass of the camera
+//! integrators against the light tracer's own beams.
+
+use std::f64::consts::PI;
+use std::path::{Path, PathBuf};
+
+use spectrace_lights::LightSource;
+use spectrace_renderer::{RenderOptions, Scene, render_in_memory, sensor_grid};
+use spectrace_spectrum::{CieIlluminant, luminous_efficacy};
+use spectrace_tracer::IntegratorChoice;
+
+/// A folder of its own for a test's files.
+fn folder(name: &str) -> PathBuf {
+    let d =
+        std::env::temp_dir().join(format!("spectrace-photometry-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Renders `scene` with the light tracer and returns sensor 0's illuminance per cell (lux), its
+/// estimated standard error per cell, and the relative error of its average.
+fn measure(scene: &Scene, beams: u64, seed: u64) -> (Vec<f64>, Vec<f64>, f64) {
+    let options = RenderOptions {
+        beams: Some(beams),
+        seed: Some(seed),
+        threads: Some(2),
+        integrator: Some(IntegratorChoice::Light),
+        ..RenderOptions::default()
+    };
+    let out = render_in_memory(scene, &options).unwrap();
+    let sums = out.output.film.sensor_sums(1.0);
+    let (grid, average_error, _) =
+        sensor_grid(&scene.sensors, 0, &sums, scene.lights.power(), out.output.beams);
+    // Per-cell standard error from the same sums.
+    let sensor = &scene.sensors.sensors()[0];
+    let per_beam = scene.lights.power() / out.output.beams as f64;
+    let n = out.output.beams as f64;
+    let errors = sums[..sensor.cell_count() as usize]
+        .iter()
+        .map(|c| (c[2] - c[1] * c[1] / n).max(0.0).sqrt() * per_beam / sensor.cell_area())
+        .collect();
+    (grid.illuminance, errors, average_error.unwrap())
+}
+
+/// A scene with a black floor below a 2 m x 2 m sensor of 8 x 8 cells at y = 0 facing up,
+/// lit by `light`.
+fn plane_scene(light: &str, dir: &Path) -> Scene {
+    let json = format!(
+        r#"{{
+  "camera": {{"position": [0, 1, 5], "look_at": [0, 0, 0], "fov": 40,
+             "width": 8, "height": 8}},
+  "objects": [{{"shape": {{"type": "Rectangle", "corner": [-10, -0.01, -10], "edge_u": [0, 0, 20],
+                            "edge_v": [20, 0, 0]}},
+               "material": {{"type": "Diffuse", "reflectance": 0}}}}],
+  "lights": [{light}],
+  "sensors": [{{"type": "IrradianceSensor", "name": "plane", "corner": [-1, 0, -1],
+               "edge_u": [0, 0, 2], "edge_v": [2, 0, 0], "cells": [8, 8]}}]
+}}"#
+    );
+    Scene::from_json(&json, &dir.join("scene.json")).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Each cell's expected illuminance: `I(d) cos / r^2` averaged over the cell by 16 x 16
+/// midpoints, for a light at `light` with intensity `intensity(direction)` (cd).
+fn expected(light: [f64; 3], intensity: &dyn Fn([f64; 3]) -> f64) -> Vec<f64> {
+    let (nu, nv, k) = (8, 8, 16);
+    let mut out = Vec::new();
+    for iv in 0..nv {
+        for iu in 0..nu {
+            let mut sum = 0.0;
+            for a in 0..k {
+                for b in 0..k {
+                    // u runs along +z, v along +x, from the corner (-1, 0, -1).
+                    let z = -1.0 + 2.0 * (iu as f64 + (a as f64 + 0.5) / k as f64) / nu as f64;
+                    let x = -1.0 + 2.0 * (iv as f64 + (b as f64 + 0.5) / k as f64) / nv as f64;
+                    let d = [x - light[0], -light[1], z - light[2]];
+                    let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                    let r = r2.sqrt();
+                    let unit = [d[0] / r, d[1] / r, d[2] / r];
+                    let cos = -unit[1];
+                    sum += intensity(unit) * cos / r2;
+                }
+            }
+            out.push(sum / (k * k) as f64);
+        }
+    }
+    out
+}
+
+/// Every cell within 5 of its standard errors, the whole grid's chi-square near its cell
+/// count, and the average within 4 standard errors; and the check is sharp.
+fn assert_cells_agree(what: &str, got: &[f64], errors: &[f64], want: &[f64], average_error: f64) {
+    let mut chi2 = 0.0;
+    for (i, ((g, e), w)) in got.iter().zip(errors).zip(want).enumerate() {
+        assert!((g - w).abs() < 5.0 * e, "{what}: cell {i}: {g} vs {w} (se {e})");
+        chi2 += ((g - w) / e).powi(2);
+    }
+    let n = got.len() as f64;
+    // chi-square with 64 degrees of freedom: below 110 with probability 0.9997.
+    assert!(chi2 < 110.0, "{what}: chi-square {chi2} over {n} cells");
+    let (mean_got, mean_want) = (got.iter().sum::<f64>() / n, want.iter().sum::<f64>() / n);
+    assert!(
+        (mean_got - mean_want).abs() < 4.0 * average_error * mean_got,
+        "{what}: average {mean_got} vs {mean_want}"
+    );
+    assert!(average_error < 0.005, "{what}: the average is known to {average_error}");
+    let worst = got.iter().zip(errors).map(|(g, e)| e / g).fold(0.0, f64::max);
+    assert!(worst < 0.05, "{what}: a cell is known only to {worst}");
+}
+
+#[test]
+fn a_point_light_over_a_sensor_gives_the_inverse_square_cosine_law() {
+    let dir = folder("point");
+    // 100 W of D65 at 1.2 m: I = power x efficacy / 4 pi (cd), the same every way.
+    let scene = plane_scene(
+        r#"{"type": "PointLight", "position": [0.3, 1.2, -0.2], "power": 100,
+            "spd": {"type": "CieIlluminant", "name": "D65"}}"#,
+        &dir,
+    );
+    let d65 = CieIlluminant::new("D65").unwrap();
+    let candela = 100.0 * luminous_efficacy(&d65) / (4.0 * PI);
+    let want = expected([0.3, 1.2, -0.2], &|_| candela);
+    let (got, errors, average_error) = measure(&scene, 3_000_000, 1);
+    assert_cells_agree("point light", &got, &errors, &want, average_error);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// An asymmetric IES table: no symmetry, C every 45 degrees, gamma every 15 up to 90.
+fn asymmetric_ies() -> (Vec<f64>, Vec<f64>, Vec<Vec<f64>>, String) {
+    let vertical: Vec<f64> = (0..=6).map(|k| k as f64 * 15.0).collect();
+    let horizontal: Vec<f64> = (0..=8).map(|k| k as f64 * 45.0).collect();
+    let candela: Vec<Vec<f64>> = horizontal
+        .iter()
+        .map(|&c: &f64| {
+            vertical
+                .iter()
+                .map(|&g: &f64| {
+                    (800.0 * (1.0 + 0.8 * c.to_radians().sin()) * (1.0 - g / 95.0)).round()
+                })
+                .collect()
+        })
+        .collect();
+    let join = |v: &[f64]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(" ");
+    let mut text = format!(
+        "IESNA:LM-63-2002\n[TEST] spectrace\nTILT=NONE\n1 2000 1 {} {} 1 2 0.1 0.1 0\n1 1 20\n{}\n{}\n",
+        vertical.len(),
+        horizontal.len(),
+        join(&vertical),
+        join(&horizontal)
+    );
+    for row in &candela {
+        text += &join(row);
+        text += "\n";
+    }
+    (vertical, horizontal, candela, text)
+}
+
+#[test]
+fn an_asymmetric_ies_luminaire_over_a_sensor_gives_its_candela_table() {
+    let dir = folder("ies");
+    let (vertical, horizontal, candela, text) = asymmetric_ies();
+    std::fs::write(dir.join("asym.ies"), text).unwrap();
+    let scene = plane_scene(
+        r#"{"type": "IesLight", "file": "asym.ies", "position": [-0.2, 1.5, 0.1], "cct": 4000}"#,
+        &dir,
+    );
+    // The table, interpolated as documented (linear in C and in cos gamma), in the default
+    // orientation: nadir -y, C 0 along +x, C 90 along c0 x nadir = -z.
+    let h: Vec<f64> = horizontal.iter().map(|c| c.to_radians()).collect();
+    let v: Vec<f64> = vertical.iter().map(|g| g.to_radians().cos()).collect();
+    let intensity = |d: [f64; 3]| {
+        let mu = -d[1];
+        let c = (-d[2]).atan2(d[0]).rem_euclid(2.0 * PI);
+        let a = (h.partition_point(|&x| x <= c).max(1) - 1).min(h.len() - 2);
+        let t = (c - h[a]) / (h[a + 1] - h[a]);
+        let b = (v.partition_point(|&x| x >= mu).max(1) - 1).min(v.len() - 2);
+        let s = (mu - v[b]) / (v[b + 1] - v[b]);
+        let row = |k: usize| candela[k][b] * (1.0 - s) + candela[k][b + 1] * s;
+        row(a) * (1.0 - t) + row(a + 1) * t
+    };
+    let want = expected([-0.2, 1.5, 0.1], &intensity);
+    let (got, errors, average_error) = measure(&scene, 3_000_000, 2);
+    assert_cells_agree("IES luminaire", &got, &errors, &want, average_error);
+    // The asymmetry is visible: the -z half (towards C 90) is brighter than the +z half.
+    let half = |far: bool| {
+        got.iter().enumerate().filter(|(i, _)| ((i % 8) < 4) == far).map(|(_, e)| e).sum::<f64>()
+    };
+    assert!(half(true) > 1.3 * half(false), "{} vs {}", half(true), half(false));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_sensor_in_a_closed_white_sphere_reads_the_integrating_sphere_formula() {
+    let dir = folder("sphere");
+    // A point light at the centre of a sphere of radius 1 and reflectance 0.8; the sensor
+    // faces away from the light, so it reads only the walls: E = rho Phi / (A (1 - rho)).
+    let json = r#"{
+  "camera": {"position": [0, 0, 0.5], "look_at": [0, 0, -1], "fov": 40,
+             "width": 4, "height": 4},
+  "objects": [{"shape": {"type": "Sphere", "center": [0, 0, 0], "radius": 1},
+               "material": {"type": "Diffuse", "reflectance": 0.8}}],
+  "lights": [{"type": "PointLight", "position": [0, 0, 0], "power": 10,
+              "spd": {"type": "CieIlluminant", "name": "D65"}}],
+  "settings": {"max_depth": 200, "rr_depth": 50},
+  "sensors": [{"type": "IrradianceSensor", "name": "inside", "corner": [-0.1, -0.5, -0.1],
+               "edge_u": [0.2, 0, 0], "edge_v": [0, 0, 0.2], "cells": [2, 2]}]
+}"#;
+    let scene = Scene::from_json(json, &dir.join("sphere.json")).unwrap_or_else(|e| panic!("{e}"));
+    let d65 = CieIlluminant::new("D65").unwrap();
+    let lumens = 10.0 * luminous_efficacy(&d65);
+    let want = 0.8 * lumens / (4.0 * PI * (1.0 - 0.8));
+    let (got, errors, average_error) = measure(&scene, 600_000, 3);
+    let mean = got.iter().sum::<f64>() / got.len() as f64;
+    assert!(
+        (mean - want).abs() < 4.0 * average_error * mean,
+        "{mean} vs {want} (relative se {average_error})"
+    );
+    assert!(average_error < 0.01, "the check is sharp to 1%: {average_error}");
+    for (g, e) in got.iter().zip(&errors) {
+        assert!((g - want).abs() < 5.0 * e, "{g} vs {want}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
