@@ -467,7 +467,7 @@ impl LdtFile {
     }
 
     /// The stored C angles (degrees): the planes `intensities` holds, in the IES ranges
-    /// ([0] for Isym 1).
+    /// (`[0]` for Isym 1).
     pub fn stored_c_angles(&self) -> Vec<f64> {
         if self.symmetry == LdtSymmetry::Rotational {
             return vec![0.0];
