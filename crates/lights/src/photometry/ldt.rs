@@ -266,7 +266,7 @@ impl LdtFile {
             LdtSymmetry::Quadrants => (4, "end at C90"),
             LdtSymmetry::None | LdtSymmetry::Rotational => (1, ""),
         };
-        if mc % needed != 0 {
+        if !mc.is_multiple_of(needed) {
             return Err(r.error(
                 mc_line,
                 format!(
@@ -324,16 +324,16 @@ impl LdtFile {
                     ),
                 ));
             }
-            if let Some(first) = lamp_sets.first().map(|f: &LampSet| f.lamps) {
-                if (first < 0) != (lamps < 0) {
-                    return Err(r.error(
-                        lamps_line,
-                        format!(
-                            "{} = {lamps}, but lamp set 1 has {first}: a negative number (absolute photometry) must be used by every set or none",
-                            what("the number of lamps")
-                        ),
-                    ));
-                }
+            if let Some(first) = lamp_sets.first().map(|f: &LampSet| f.lamps)
+                && (first < 0) != (lamps < 0)
+            {
+                return Err(r.error(
+                    lamps_line,
+                    format!(
+                        "{} = {lamps}, but lamp set 1 has {first}: a negative number (absolute photometry) must be used by every set or none",
+                        what("the number of lamps")
+                    ),
+                ));
             }
             let kind = r.text(&what("the lamp type"))?.0.to_owned();
             let (flux, line) = r.number(&what("the total luminous flux"))?;
@@ -383,16 +383,16 @@ impl LdtFile {
             LdtSymmetry::Quadrants => &[(mc / 4, 90.0)],
         };
         for &(i, want) in ends {
-            if let Some(&(c, line)) = c_angles.get(i) {
-                if c != want {
-                    return Err(r.error(
-                        line,
-                        format!(
-                            "C angle[{i}] = {c}: with Isym {} and Mc = {mc} the stored planes end at C{want}, which must be angle {i}",
-                            symmetry.indicator()
-                        ),
-                    ));
-                }
+            if let Some(&(c, line)) = c_angles.get(i)
+                && c != want
+            {
+                return Err(r.error(
+                    line,
+                    format!(
+                        "C angle[{i}] = {c}: with Isym {} and Mc = {mc} the stored planes {planes}, so angle {i} must be C{want}",
+                        symmetry.indicator()
+                    ),
+                ));
             }
         }
         let gamma_angles = r.numbers("gamma angle", ng)?;
@@ -408,8 +408,8 @@ impl LdtFile {
         for p in 0..count {
             let angle = c_angles.get(first + p).map_or(0.0, |c| c.0);
             let mut row = Vec::with_capacity(ng);
-            for g in 0..ng {
-                let what = format!("intensity[{p}][{g}] (C{angle}, gamma {})", gamma_angles[g].0);
+            for (g, &(gamma, _)) in gamma_angles.iter().enumerate() {
+                let what = format!("intensity[{p}][{g}] (C{angle}, gamma {gamma})");
                 let (v, line) = r.number(&what)?;
                 if v < 0.0 {
                     return Err(r.error(line, format!("{what} = {v}: must be >= 0 cd/klm")));
@@ -467,7 +467,7 @@ impl LdtFile {
     }
 
     /// The stored C angles (degrees): the planes `intensities` holds, in the IES ranges
-    /// ([0] for Isym 1).
+    /// (`[0]` for Isym 1).
     pub fn stored_c_angles(&self) -> Vec<f64> {
         if self.symmetry == LdtSymmetry::Rotational {
             return vec![0.0];

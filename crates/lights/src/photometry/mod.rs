@@ -44,7 +44,7 @@ pub type IesError = PhotometryError;
 #[derive(Debug, Clone, PartialEq)]
 pub struct CandelaPlanes {
     /// Horizontal (C-plane) angles in degrees, strictly increasing, in the stored range that
-    /// declares the symmetry exactly as IES LM-63 does: [0] (rotational), 0..=90 (quadrant),
+    /// declares the symmetry exactly as IES LM-63 does: `[0]` (rotational), 0..=90 (quadrant),
     /// 0..=180 (bilateral about C0-C180), 90..=270 (bilateral about C90-C270), 0..<=360 (none).
     pub horizontal: Vec<f64>,
     /// Vertical (gamma) angles in degrees from nadir, strictly increasing, within [0, 180].
