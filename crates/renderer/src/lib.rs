@@ -26,6 +26,7 @@ mod output;
 mod part;
 pub mod pilot;
 mod scene;
+mod sensor_output;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -47,6 +48,9 @@ pub use part::{PARTIAL_VERSION, PartialFilm};
 pub use scene::{
     DEFAULT_SPP, EffectsSettings, LoadOptions, Object, OutputSettings, Scene, SceneError,
     SceneFile, Settings, check_target_error,
+};
+pub use sensor_output::{
+    MAX_SENSOR_CELLS, SensorGrid, SensorSummary, sensor_colour, write_sensor_files,
 };
 
 /// Command-line overrides of a scene's settings.
