@@ -431,7 +431,7 @@ fn format_decimal(k: u64, e: i32) -> String {
     let magnitude = digits.len() as i32 - 1 + e; // floor(log10(k 10^e))
     if (0..6).contains(&magnitude) && e >= 0 {
         format!("{digits}{}", "0".repeat(e as usize))
-    } else if e < 0 && e >= -4 && magnitude < 6 {
+    } else if (-4..0).contains(&e) && magnitude < 6 {
         let frac = (-e) as usize;
         let padded = format!("{digits:0>width$}", width = frac + 1);
         let (int, dec) = padded.split_at(padded.len() - frac);
@@ -705,11 +705,9 @@ mod tests {
             .unwrap();
         let rows = &image.layer_data.channel_data.pixels;
         assert_eq!((rows.len(), rows[0].len()), (2, 3));
-        for iv in 0..2 {
-            for iu in 0..3 {
-                let i = iv * 3 + iu;
-                assert_eq!(rows[1 - iv][iu], (g.illuminance[i] as f32, g.irradiance[i] as f32));
-            }
+        for (i, (l, e)) in g.illuminance.iter().zip(&g.irradiance).enumerate() {
+            let (iu, iv) = (i % 3, i / 3);
+            assert_eq!(rows[1 - iv][iu], (*l as f32, *e as f32), "cell ({iu}, {iv})");
         }
         // Deterministic bytes, and the CSV is the grid's.
         let bytes = std::fs::read(&written[1]).unwrap();
