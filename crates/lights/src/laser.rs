@@ -28,7 +28,7 @@ use spectrace_sampling::{Frame, sample_uniform_disk_concentric};
 pub(crate) const SAME_DIRECTION: f64 = 1e-9;
 
 use crate::geometry::{finite_point, non_negative, unit_direction};
-use crate::source::uniform;
+use crate::source::{power_from_keys, uniform};
 use crate::{
     Beam, EmissionSample, LightError, LightFlags, LightSource, SpdLight, WavelengthSampling,
 };
@@ -50,7 +50,10 @@ pub struct Laser {
 struct LaserRepr {
     position: DVec3,
     direction: DVec3,
-    power: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    power: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    lumens: Option<f64>,
     spd: Arc<dyn SpectralPowerDistribution>,
     #[serde(default)]
     beam_radius: f64,
@@ -61,7 +64,8 @@ struct LaserRepr {
 impl TryFrom<LaserRepr> for Laser {
     type Error = LightError;
     fn try_from(r: LaserRepr) -> Result<Self, LightError> {
-        Self::new(r.position, r.direction, r.power, r.spd, r.beam_radius, r.wavelength_sampling)
+        let power = power_from_keys("Laser", r.power, r.lumens, None, false, r.spd.as_ref())?;
+        Self::new(r.position, r.direction, power, r.spd, r.beam_radius, r.wavelength_sampling)
     }
 }
 
@@ -70,7 +74,8 @@ impl From<Laser> for LaserRepr {
         Self {
             position: l.position,
             direction: l.direction,
-            power: l.emission.power(),
+            power: Some(l.emission.power()),
+            lumens: None,
             spd: l.emission.spd().clone(),
             beam_radius: l.beam_radius,
             wavelength_sampling: l.emission.sampling(),

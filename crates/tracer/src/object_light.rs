@@ -3,7 +3,8 @@
 //!
 //! | field | unit | default | meaning |
 //! |---|---|---|---|
-//! | `power` | W | required | total emitted power (both sides together when two-sided) |
+//! | `power` | W | one of `power`, `lumens` | total emitted power (both sides together when two-sided) |
+//! | `lumens` | lm | one of `power`, `lumens` | total luminous flux instead: `power = lumens / luminous_efficacy(spd)` |
 //! | `spd` | SPD | required | spectrum |
 //! | `two_sided` | | `false` | emit from both sides of the surface (else only outwards: along the geometric normal) |
 //!
@@ -11,7 +12,13 @@
 //! {"shape": {"type": "Sphere", "center": [0, 1, 0], "radius": 0.1},
 //!  "material": {"type": "Diffuse", "reflectance": 0.8},
 //!  "emission": {"power": 20, "spd": {"type": "Blackbody", "kelvin": 2700}}}
+//! {"shape": {"type": "Sphere", "center": [0, 1, 0], "radius": 0.1},
+//!  "material": {"type": "Diffuse", "reflectance": 0.8},
+//!  "emission": {"lumens": 800, "spd": {"type": "CieIlluminant", "name": "A"}}}
 //! ```
+//!
+//! `lumens` is converted to watts when the scene is read (`spectrace_lights::power_from_keys`);
+//! serialising an emission writes `power`.
 //!
 //! Every point of the surface emits the radiance `L = power / (pi * area)` (halved when
 //! two-sided) into the hemisphere around its outward normal; the object's material still
@@ -27,22 +34,44 @@ use serde::{Deserialize, Serialize};
 use spectrace_geometry::{Ray, Shape};
 use spectrace_lights::{
     Beam, EmissionSample, LightError, LightFlags, LightSample, LightSource, SpdLight,
-    WavelengthSampling, uniform,
+    WavelengthSampling, power_from_keys, uniform,
 };
 use spectrace_sampling::{Frame, sample_cosine_hemisphere_concentric};
 use spectrace_spectrum::SpectralPowerDistribution;
 
-/// The scene-file form of an object's emission.
+/// The scene-file form of an object's emission. A scene file gives its output as `power` (W) or
+/// `lumens` (lm, converted to watts when read: `W = lm / luminous_efficacy(spd)`); it is written
+/// back as `power`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(try_from = "EmissionRepr")]
 pub struct ObjectEmission {
     /// Total emitted power (W).
     pub power: f64,
     /// The spectrum.
     pub spd: Arc<dyn SpectralPowerDistribution>,
     /// Whether both sides emit.
-    #[serde(default)]
     pub two_sided: bool,
+}
+
+/// What a scene file may write for [`ObjectEmission`]: exactly one of `power` and `lumens`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EmissionRepr {
+    #[serde(default)]
+    power: Option<f64>,
+    #[serde(default)]
+    lumens: Option<f64>,
+    spd: Arc<dyn SpectralPowerDistribution>,
+    #[serde(default)]
+    two_sided: bool,
+}
+
+impl TryFrom<EmissionRepr> for ObjectEmission {
+    type Error = LightError;
+    fn try_from(r: EmissionRepr) -> Result<Self, LightError> {
+        let power = power_from_keys("emission", r.power, r.lumens, None, false, r.spd.as_ref())?;
+        Ok(Self { power, spd: r.spd, two_sided: r.two_sided })
+    }
 }
 
 /// A glowing object: a Lambertian emitter over a shape's surface.
