@@ -272,3 +272,65 @@ impl LightSource for ObjectLight {
         Some((1.0 / self.area, self.density(n, direction)))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use spectrace_spectrum::luminous_efficacy;
+
+    fn emission(json: &str) -> Result<ObjectEmission, String> {
+        serde_json::from_str(json).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn an_emission_in_lumens_is_read_as_watts_and_written_as_watts() {
+        let e = emission(
+            r#"{"lumens": 800, "spd": {"type": "CieIlluminant", "name": "A"}, "two_sided": true}"#,
+        )
+        .unwrap();
+        assert_eq!(e.power, 800.0 / luminous_efficacy(e.spd.as_ref()));
+        assert!(e.two_sided);
+        let line =
+            emission(r#"{"lumens": 683, "spd": {"type": "Monochromatic", "lambda_nm": 555}}"#)
+                .unwrap();
+        assert!((line.power - 1.0).abs() < 1e-12, "{}", line.power);
+        assert!(!line.two_sided);
+        // Written back in watts, and read again to the same power.
+        let json = serde_json::to_string(&e).unwrap();
+        assert!(json.contains(r#""power":"#) && !json.contains("lumens"), "{json}");
+        assert_eq!(emission(&json).unwrap().power, e.power);
+    }
+
+    #[test]
+    fn an_emission_needs_exactly_one_visible_output() {
+        let spd = r#""spd": {"type": "Blackbody", "kelvin": 2700}"#;
+        let cases = [
+            (
+                format!(r#"{{"power": 1, "lumens": 5, {spd}}}"#),
+                "emission.lumens = 5.0: `power` is given too",
+            ),
+            (
+                format!(r#"{{{spd}}}"#),
+                "emission.power = missing: the light's output is missing: give exactly one of `power` (W) or `lumens` (lm)",
+            ),
+            (
+                format!(r#"{{"lumens": -5, {spd}}}"#),
+                "emission.lumens = -5.0: must be finite and >= 0",
+            ),
+            (
+                format!(r#"{{"power": -1, {spd}}}"#),
+                "emission.power = -1.0: must be finite and >= 0",
+            ),
+            (format!(r#"{{"candela": 5, {spd}}}"#), "unknown field `candela`"),
+            (
+                r#"{"lumens": 5, "spd": {"type": "Monochromatic", "lambda_nm": 1000}}"#.to_owned(),
+                "emission.lumens = 5.0: the spectrum has no visible light",
+            ),
+        ];
+        for (json, needle) in cases {
+            let e = emission(&json).unwrap_err();
+            assert!(e.contains(needle), "error for {json}\n  was: {e}\n  expected: {needle}");
+        }
+    }
+}
