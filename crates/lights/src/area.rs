@@ -7,7 +7,8 @@
 //!
 //! | light | field | unit | default | meaning |
 //! |---|---|---|---|---|
-//! | both | `power` | W | required | total emitted power (both sides together when two-sided) |
+//! | both | `power` | W | one of `power`, `lumens` | total emitted power (both sides together when two-sided) |
+//! | both | `lumens` | lm | one of `power`, `lumens` | total luminous flux instead: `power = lumens / luminous_efficacy(spd)` (written back as `power`) |
 //! | both | `spd` | SPD | required | spectrum |
 //! | both | `two_sided` | | `false` | emit from both faces |
 //! | both | `wavelength_sampling` | | `"importance"` | `"importance"` or `"equal_wavelengths"` |

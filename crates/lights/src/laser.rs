@@ -4,7 +4,8 @@
 //! |---|---|---|---|
 //! | `position` | m, `[x, y, z]` | required | where the beams start (the beam's centre) |
 //! | `direction` | `[x, y, z]` | required | direction of the beams (normalised; must be non-zero) |
-//! | `power` | W | required | total emitted power |
+//! | `power` | W | one of `power`, `lumens` | total emitted power |
+//! | `lumens` | lm | one of `power`, `lumens` | total luminous flux instead: `power = lumens / luminous_efficacy(spd)` (written back as `power`) |
 //! | `spd` | SPD | required | spectrum, e.g. a narrow `Gaussian` or `Monochromatic` line |
 //! | `beam_radius` | m | `0` | radius of a finite beam: origins uniform over a disk perpendicular to `direction` |
 //! | `wavelength_sampling` | | `"importance"` | `"importance"` or `"equal_wavelengths"` |

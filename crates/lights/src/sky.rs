@@ -9,7 +9,8 @@
 //! | `corner` | m | required | one corner of the rectangle |
 //! | `edge_u`, `edge_v` | m | required | the two edges from `corner`; must span a rectangle (not parallel, not zero) |
 //! | `direction` | | required | direction of every beam; must not lie in the rectangle's plane |
-//! | `power` | W | required | total power through the rectangle |
+//! | `power` | W | one of `power`, `lumens` | total power through the rectangle |
+//! | `lumens` | lm | one of `power`, `lumens` | total luminous flux through it instead: `power = lumens / luminous_efficacy(spd)` (written back as `power`) |
 //! | `spd` | SPD | required | spectrum, e.g. `{"type": "CieIlluminant", "name": "D65"}` |
 //! | `wavelength_sampling` | | `"importance"` | `"importance"` or `"equal_wavelengths"` |
 //!

@@ -6,7 +6,9 @@
 //! | light | field | unit | default | meaning |
 //! |---|---|---|---|---|
 //! | all | `position` | m | required | the point the light shines from |
-//! | all | `power` | W | required | total emitted power |
+//! | all | `power` | W | one of `power`, `lumens`, `candela` | total emitted power |
+//! | all | `lumens` | lm | one of `power`, `lumens`, `candela` | total luminous flux instead: `power = lumens / K` |
+//! | all | `candela` | cd | one of `power`, `lumens`, `candela` | peak luminous intensity instead (on the axis; a point light's everywhere): `power = candela * omega / K` |
 //! | all | `spd` | SPD | required | spectrum |
 //! | all | `wavelength_sampling` | | `"importance"` | `"importance"` or `"equal_wavelengths"` |
 //! | spots | `direction` | | required | axis of the cone |
@@ -19,7 +21,19 @@
 //! {"type": "FadingSpotLight", "position": [0, 2, 0], "direction": [0, -1, 0], "cone_angle": 30,
 //!  "fade_per_angle": 0.1, "power": 100, "spd": {"type": "Blackbody", "kelvin": 3200}}
 //! {"type": "PointLight", "position": [0, 2, 0], "power": 60, "spd": {"type": "CieIlluminant", "name": "A"}}
+//! {"type": "PointLight", "position": [0, 2, 0], "lumens": 800, "spd": {"type": "CieIlluminant", "name": "A"}}
+//! {"type": "UniformSpotLight", "position": [0, 2, 0], "direction": [0, -1, 0], "cone_angle": 20,
+//!  "candela": 2000, "spd": {"type": "CieIlluminant", "name": "A"}}
 //! ```
+//!
+//! # Photometric units
+//! `K = luminous_efficacy(spd)` is the light's luminous efficacy, `683 * integral of spd(lambda)
+//! ybar(lambda)` lm/W. `omega` is the solid angle the intensity profile (peak 1) integrates to,
+//! so that the flux is `candela * omega`: `4 pi` for a point light, `2 pi (1 - cos cone_angle)` for
+//! a uniform spot ([`UniformSpotLight::solid_angle_of`]), and for a fading spot the integral of its
+//! profile that its beams are normalised by ([`FadingSpotLight::solid_angle_of`]), so that the
+//! peak intensity of the built light is exactly `candela / K` W/sr. A spectrum with no visible
+//! light cannot be given in lumens or candela (an error). Serialising a light writes `power` (W).
 //!
 //! # The fading profile
 //! The fading spot's intensity per solid angle is 1 up to `fade_angle = cone_angle -

@@ -240,19 +240,22 @@ fn output_keys_must_be_exactly_one_and_meaningful() {
     }
 }
 
+/// `power`, `lumens` and `candela` with its solid angle, as `power_from_keys` takes them.
+type Keys = (Option<f64>, Option<f64>, Option<(f64, f64)>);
+
 #[test]
 fn nan_and_infinite_outputs_are_rejected_by_name() {
     // JSON cannot write them; the helper rejects them for any caller.
     let spd = Blackbody::new(3200.0).unwrap();
-    let cases: [(Option<f64>, Option<f64>, Option<(f64, f64)>, &str); 6] = [
-        (Some(f64::NAN), None, None, "Test.power = NaN"),
-        (Some(f64::INFINITY), None, None, "Test.power = inf"),
-        (None, Some(f64::NAN), None, "Test.lumens = NaN"),
-        (None, Some(f64::INFINITY), None, "Test.lumens = inf"),
-        (None, None, Some((f64::NAN, 1.0)), "Test.candela = NaN"),
-        (None, None, Some((f64::INFINITY, 1.0)), "Test.candela = inf"),
+    let cases: [(Keys, &str); 6] = [
+        ((Some(f64::NAN), None, None), "Test.power = NaN"),
+        ((Some(f64::INFINITY), None, None), "Test.power = inf"),
+        ((None, Some(f64::NAN), None), "Test.lumens = NaN"),
+        ((None, Some(f64::INFINITY), None), "Test.lumens = inf"),
+        ((None, None, Some((f64::NAN, 1.0))), "Test.candela = NaN"),
+        ((None, None, Some((f64::INFINITY, 1.0))), "Test.candela = inf"),
     ];
-    for (power, lumens, candela, needle) in cases {
+    for ((power, lumens, candela), needle) in cases {
         let e = power_from_keys("Test", power, lumens, candela, true, &spd).unwrap_err();
         assert!(e.to_string().starts_with(needle), "{e}");
     }
