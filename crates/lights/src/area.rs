@@ -7,7 +7,8 @@
 //!
 //! | light | field | unit | default | meaning |
 //! |---|---|---|---|---|
-//! | both | `power` | W | required | total emitted power (both sides together when two-sided) |
+//! | both | `power` | W | one of `power`, `lumens` | total emitted power (both sides together when two-sided) |
+//! | both | `lumens` | lm | one of `power`, `lumens` | total luminous flux instead: `power = lumens / luminous_efficacy(spd)` (written back as `power`) |
 //! | both | `spd` | SPD | required | spectrum |
 //! | both | `two_sided` | | `false` | emit from both faces |
 //! | both | `wavelength_sampling` | | `"importance"` | `"importance"` or `"equal_wavelengths"` |
@@ -37,7 +38,7 @@ use spectrace_sampling::{
 
 use crate::geometry::{finite_point, positive, unit_direction};
 use crate::sky::rectangle_normal;
-use crate::source::uniform;
+use crate::source::{power_from_keys, uniform};
 use crate::{
     Beam, EmissionSample, LightError, LightFlags, LightSample, LightSource, LightSurface, SpdLight,
     WavelengthSampling,
@@ -169,7 +170,10 @@ struct RectangleRepr {
     corner: DVec3,
     edge_u: DVec3,
     edge_v: DVec3,
-    power: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    power: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    lumens: Option<f64>,
     spd: Arc<dyn SpectralPowerDistribution>,
     #[serde(default)]
     two_sided: bool,
@@ -180,7 +184,9 @@ struct RectangleRepr {
 impl TryFrom<RectangleRepr> for RectangleLight {
     type Error = LightError;
     fn try_from(r: RectangleRepr) -> Result<Self, LightError> {
-        Self::new(r.corner, r.edge_u, r.edge_v, r.power, r.spd, r.two_sided, r.wavelength_sampling)
+        let power =
+            power_from_keys("RectangleLight", r.power, r.lumens, None, false, r.spd.as_ref())?;
+        Self::new(r.corner, r.edge_u, r.edge_v, power, r.spd, r.two_sided, r.wavelength_sampling)
     }
 }
 
@@ -190,7 +196,8 @@ impl From<RectangleLight> for RectangleRepr {
             corner: l.corner,
             edge_u: l.edge_u,
             edge_v: l.edge_v,
-            power: l.emission.power(),
+            power: Some(l.emission.power()),
+            lumens: None,
             spd: l.emission.spd().clone(),
             two_sided: l.two_sided,
             wavelength_sampling: l.emission.sampling(),
@@ -322,7 +329,10 @@ struct DiskRepr {
     center: DVec3,
     normal: DVec3,
     radius: f64,
-    power: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    power: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    lumens: Option<f64>,
     spd: Arc<dyn SpectralPowerDistribution>,
     #[serde(default)]
     two_sided: bool,
@@ -333,7 +343,8 @@ struct DiskRepr {
 impl TryFrom<DiskRepr> for DiskLight {
     type Error = LightError;
     fn try_from(r: DiskRepr) -> Result<Self, LightError> {
-        Self::new(r.center, r.normal, r.radius, r.power, r.spd, r.two_sided, r.wavelength_sampling)
+        let power = power_from_keys("DiskLight", r.power, r.lumens, None, false, r.spd.as_ref())?;
+        Self::new(r.center, r.normal, r.radius, power, r.spd, r.two_sided, r.wavelength_sampling)
     }
 }
 
@@ -343,7 +354,8 @@ impl From<DiskLight> for DiskRepr {
             center: l.center,
             normal: l.normal,
             radius: l.radius,
-            power: l.emission.power(),
+            power: Some(l.emission.power()),
+            lumens: None,
             spd: l.emission.spd().clone(),
             two_sided: l.two_sided,
             wavelength_sampling: l.emission.sampling(),

@@ -4,7 +4,8 @@
 //! |---|---|---|---|
 //! | `position` | m, `[x, y, z]` | required | where the beams start (the beam's centre) |
 //! | `direction` | `[x, y, z]` | required | direction of the beams (normalised; must be non-zero) |
-//! | `power` | W | required | total emitted power |
+//! | `power` | W | one of `power`, `lumens` | total emitted power |
+//! | `lumens` | lm | one of `power`, `lumens` | total luminous flux instead: `power = lumens / luminous_efficacy(spd)` (written back as `power`) |
 //! | `spd` | SPD | required | spectrum, e.g. a narrow `Gaussian` or `Monochromatic` line |
 //! | `beam_radius` | m | `0` | radius of a finite beam: origins uniform over a disk perpendicular to `direction` |
 //! | `wavelength_sampling` | | `"importance"` | `"importance"` or `"equal_wavelengths"` |
@@ -28,7 +29,7 @@ use spectrace_sampling::{Frame, sample_uniform_disk_concentric};
 pub(crate) const SAME_DIRECTION: f64 = 1e-9;
 
 use crate::geometry::{finite_point, non_negative, unit_direction};
-use crate::source::uniform;
+use crate::source::{power_from_keys, uniform};
 use crate::{
     Beam, EmissionSample, LightError, LightFlags, LightSource, SpdLight, WavelengthSampling,
 };
@@ -50,7 +51,10 @@ pub struct Laser {
 struct LaserRepr {
     position: DVec3,
     direction: DVec3,
-    power: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    power: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    lumens: Option<f64>,
     spd: Arc<dyn SpectralPowerDistribution>,
     #[serde(default)]
     beam_radius: f64,
@@ -61,7 +65,8 @@ struct LaserRepr {
 impl TryFrom<LaserRepr> for Laser {
     type Error = LightError;
     fn try_from(r: LaserRepr) -> Result<Self, LightError> {
-        Self::new(r.position, r.direction, r.power, r.spd, r.beam_radius, r.wavelength_sampling)
+        let power = power_from_keys("Laser", r.power, r.lumens, None, false, r.spd.as_ref())?;
+        Self::new(r.position, r.direction, power, r.spd, r.beam_radius, r.wavelength_sampling)
     }
 }
 
@@ -70,7 +75,8 @@ impl From<Laser> for LaserRepr {
         Self {
             position: l.position,
             direction: l.direction,
-            power: l.emission.power(),
+            power: Some(l.emission.power()),
+            lumens: None,
             spd: l.emission.spd().clone(),
             beam_radius: l.beam_radius,
             wavelength_sampling: l.emission.sampling(),

@@ -58,7 +58,7 @@ pub use set::LightSet;
 pub use sky::Sky;
 pub use source::{
     EmissionSample, LightFlags, LightSample, LightSource, LightSurface, SpdLight, SpdMap,
-    WavelengthSampling,
+    WavelengthSampling, power_from_keys,
 };
 pub use spot::{FadingSpotLight, PointLight, UniformSpotLight};
 

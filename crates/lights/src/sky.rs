@@ -9,7 +9,8 @@
 //! | `corner` | m | required | one corner of the rectangle |
 //! | `edge_u`, `edge_v` | m | required | the two edges from `corner`; must span a rectangle (not parallel, not zero) |
 //! | `direction` | | required | direction of every beam; must not lie in the rectangle's plane |
-//! | `power` | W | required | total power through the rectangle |
+//! | `power` | W | one of `power`, `lumens` | total power through the rectangle |
+//! | `lumens` | lm | one of `power`, `lumens` | total luminous flux through it instead: `power = lumens / luminous_efficacy(spd)` (written back as `power`) |
 //! | `spd` | SPD | required | spectrum, e.g. `{"type": "CieIlluminant", "name": "D65"}` |
 //! | `wavelength_sampling` | | `"importance"` | `"importance"` or `"equal_wavelengths"` |
 //!
@@ -26,7 +27,7 @@ use serde::{Deserialize, Serialize};
 use spectrace_spectrum::SpectralPowerDistribution;
 
 use crate::geometry::{finite_point, safe_length, unit_direction};
-use crate::source::uniform;
+use crate::source::{power_from_keys, uniform};
 use crate::{
     Beam, EmissionSample, LightError, LightFlags, LightSource, SpdLight, WavelengthSampling,
 };
@@ -55,7 +56,10 @@ struct SkyRepr {
     edge_u: DVec3,
     edge_v: DVec3,
     direction: DVec3,
-    power: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    power: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    lumens: Option<f64>,
     spd: Arc<dyn SpectralPowerDistribution>,
     #[serde(default)]
     wavelength_sampling: WavelengthSampling,
@@ -64,7 +68,8 @@ struct SkyRepr {
 impl TryFrom<SkyRepr> for Sky {
     type Error = LightError;
     fn try_from(r: SkyRepr) -> Result<Self, LightError> {
-        Self::new(r.corner, r.edge_u, r.edge_v, r.direction, r.power, r.spd, r.wavelength_sampling)
+        let power = power_from_keys("Sky", r.power, r.lumens, None, false, r.spd.as_ref())?;
+        Self::new(r.corner, r.edge_u, r.edge_v, r.direction, power, r.spd, r.wavelength_sampling)
     }
 }
 
@@ -75,7 +80,8 @@ impl From<Sky> for SkyRepr {
             edge_u: s.edge_u,
             edge_v: s.edge_v,
             direction: s.direction,
-            power: s.emission.power(),
+            power: Some(s.emission.power()),
+            lumens: None,
             spd: s.emission.spd().clone(),
             wavelength_sampling: s.emission.sampling(),
         }

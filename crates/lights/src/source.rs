@@ -8,7 +8,7 @@ use glam::DVec3;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 use spectrace_sampling::PiecewiseConstant;
-use spectrace_spectrum::{SpectralPowerDistribution, cmf, integrate_panels};
+use spectrace_spectrum::{SpectralPowerDistribution, cmf, integrate_panels, luminous_efficacy};
 
 use crate::{Beam, BeamCounter, LightError};
 
@@ -530,4 +530,123 @@ macro_rules! delegate_to_spd_light {
             self.$field.map_spd(f)
         }
     };
+}
+
+/// The radiant power (W) of a light whose scene file gives its output in one of three units:
+/// `power` (W, returned as is), `lumens` (luminous flux, lm: `W = lm / K`) or `candela` (peak
+/// luminous intensity, cd = lm/sr, given with the solid angle `omega` (sr) that the light's
+/// intensity profile integrates to, its peak being 1: `W = cd * omega / K`), where
+/// `K = luminous_efficacy(spd)` (lm/W, `683 * integral of spd(lambda) ybar(lambda)`).
+/// `takes_candela` says whether the light offers the `candela` key (for the error that lists the
+/// keys); `light` names the light in errors.
+///
+/// # Errors
+/// [`LightError::Parameter`] naming `power` when no key is given, the second key when more than
+/// one is, the key itself when its value is negative, NaN or infinite, `lumens` / `candela` when
+/// the spectrum has no visible light (`K = 0`: no power makes any lumens) or the power in watts
+/// overflows.
+pub fn power_from_keys(
+    light: &'static str,
+    power: Option<f64>,
+    lumens: Option<f64>,
+    candela: Option<(f64, f64)>,
+    takes_candela: bool,
+    spd: &dyn SpectralPowerDistribution,
+) -> Result<f64, LightError> {
+    let reject = |field: &'static str, value: f64, reason: &'static str| {
+        Err(LightError::parameter(light, field, value, reason))
+    };
+    match (power, lumens, candela) {
+        (None, None, None) => Err(LightError::Parameter {
+            light,
+            field: "power",
+            value: "missing".to_owned(),
+            reason: if takes_candela {
+                "the light's output is missing: give exactly one of `power` (W), `lumens` (lm) or `candela` (cd)"
+            } else {
+                "the light's output is missing: give exactly one of `power` (W) or `lumens` (lm)"
+            },
+        }),
+        (Some(_), Some(l), None) => reject(
+            "lumens",
+            l,
+            if takes_candela {
+                "`power` is given too: give exactly one of `power` (W), `lumens` (lm) or `candela` (cd)"
+            } else {
+                "`power` is given too: give exactly one of `power` (W) or `lumens` (lm)"
+            },
+        ),
+        (Some(_), None, Some((c, _))) => reject(
+            "candela",
+            c,
+            "`power` is given too: give exactly one of `power` (W), `lumens` (lm) or `candela` (cd)",
+        ),
+        (None, Some(_), Some((c, _))) => reject(
+            "candela",
+            c,
+            "`lumens` is given too: give exactly one of `power` (W), `lumens` (lm) or `candela` (cd)",
+        ),
+        (Some(_), Some(_), Some((c, _))) => reject(
+            "candela",
+            c,
+            "`power` and `lumens` are given too: give exactly one of `power` (W), `lumens` (lm) or `candela` (cd)",
+        ),
+        (Some(w), None, None) => {
+            if w >= 0.0 && w.is_finite() {
+                Ok(w)
+            } else {
+                reject("power", w, "must be finite and >= 0 (watts)")
+            }
+        }
+        (None, Some(l), None) => {
+            if !(l >= 0.0 && l.is_finite()) {
+                return reject("lumens", l, "must be finite and >= 0 (lumens)");
+            }
+            watts_of_flux(light, "lumens", l, l, spd)
+        }
+        (None, None, Some((c, omega))) => {
+            if !(c >= 0.0 && c.is_finite()) {
+                return reject("candela", c, "must be finite and >= 0 (candela)");
+            }
+            if !(omega > 0.0 && omega <= 4.0 * std::f64::consts::PI) {
+                return reject(
+                    "candela",
+                    c,
+                    "the light's intensity profile has no solid angle to spread it over",
+                );
+            }
+            watts_of_flux(light, "candela", c, c * omega, spd)
+        }
+    }
+}
+
+/// Watts carrying the luminous flux `lumens` with spectrum `spd` (`lumens / K`); errors name
+/// `field` (whose value was `value`) for an invisible spectrum or an overflow.
+fn watts_of_flux(
+    light: &'static str,
+    field: &'static str,
+    value: f64,
+    lumens: f64,
+    spd: &dyn SpectralPowerDistribution,
+) -> Result<f64, LightError> {
+    let efficacy = luminous_efficacy(spd);
+    if !(efficacy > 0.0) {
+        return Err(LightError::parameter(
+            light,
+            field,
+            value,
+            "the spectrum has no visible light (luminous efficacy 0 lm/W: nothing inside 360-830 nm), so no power gives it; give `power` in watts",
+        ));
+    }
+    let watts = lumens / efficacy;
+    if watts.is_finite() {
+        Ok(watts)
+    } else {
+        Err(LightError::parameter(
+            light,
+            field,
+            value,
+            "too large: the power in watts it needs overflows",
+        ))
+    }
 }

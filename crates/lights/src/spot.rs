@@ -6,7 +6,9 @@
 //! | light | field | unit | default | meaning |
 //! |---|---|---|---|---|
 //! | all | `position` | m | required | the point the light shines from |
-//! | all | `power` | W | required | total emitted power |
+//! | all | `power` | W | one of `power`, `lumens`, `candela` | total emitted power |
+//! | all | `lumens` | lm | one of `power`, `lumens`, `candela` | total luminous flux instead: `power = lumens / K` |
+//! | all | `candela` | cd | one of `power`, `lumens`, `candela` | peak luminous intensity instead (on the axis; a point light's everywhere): `power = candela * omega / K` |
 //! | all | `spd` | SPD | required | spectrum |
 //! | all | `wavelength_sampling` | | `"importance"` | `"importance"` or `"equal_wavelengths"` |
 //! | spots | `direction` | | required | axis of the cone |
@@ -19,7 +21,19 @@
 //! {"type": "FadingSpotLight", "position": [0, 2, 0], "direction": [0, -1, 0], "cone_angle": 30,
 //!  "fade_per_angle": 0.1, "power": 100, "spd": {"type": "Blackbody", "kelvin": 3200}}
 //! {"type": "PointLight", "position": [0, 2, 0], "power": 60, "spd": {"type": "CieIlluminant", "name": "A"}}
+//! {"type": "PointLight", "position": [0, 2, 0], "lumens": 800, "spd": {"type": "CieIlluminant", "name": "A"}}
+//! {"type": "UniformSpotLight", "position": [0, 2, 0], "direction": [0, -1, 0], "cone_angle": 20,
+//!  "candela": 2000, "spd": {"type": "CieIlluminant", "name": "A"}}
 //! ```
+//!
+//! # Photometric units
+//! `K = luminous_efficacy(spd)` is the light's luminous efficacy, `683 * integral of spd(lambda)
+//! ybar(lambda)` lm/W. `omega` is the solid angle the intensity profile (peak 1) integrates to,
+//! so that the flux is `candela * omega`: `4 pi` for a point light, `2 pi (1 - cos cone_angle)` for
+//! a uniform spot ([`UniformSpotLight::solid_angle_of`]), and for a fading spot the integral of its
+//! profile that its beams are normalised by ([`FadingSpotLight::solid_angle_of`]), so that the
+//! peak intensity of the built light is exactly `candela / K` W/sr. A spectrum with no visible
+//! light cannot be given in lumens or candela (an error). Serialising a light writes `power` (W).
 //!
 //! # The fading profile
 //! The fading spot's intensity per solid angle is 1 up to `fade_angle = cone_angle -
@@ -45,7 +59,7 @@ use spectrace_sampling::{
 use spectrace_spectrum::SpectralPowerDistribution;
 
 use crate::geometry::{finite_point, positive, unit_direction};
-use crate::source::uniform;
+use crate::source::{power_from_keys, uniform};
 use crate::{
     Beam, EmissionSample, LightError, LightFlags, LightSample, LightSource, SpdLight,
     WavelengthSampling,
@@ -123,7 +137,12 @@ struct SpotRepr {
     position: DVec3,
     direction: DVec3,
     cone_angle: f64,
-    power: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    power: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    lumens: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    candela: Option<f64>,
     spd: Arc<dyn SpectralPowerDistribution>,
     #[serde(default)]
     wavelength_sampling: WavelengthSampling,
@@ -132,7 +151,13 @@ struct SpotRepr {
 impl TryFrom<SpotRepr> for UniformSpotLight {
     type Error = LightError;
     fn try_from(r: SpotRepr) -> Result<Self, LightError> {
-        Self::new(r.position, r.direction, r.cone_angle, r.power, r.spd, r.wavelength_sampling)
+        const L: &str = "UniformSpotLight";
+        let candela = match r.candela {
+            Some(c) => Some((c, Self::solid_angle_of(cone(L, r.cone_angle)?))),
+            None => None,
+        };
+        let power = power_from_keys(L, r.power, r.lumens, candela, true, r.spd.as_ref())?;
+        Self::new(r.position, r.direction, r.cone_angle, power, r.spd, r.wavelength_sampling)
     }
 }
 
@@ -142,7 +167,9 @@ impl From<UniformSpotLight> for SpotRepr {
             position: s.position,
             direction: s.direction,
             cone_angle: s.cone_angle,
-            power: s.emission.power(),
+            power: Some(s.emission.power()),
+            lumens: None,
+            candela: None,
             spd: s.emission.spd().clone(),
             wavelength_sampling: s.emission.sampling(),
         }
@@ -181,6 +208,13 @@ impl UniformSpotLight {
     /// Radiant intensity (W/sr) inside the cone: `power / (2 pi (1 - cos cone))`.
     pub fn intensity(&self) -> f64 {
         self.emission.power() / (TAU * self.one_minus_cos)
+    }
+
+    /// The solid angle (sr) of a cone of half-angle `cone_angle` degrees, `2 pi (1 - cos cone)`
+    /// with `1 - cos` free of cancellation: the flux per unit of intensity, which turns a
+    /// `candela` key into lumens.
+    pub fn solid_angle_of(cone_angle: f64) -> f64 {
+        TAU * one_minus_cos(cone_angle.to_radians())
     }
 
     /// `cos(cone_angle)`.
@@ -265,7 +299,12 @@ struct FadingRepr {
     direction: DVec3,
     cone_angle: f64,
     fade_per_angle: f64,
-    power: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    power: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    lumens: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    candela: Option<f64>,
     spd: Arc<dyn SpectralPowerDistribution>,
     #[serde(default)]
     wavelength_sampling: WavelengthSampling,
@@ -274,12 +313,18 @@ struct FadingRepr {
 impl TryFrom<FadingRepr> for FadingSpotLight {
     type Error = LightError;
     fn try_from(r: FadingRepr) -> Result<Self, LightError> {
+        let candela = match r.candela {
+            Some(c) => Some((c, Self::solid_angle_of(r.cone_angle, r.fade_per_angle)?)),
+            None => None,
+        };
+        let power =
+            power_from_keys("FadingSpotLight", r.power, r.lumens, candela, true, r.spd.as_ref())?;
         Self::new(
             r.position,
             r.direction,
             r.cone_angle,
             r.fade_per_angle,
-            r.power,
+            power,
             r.spd,
             r.wavelength_sampling,
         )
@@ -293,7 +338,9 @@ impl From<FadingSpotLight> for FadingRepr {
             direction: s.direction,
             cone_angle: s.cone_angle,
             fade_per_angle: s.fade_per_angle,
-            power: s.emission.power(),
+            power: Some(s.emission.power()),
+            lumens: None,
+            candela: None,
             spd: s.emission.spd().clone(),
             wavelength_sampling: s.emission.sampling(),
         }
@@ -319,19 +366,8 @@ impl FadingSpotLight {
         const L: &str = "FadingSpotLight";
         let position = finite_point(L, "position", position)?;
         let direction = unit_direction(L, "direction", direction)?;
-        let cone_angle = cone(L, cone_angle)?;
-        let fade_per_angle = positive(L, "fade_per_angle", fade_per_angle)?;
-        let fade_width = 1.0 / fade_per_angle;
-        if fade_width > cone_angle {
-            return Err(LightError::parameter(
-                L,
-                "fade_per_angle",
-                fade_per_angle,
-                "the fade (1 / fade_per_angle degrees) is longer than the cone",
-            ));
-        }
+        let (tc, tf) = fade_angles(cone_angle, fade_per_angle)?;
         let emission = SpdLight::new(L, spd, power, wavelength_sampling)?;
-        let (tc, tf) = (cone_angle.to_radians(), (cone_angle - fade_width).to_radians());
         // Nodes in proportion to each part's angle, with a node exactly at the fade angle.
         let core = ((FADE_SEGMENTS as f64 * tf / tc).round() as usize).min(FADE_SEGMENTS - 64);
         let ring = FADE_SEGMENTS - core;
@@ -345,24 +381,7 @@ impl FadingSpotLight {
         let theta = PiecewiseLinear::new(&thetas, &density).map_err(|_| {
             LightError::parameter(L, "cone_angle", cone_angle, "the cone is too narrow to tabulate")
         })?;
-        // Integral of I(theta) sin(theta) over the cone (profile 1 at the centre): the core is
-        // 1 - cos tf = 2 sin^2(tf / 2); the ring's closed form cancels catastrophically for
-        // narrow fades, so it is integrated by 8-point Gauss-Legendre on 8 panels (the
-        // integrand is smooth, so this is exact to rounding).
-        let half = tf / 2.0;
-        let ring_integrand = |t: f64| (tc - t) / (tc - tf) * t.sin();
-        let panel = (tc - tf) / 8.0;
-        let ring: f64 = (0..8)
-            .map(|k| {
-                gauss_legendre_8(
-                    &ring_integrand,
-                    tf + panel * k as f64,
-                    tf + panel * (k + 1) as f64,
-                )
-            })
-            .sum();
-        let z = 2.0 * half.sin() * half.sin() + ring;
-        let peak_density = 1.0 / (TAU * z);
+        let peak_density = 1.0 / profile_solid_angle(tc, tf);
         let peak_intensity = power * peak_density;
         Ok(Self {
             emission,
@@ -375,6 +394,19 @@ impl FadingSpotLight {
             peak_density,
             frame: Frame::from_normal(direction),
         })
+    }
+
+    /// The solid angle (sr) that the profile of a fading spot with these `cone_angle` and
+    /// `fade_per_angle` integrates to (its peak being 1): the flux per unit of peak intensity,
+    /// which turns a `candela` key into lumens. It is the integral the light normalises its
+    /// beams' directions by, so [`peak_intensity`](Self::peak_intensity) is exactly
+    /// `power / solid_angle`.
+    ///
+    /// # Errors
+    /// [`LightError::Parameter`] naming `cone_angle` or `fade_per_angle`, as [`Self::new`].
+    pub fn solid_angle_of(cone_angle: f64, fade_per_angle: f64) -> Result<f64, LightError> {
+        let (tc, tf) = fade_angles(cone_angle, fade_per_angle)?;
+        Ok(profile_solid_angle(tc, tf))
     }
 
     /// The stated intensity profile relative to the centre at polar angle `theta_deg` degrees:
@@ -438,6 +470,40 @@ impl LightSource for FadingSpotLight {
     }
 }
 
+/// Checks a fading spot's `cone_angle` and `fade_per_angle`; returns the cone and fade angles in
+/// radians.
+fn fade_angles(cone_angle: f64, fade_per_angle: f64) -> Result<(f64, f64), LightError> {
+    const L: &str = "FadingSpotLight";
+    let cone_angle = cone(L, cone_angle)?;
+    let fade_per_angle = positive(L, "fade_per_angle", fade_per_angle)?;
+    let fade_width = 1.0 / fade_per_angle;
+    if fade_width > cone_angle {
+        return Err(LightError::parameter(
+            L,
+            "fade_per_angle",
+            fade_per_angle,
+            "the fade (1 / fade_per_angle degrees) is longer than the cone",
+        ));
+    }
+    Ok((cone_angle.to_radians(), (cone_angle - fade_width).to_radians()))
+}
+
+/// The solid angle (sr) of a fading spot's profile (peak 1) with cone angle `tc` and fade angle
+/// `tf` (radians): `2 pi` times the integral of `I(theta) sin(theta)` over the cone. The core is
+/// `1 - cos tf = 2 sin^2(tf / 2)`; the ring's closed form cancels catastrophically for narrow
+/// fades, so it is integrated by 8-point Gauss-Legendre on 8 panels (the integrand is smooth, so
+/// this is exact to rounding).
+fn profile_solid_angle(tc: f64, tf: f64) -> f64 {
+    let ring_integrand = |t: f64| (tc - t) / (tc - tf) * t.sin();
+    let panel = (tc - tf) / 8.0;
+    let ring: f64 = (0..8)
+        .map(|k| {
+            gauss_legendre_8(&ring_integrand, tf + panel * k as f64, tf + panel * (k + 1) as f64)
+        })
+        .sum();
+    TAU * (one_minus_cos(tf) + ring)
+}
+
 /// Integrates `f` over `[a, b]` with 8-point Gauss-Legendre quadrature (exact to degree 15).
 fn gauss_legendre_8(f: &dyn Fn(f64) -> f64, a: f64, b: f64) -> f64 {
     const NODES: [(f64, f64); 4] = [
@@ -465,7 +531,12 @@ pub struct PointLight {
 #[serde(deny_unknown_fields)]
 struct PointRepr {
     position: DVec3,
-    power: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    power: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    lumens: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    candela: Option<f64>,
     spd: Arc<dyn SpectralPowerDistribution>,
     #[serde(default)]
     wavelength_sampling: WavelengthSampling,
@@ -474,7 +545,10 @@ struct PointRepr {
 impl TryFrom<PointRepr> for PointLight {
     type Error = LightError;
     fn try_from(r: PointRepr) -> Result<Self, LightError> {
-        Self::new(r.position, r.power, r.spd, r.wavelength_sampling)
+        let candela = r.candela.map(|c| (c, 4.0 * PI));
+        let power =
+            power_from_keys("PointLight", r.power, r.lumens, candela, true, r.spd.as_ref())?;
+        Self::new(r.position, power, r.spd, r.wavelength_sampling)
     }
 }
 
@@ -482,7 +556,9 @@ impl From<PointLight> for PointRepr {
     fn from(p: PointLight) -> Self {
         Self {
             position: p.position,
-            power: p.emission.power(),
+            power: Some(p.emission.power()),
+            lumens: None,
+            candela: None,
             spd: p.emission.spd().clone(),
             wavelength_sampling: p.emission.sampling(),
         }

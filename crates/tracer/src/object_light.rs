@@ -3,7 +3,8 @@
 //!
 //! | field | unit | default | meaning |
 //! |---|---|---|---|
-//! | `power` | W | required | total emitted power (both sides together when two-sided) |
+//! | `power` | W | one of `power`, `lumens` | total emitted power (both sides together when two-sided) |
+//! | `lumens` | lm | one of `power`, `lumens` | total luminous flux instead: `power = lumens / luminous_efficacy(spd)` |
 //! | `spd` | SPD | required | spectrum |
 //! | `two_sided` | | `false` | emit from both sides of the surface (else only outwards: along the geometric normal) |
 //!
@@ -11,7 +12,13 @@
 //! {"shape": {"type": "Sphere", "center": [0, 1, 0], "radius": 0.1},
 //!  "material": {"type": "Diffuse", "reflectance": 0.8},
 //!  "emission": {"power": 20, "spd": {"type": "Blackbody", "kelvin": 2700}}}
+//! {"shape": {"type": "Sphere", "center": [0, 1, 0], "radius": 0.1},
+//!  "material": {"type": "Diffuse", "reflectance": 0.8},
+//!  "emission": {"lumens": 800, "spd": {"type": "CieIlluminant", "name": "A"}}}
 //! ```
+//!
+//! `lumens` is converted to watts when the scene is read (`spectrace_lights::power_from_keys`);
+//! serialising an emission writes `power`.
 //!
 //! Every point of the surface emits the radiance `L = power / (pi * area)` (halved when
 //! two-sided) into the hemisphere around its outward normal; the object's material still
@@ -27,22 +34,44 @@ use serde::{Deserialize, Serialize};
 use spectrace_geometry::{Ray, Shape};
 use spectrace_lights::{
     Beam, EmissionSample, LightError, LightFlags, LightSample, LightSource, SpdLight,
-    WavelengthSampling, uniform,
+    WavelengthSampling, power_from_keys, uniform,
 };
 use spectrace_sampling::{Frame, sample_cosine_hemisphere_concentric};
 use spectrace_spectrum::SpectralPowerDistribution;
 
-/// The scene-file form of an object's emission.
+/// The scene-file form of an object's emission. A scene file gives its output as `power` (W) or
+/// `lumens` (lm, converted to watts when read: `W = lm / luminous_efficacy(spd)`); it is written
+/// back as `power`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(try_from = "EmissionRepr")]
 pub struct ObjectEmission {
     /// Total emitted power (W).
     pub power: f64,
     /// The spectrum.
     pub spd: Arc<dyn SpectralPowerDistribution>,
     /// Whether both sides emit.
-    #[serde(default)]
     pub two_sided: bool,
+}
+
+/// What a scene file may write for [`ObjectEmission`]: exactly one of `power` and `lumens`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EmissionRepr {
+    #[serde(default)]
+    power: Option<f64>,
+    #[serde(default)]
+    lumens: Option<f64>,
+    spd: Arc<dyn SpectralPowerDistribution>,
+    #[serde(default)]
+    two_sided: bool,
+}
+
+impl TryFrom<EmissionRepr> for ObjectEmission {
+    type Error = LightError;
+    fn try_from(r: EmissionRepr) -> Result<Self, LightError> {
+        let power = power_from_keys("emission", r.power, r.lumens, None, false, r.spd.as_ref())?;
+        Ok(Self { power, spd: r.spd, two_sided: r.two_sided })
+    }
 }
 
 /// A glowing object: a Lambertian emitter over a shape's surface.
@@ -241,5 +270,67 @@ impl LightSource for ObjectLight {
     fn pdf_emission(&self, position: DVec3, direction: DVec3) -> Option<(f64, f64)> {
         let n = self.normal_crossing(position, direction)?;
         Some((1.0 / self.area, self.density(n, direction)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use spectrace_spectrum::luminous_efficacy;
+
+    fn emission(json: &str) -> Result<ObjectEmission, String> {
+        serde_json::from_str(json).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn an_emission_in_lumens_is_read_as_watts_and_written_as_watts() {
+        let e = emission(
+            r#"{"lumens": 800, "spd": {"type": "CieIlluminant", "name": "A"}, "two_sided": true}"#,
+        )
+        .unwrap();
+        assert_eq!(e.power, 800.0 / luminous_efficacy(e.spd.as_ref()));
+        assert!(e.two_sided);
+        let line =
+            emission(r#"{"lumens": 683, "spd": {"type": "Monochromatic", "lambda_nm": 555}}"#)
+                .unwrap();
+        assert!((line.power - 1.0).abs() < 1e-12, "{}", line.power);
+        assert!(!line.two_sided);
+        // Written back in watts, and read again to the same power.
+        let json = serde_json::to_string(&e).unwrap();
+        assert!(json.contains(r#""power":"#) && !json.contains("lumens"), "{json}");
+        assert_eq!(emission(&json).unwrap().power, e.power);
+    }
+
+    #[test]
+    fn an_emission_needs_exactly_one_visible_output() {
+        let spd = r#""spd": {"type": "Blackbody", "kelvin": 2700}"#;
+        let cases = [
+            (
+                format!(r#"{{"power": 1, "lumens": 5, {spd}}}"#),
+                "emission.lumens = 5.0: `power` is given too",
+            ),
+            (
+                format!(r#"{{{spd}}}"#),
+                "emission.power = missing: the light's output is missing: give exactly one of `power` (W) or `lumens` (lm)",
+            ),
+            (
+                format!(r#"{{"lumens": -5, {spd}}}"#),
+                "emission.lumens = -5.0: must be finite and >= 0",
+            ),
+            (
+                format!(r#"{{"power": -1, {spd}}}"#),
+                "emission.power = -1.0: must be finite and >= 0",
+            ),
+            (format!(r#"{{"candela": 5, {spd}}}"#), "unknown field `candela`"),
+            (
+                r#"{"lumens": 5, "spd": {"type": "Monochromatic", "lambda_nm": 1000}}"#.to_owned(),
+                "emission.lumens = 5.0: the spectrum has no visible light",
+            ),
+        ];
+        for (json, needle) in cases {
+            let e = emission(&json).unwrap_err();
+            assert!(e.contains(needle), "error for {json}\n  was: {e}\n  expected: {needle}");
+        }
     }
 }
