@@ -100,8 +100,8 @@ impl IrradianceSensor {
         }
         let normal = edge_u.cross(edge_v);
         let area = normal.length();
-        if !(area > 0.0 && area.is_finite()) || !(area > 1e-12 * edge_u.length() * edge_v.length())
-        {
+        let spanned = area > 1e-12 * edge_u.length() * edge_v.length();
+        if !(area > 0.0 && area.is_finite() && spanned) {
             return Err(format!(
                 "edge_u {:?} and edge_v {:?}: must be non-zero and not parallel (they span the \
                  sensor's rectangle)",
