@@ -76,7 +76,7 @@ enum Command {
         /// No progress bar or effects line.
         #[arg(long)]
         quiet: bool,
-        /// Refuse any file the scene names (OBJ meshes) outside the scene file's folder, symlinks
+        /// Refuse any file the scene names (OBJ meshes, luminaire files) outside the scene file's folder, symlinks
         /// resolved: for scenes from others (see docs/robustness.md).
         #[arg(long)]
         restrict_paths: bool,

@@ -77,7 +77,7 @@ pub struct RenderOptions {
     pub out_dir: PathBuf,
     /// Show a progress bar and print the effects decision.
     pub verbose: bool,
-    /// Refuse files (OBJ meshes) outside the scene file's folder (see [`LoadOptions`]).
+    /// Refuse files (OBJ meshes, luminaire files) outside the scene file's folder (see [`LoadOptions`]).
     pub restrict_paths: bool,
     /// The estimator (overrides `settings.integrator`).
     pub integrator: Option<IntegratorChoice>,

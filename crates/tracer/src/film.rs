@@ -188,7 +188,8 @@ impl Film {
 
     /// The number of sensor cells after the pixels.
     pub fn sensor_cells(&self) -> u32 {
-        (self.sums.len() - self.pixels()) as u32
+        // A film read from a forged part file may hold fewer sums than its size says.
+        self.sums.len().saturating_sub(self.pixels()) as u32
     }
 
     fn pixels(&self) -> usize {
@@ -198,7 +199,9 @@ impl Film {
     /// The sensor cells' sums, `[radiant, luminous, luminous^2]` each, multiplied by `scale`
     /// (the first two) and `scale^2` (the squares).
     pub fn sensor_sums(&self, scale: f64) -> Vec<crate::SensorSums> {
-        self.sums[self.pixels()..]
+        self.sums
+            .get(self.pixels()..)
+            .unwrap_or_default()
             .iter()
             .map(|c| [c[0].value() * scale, c[1].value() * scale, c[2].value() * scale * scale])
             .collect()
@@ -304,8 +307,9 @@ impl Film {
     /// The accumulated XYZ of every pixel, row-major, multiplied by `scale` (the estimator's
     /// normalisation, e.g. `1 / beams`).
     pub fn to_xyz(&self, scale: f64) -> Vec<Xyz> {
-        self.sums[..self.pixels()]
+        self.sums
             .iter()
+            .take(self.pixels())
             .map(|p| Xyz::new(p[0].value() * scale, p[1].value() * scale, p[2].value() * scale))
             .collect()
     }
@@ -606,6 +610,37 @@ mod tests {
             let quick = fixed_to_f64(fixed);
             assert!((quick - exact).abs() <= 4.0 * f64::EPSILON * exact.abs() + 1e-300, "{x}");
         }
+    }
+
+    #[test]
+    fn sensor_cells_sum_apart_from_the_pixels_and_merge_exactly() {
+        let mut direct = Film::with_sensor_cells(3, 2, 4).unwrap();
+        assert_eq!(direct.sensor_cells(), 4);
+        assert!(direct.add_sensor(3, [1.5, 2.0, 4.0]));
+        assert!(!direct.add_sensor(4, [1.0, 1.0, 1.0]), "beyond the cells");
+        assert!(!direct.add_sensor(0, [f64::NAN, 0.0, 0.0]));
+        assert_eq!(direct.rejected(), 2);
+        assert!(direct.add(2, 1, Xyz::new(1.0, 1.0, 1.0)));
+        // The image holds only the pixels; the cells come back scaled (squares by scale^2).
+        assert_eq!(direct.to_xyz(1.0).len(), 6);
+        assert_eq!(direct.sensor_sums(2.0)[3], [3.0, 4.0, 16.0]);
+        // Through a buffered writer: bit for bit the same.
+        let shared = Mutex::new(Film::with_sensor_cells(3, 2, 4).unwrap());
+        {
+            let mut w = FilmWriter::new(&shared);
+            assert!(w.splat_sensor(3, [1.5, 2.0, 4.0]));
+            assert!(!w.splat_sensor(4, [1.0, 1.0, 1.0]));
+            assert!(w.splat(2, 1, Xyz::new(1.0, 1.0, 1.0)));
+        }
+        let shared = shared.into_inner().unwrap();
+        assert_eq!(shared.sensor_sums(1.0), direct.sensor_sums(1.0));
+        assert_eq!(shared.to_xyz(1.0), direct.to_xyz(1.0));
+        // Films with different sensor cells do not merge.
+        let mut other = Film::new(3, 2).unwrap();
+        assert!(other.merge(&direct).is_err());
+        let mut twice = direct.clone();
+        twice.merge(&direct).unwrap();
+        assert_eq!(twice.sensor_sums(1.0)[3], [3.0, 4.0, 8.0]);
     }
 
     #[test]
