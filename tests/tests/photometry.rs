@@ -223,3 +223,98 @@ fn a_sensor_in_a_closed_white_sphere_reads_the_integrating_sphere_formula() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The small plane scene with a point light, as a file in `dir`, for whole renders.
+fn write_plane_scene(dir: &Path, name: &str, sensor: &str) -> PathBuf {
+    let json = format!(
+        r#"{{
+  "camera": {{"position": [0, 1, 5], "look_at": [0, 0, 0], "fov": 40, "width": 8, "height": 8}},
+  "objects": [{{"shape": {{"type": "Rectangle", "corner": [-10, -0.01, -10], "edge_u": [0, 0, 20],
+                            "edge_v": [20, 0, 0]}},
+               "material": {{"type": "Diffuse", "reflectance": 0.5}}}}],
+  "lights": [{{"type": "IesLight", "file": "lum.ies", "position": [0, 1.5, 0], "cct": 3500}}],
+  "settings": {{"beams": 40000, "spp": 2, "sensor_beams": 40000}},
+  "sensors": [{{"type": "IrradianceSensor", "name": "{sensor}", "corner": [-1, 0, -1],
+               "edge_u": [0, 0, 2], "edge_v": [2, 0, 0], "cells": [4, 4]}}]
+}}"#
+    );
+    let (.., text) = asymmetric_ies();
+    std::fs::write(dir.join("lum.ies"), text).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, json).unwrap();
+    path
+}
+
+#[test]
+fn a_render_writes_each_sensors_files_and_figures_and_a_sensor_pass_matches_the_light_tracer() {
+    use spectrace_renderer::render_file;
+    let dir = folder("render");
+    let scene = write_plane_scene(&dir, "plane.json", "desk");
+    let render = |integrator, out: &str| {
+        let options = RenderOptions {
+            integrator: Some(integrator),
+            threads: Some(2),
+            out_dir: dir.join(out),
+            ..RenderOptions::default()
+        };
+        render_file(&scene, &options).unwrap()
+    };
+    let light = render(IntegratorChoice::Light, "light");
+    let s = &light.sensors[0];
+    assert_eq!((s.name.as_str(), s.cells, s.beams), ("desk", [4, 4], 40_000));
+    assert_eq!(s.filled_by, "image beams (light tracer)");
+    assert!(
+        s.minimum_lux > 0.0 && s.minimum_lux <= s.average_lux && s.average_lux <= s.maximum_lux
+    );
+    assert!((s.uniformity - s.minimum_lux / s.average_lux).abs() < 1e-12);
+    assert!(s.average_relative_error.unwrap() < 0.05);
+    for ext in ["csv", "exr", "png"] {
+        assert!(dir.join("light").join(format!("desk.{ext}")).is_file(), "desk.{ext}");
+    }
+    // The CSV: the header the issue names, 16 rows, the average of its lux column.
+    let csv = std::fs::read_to_string(dir.join("light/desk.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some("iu,iv,x,y,z,irradiance_w_m2,illuminance_lux"));
+    let lux: Vec<f64> =
+        lines.map(|l| l.split(',').nth(6).unwrap().parse::<f64>().unwrap()).collect();
+    assert_eq!(lux.len(), 16);
+    assert!((lux.iter().sum::<f64>() / 16.0 - s.average_lux).abs() < 1e-9 * s.average_lux);
+    // The path tracer's image comes with a sensor pass of as many beams: the same light
+    // paths (same seed, and a pinhole draws no lens uniforms), so the same sensor, bit for bit.
+    let path = render(IntegratorChoice::Path, "path");
+    let p = &path.sensors[0];
+    assert_eq!(p.filled_by, "sensor pass (light tracer)");
+    assert_eq!(
+        (p.average_lux, p.minimum_lux, p.maximum_lux),
+        (s.average_lux, s.minimum_lux, s.maximum_lux)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn sensor_names_files_and_paths_are_checked_before_rendering() {
+    use spectrace_renderer::{LoadOptions, render_file};
+    let dir = folder("names");
+    // A sensor named like the image would replace its files.
+    let scene = write_plane_scene(&dir, "plane.json", "plane");
+    let options = RenderOptions { out_dir: dir.join("out"), ..RenderOptions::default() };
+    let e = render_file(&scene, &options).unwrap_err().to_string();
+    assert!(e.contains("sensors[0].name") && e.contains("image"), "{e}");
+    // Not a plain file name.
+    let scene = write_plane_scene(&dir, "bad.json", "../up");
+    let e = Scene::load(&scene).unwrap_err().to_string();
+    assert!(e.contains("sensors[0].name"), "{e}");
+    // A luminaire outside the scene's folder is read, unless paths are restricted.
+    let inner = dir.join("inner");
+    std::fs::create_dir_all(&inner).unwrap();
+    let text = std::fs::read_to_string(write_plane_scene(&dir, "outer.json", "s")).unwrap();
+    let moved = inner.join("moved.json");
+    std::fs::write(&moved, text.replace("\"lum.ies\"", "\"../lum.ies\"")).unwrap();
+    assert!(Scene::load(&moved).is_ok());
+    let e = Scene::load_with(&moved, LoadOptions { restrict_paths: true }).unwrap_err().to_string();
+    assert!(e.contains("IesLight.file") && e.contains("--restrict-paths"), "{e}");
+    // The luminaire file is an input: an output may not replace it.
+    let loaded = Scene::load(&moved).unwrap();
+    assert!(loaded.inputs.iter().any(|p| p.ends_with("lum.ies")), "{:?}", loaded.inputs);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

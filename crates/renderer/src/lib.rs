@@ -695,7 +695,7 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
         eprintln!("{}", effects.summary());
         eprintln!("integrator: {reason}");
     }
-    with_integrator(scene, choice, effects, |tracer| {
+    with_integrator_filling(scene, choice, effects, plan.shard.is_none(), |tracer| {
         let setup = Setup { choice, reason: &reason, effects, plan, name: &name };
         render_with(scene, options, &setup, estimate_warning.into_iter().collect(), tracer)
     })
@@ -752,7 +752,21 @@ pub fn with_integrator<R>(
     effects: Effects,
     f: impl FnOnce(&dyn Integrator) -> R,
 ) -> R {
-    let tracer_scene = tracer_scene(scene);
+    with_integrator_filling(scene, choice, effects, true, f)
+}
+
+/// As [`with_integrator`]; with `sensors` false the light tracer leaves the scene's sensors
+/// alone (a shard's part holds the image only).
+pub fn with_integrator_filling<R>(
+    scene: &Scene,
+    choice: IntegratorChoice,
+    effects: Effects,
+    sensors: bool,
+    f: impl FnOnce(&dyn Integrator) -> R,
+) -> R {
+    let none = spectrace_tracer::SensorSet::default();
+    let tracer_scene =
+        if sensors { tracer_scene(scene) } else { tracer_scene(scene).with_sensors(&none) };
     match choice {
         IntegratorChoice::Path => {
             f(&PathTracer::new(&tracer_scene, scene.path_settings(), effects))

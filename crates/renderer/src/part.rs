@@ -155,10 +155,16 @@ impl PartialFilm {
             return bad("output.film", format!("size {w}x{h} is not a valid image size"));
         }
         let pixels = out.film.to_xyz(1.0);
-        if pixels.len() as u64 != u64::from(w) * u64::from(h) {
+        // Shards fill no sensors, so a part's film is its pixels and nothing more.
+        let extra = out.film.sensor_cells();
+        if pixels.len() as u64 != u64::from(w) * u64::from(h) || extra != 0 {
             return bad(
                 "output.film",
-                format!("holds {} pixels, but a {w}x{h} image has {}", pixels.len(), w * h),
+                format!(
+                    "holds {} pixels, but a {w}x{h} image has {}",
+                    pixels.len() + extra as usize,
+                    w * h
+                ),
             );
         }
         if let Some(i) = pixels.iter().position(|p| !(p.x >= 0.0 && p.y >= 0.0 && p.z >= 0.0)) {
