@@ -293,6 +293,34 @@ impl Luminaire {
         Ok(Self { emission, position, orientation, distribution: Arc::new(distribution) })
     }
 
+    /// A luminaire of the stored table `planes.0` with every value times `planes.1` (a file's
+    /// own factor) and `multiplier`, placed at `(position, nadir, c0)`, and its scene-file form.
+    pub(crate) fn placed(
+        light: &'static str,
+        planes: (&CandelaPlanes, f64),
+        (position, nadir, c0): (DVec3, DVec3, DVec3),
+        spd: Arc<dyn SpectralPowerDistribution>,
+        multiplier: f64,
+        sampling: WavelengthSampling,
+    ) -> Result<(Self, LuminaireRepr), LightError> {
+        let multiplier = check_multiplier(light, multiplier)?;
+        let orientation = Orientation::new(light, nadir, c0)?;
+        let distribution = distribution_of(light, planes.0, multiplier * planes.1)?;
+        let luminaire =
+            Self::new(light, position, orientation, distribution, spd.clone(), sampling)?;
+        let repr = LuminaireRepr {
+            file: PathBuf::new(),
+            position,
+            nadir,
+            c0,
+            spd: Some(spd),
+            cct: None,
+            multiplier,
+            wavelength_sampling: sampling,
+        };
+        Ok((luminaire, repr))
+    }
+
     /// The spectrum a luminaire gets from its scene-file keys: `spd`, or a blackbody at `cct`,
     /// or `default_cct`'s blackbody, or CIE illuminant A.
     pub(crate) fn spectrum(
@@ -352,6 +380,27 @@ impl Luminaire {
         let direction = self.sample_direction([u[0], u[1]]);
         point_emission(self.position, direction, self.pdf_direction(direction))
     }
+}
+
+/// The inherent accessors of a type holding a [`Luminaire`] in the field `luminaire`.
+macro_rules! luminaire_accessors {
+    () => {
+        /// The candela distribution (absolute, every multiplier applied).
+        pub fn distribution(&self) -> &CandelaDistribution {
+            &self.luminaire.distribution
+        }
+
+        /// The luminous flux (lm) the light emits.
+        pub fn lumens(&self) -> f64 {
+            self.luminaire.distribution.lumens()
+        }
+
+        /// Luminous intensity (cd) along the unit world direction `d`.
+        pub fn candela_towards(&self, d: DVec3) -> f64 {
+            let (c, cos_gamma) = self.luminaire.orientation.angles(d);
+            self.luminaire.distribution.candela(c, cos_gamma)
+        }
+    };
 }
 
 /// Implements the beam and density methods of [`LightSource`] for a type holding a
@@ -417,7 +466,7 @@ pub struct IesLight {
 /// Scene-file form of [`IesLight`] and [`EulumdatLight`].
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct LuminaireRepr {
+pub(crate) struct LuminaireRepr {
     file: PathBuf,
     position: DVec3,
     #[serde(default = "default_nadir")]
@@ -503,29 +552,16 @@ impl IesLight {
         multiplier: f64,
         sampling: WavelengthSampling,
     ) -> Result<Self, LightError> {
-        const LIGHT: &str = "IesLight";
-        let multiplier = check_multiplier(LIGHT, multiplier)?;
-        let orientation = Orientation::new(LIGHT, nadir, c0)?;
-        let distribution =
-            distribution_of(LIGHT, &ies.candela_planes(), multiplier * ies.ballast_factor)?;
-        let luminaire =
-            Luminaire::new(LIGHT, position, orientation, distribution, spd.clone(), sampling)?;
-        let repr = LuminaireRepr {
-            file: PathBuf::new(),
-            position,
-            nadir,
-            c0,
-            spd: Some(spd),
-            cct: None,
+        let planes = ies.candela_planes();
+        let (luminaire, repr) = Luminaire::placed(
+            "IesLight",
+            (&planes, ies.ballast_factor),
+            (position, nadir, c0),
+            spd,
             multiplier,
-            wavelength_sampling: sampling,
-        };
+            sampling,
+        )?;
         Ok(Self { luminaire, repr: Arc::new(repr), file: Arc::new(ies) })
-    }
-
-    /// The candela distribution (scaled by the multipliers).
-    pub fn distribution(&self) -> &CandelaDistribution {
-        &self.luminaire.distribution
     }
 
     /// The parsed file.
@@ -533,16 +569,7 @@ impl IesLight {
         &self.file
     }
 
-    /// The luminous flux (lm) the light emits.
-    pub fn lumens(&self) -> f64 {
-        self.luminaire.distribution.lumens()
-    }
-
-    /// Luminous intensity (cd) along the unit world direction `d`.
-    pub fn candela_towards(&self, d: DVec3) -> f64 {
-        let (c, cos_gamma) = self.luminaire.orientation.angles(d);
-        self.luminaire.distribution.candela(c, cos_gamma)
-    }
+    luminaire_accessors!();
 }
 
 #[typetag::serde]
@@ -620,28 +647,16 @@ impl EulumdatLight {
         multiplier: f64,
         sampling: WavelengthSampling,
     ) -> Result<Self, LightError> {
-        const LIGHT: &str = "EulumdatLight";
-        let multiplier = check_multiplier(LIGHT, multiplier)?;
-        let orientation = Orientation::new(LIGHT, nadir, c0)?;
-        let distribution = distribution_of(LIGHT, &ldt.candela_planes(), multiplier)?;
-        let luminaire =
-            Luminaire::new(LIGHT, position, orientation, distribution, spd.clone(), sampling)?;
-        let repr = LuminaireRepr {
-            file: PathBuf::new(),
-            position,
-            nadir,
-            c0,
-            spd: Some(spd),
-            cct: None,
+        let planes = ldt.candela_planes();
+        let (luminaire, repr) = Luminaire::placed(
+            "EulumdatLight",
+            (&planes, 1.0),
+            (position, nadir, c0),
+            spd,
             multiplier,
-            wavelength_sampling: sampling,
-        };
+            sampling,
+        )?;
         Ok(Self { luminaire, repr: Arc::new(repr), file: Arc::new(ldt) })
-    }
-
-    /// The candela distribution (absolute, scaled by `multiplier`).
-    pub fn distribution(&self) -> &CandelaDistribution {
-        &self.luminaire.distribution
     }
 
     /// The parsed file.
@@ -649,16 +664,7 @@ impl EulumdatLight {
         &self.file
     }
 
-    /// The luminous flux (lm) the light emits.
-    pub fn lumens(&self) -> f64 {
-        self.luminaire.distribution.lumens()
-    }
-
-    /// Luminous intensity (cd) along the unit world direction `d`.
-    pub fn candela_towards(&self, d: DVec3) -> f64 {
-        let (c, cos_gamma) = self.luminaire.orientation.angles(d);
-        self.luminaire.distribution.candela(c, cos_gamma)
-    }
+    luminaire_accessors!();
 }
 
 #[typetag::serde]
