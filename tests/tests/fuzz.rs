@@ -63,9 +63,11 @@ enum Reached {
     Rendered,
 }
 
-/// Loads a scene text; if it loads, renders a few beams and checks the image is finite.
+/// Loads a scene text (as if it were a file in `scenes/`, so that the shipped scenes' luminaire
+/// files resolve); if it loads, renders a few beams and checks the image is finite.
 fn exercise_scene(text: &str) -> Reached {
-    let Ok(scene) = Scene::from_json(text, Path::new("fuzz.json")) else { return Reached::Refused };
+    let path = workspace().join("scenes").join("fuzz.json");
+    let Ok(scene) = Scene::from_json(text, &path) else { return Reached::Refused };
     let pixels = u64::from(scene.camera.width()) * u64::from(scene.camera.height());
     if pixels > RENDER_PIXELS || scene.settings.max_depth > 256 {
         return Reached::Loaded;
