@@ -233,7 +233,7 @@ fn write_plane_scene(dir: &Path, name: &str, sensor: &str) -> PathBuf {
                             "edge_v": [20, 0, 0]}},
                "material": {{"type": "Diffuse", "reflectance": 0.5}}}}],
   "lights": [{{"type": "IesLight", "file": "lum.ies", "position": [0, 1.5, 0], "cct": 3500}}],
-  "settings": {{"beams": 40000, "spp": 2, "sensor_beams": 40000}},
+  "settings": {{"beams": 40000, "spp": 2, "sensor_beams": 40000, "sensor_integrator": "light"}},
   "sensors": [{{"type": "IrradianceSensor", "name": "{sensor}", "corner": [-1, 0, -1],
                "edge_u": [0, 0, 2], "edge_v": [2, 0, 0], "cells": [4, 4]}}]
 }}"#
@@ -288,6 +288,24 @@ fn a_render_writes_each_sensors_files_and_figures_and_a_sensor_pass_matches_the_
         (p.average_lux, p.minimum_lux, p.maximum_lux),
         (s.average_lux, s.minimum_lux, s.maximum_lux)
     );
+    // By default a camera integrator's image comes with the path tracer sampling points on the
+    // sensor instead: the same average within the two estimates' errors.
+    let text = std::fs::read_to_string(&scene).unwrap();
+    std::fs::write(&scene, text.replace(r#", "sensor_integrator": "light""#, "")).unwrap();
+    let sampled = render(IntegratorChoice::Path, "sampled");
+    let q = &sampled.sensors[0];
+    assert_eq!(q.filled_by, "points sampled on the sensor (path tracer)");
+    assert_eq!(q.beams, 64, "the default sensor_spp");
+    let se = (q.average_relative_error.unwrap().powi(2)
+        + s.average_relative_error.unwrap().powi(2))
+    .sqrt()
+        * s.average_lux;
+    assert!(
+        (q.average_lux - s.average_lux).abs() < 4.0 * se,
+        "{} vs {}",
+        q.average_lux,
+        s.average_lux
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -316,5 +334,71 @@ fn sensor_names_files_and_paths_are_checked_before_rendering() {
     // The luminaire file is an input: an output may not replace it.
     let loaded = Scene::load(&moved).unwrap();
     assert!(loaded.inputs.iter().any(|p| p.ends_with("lum.ies")), "{:?}", loaded.inputs);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// As [`measure`], with the path tracer sampling `passes` points of every cell.
+fn measure_path(scene: &Scene, passes: u64) -> (Vec<f64>, Vec<f64>, f64) {
+    use spectrace_renderer::{decide_effects, sensor_pass_path};
+    let (film, n, _) = sensor_pass_path(scene, passes, 2, decide_effects(scene, None)).unwrap();
+    assert_eq!(n, passes);
+    let sums = film.sensor_sums(1.0);
+    let (grid, average_error, _) = sensor_grid(&scene.sensors, 0, &sums, scene.lights.power(), n);
+    let sensor = &scene.sensors.sensors()[0];
+    let per = scene.lights.power() / n as f64;
+    let errors = sums[..sensor.cell_count() as usize]
+        .iter()
+        .map(|c| (c[2] - c[1] * c[1] / n as f64).max(0.0).sqrt() * per / sensor.cell_area())
+        .collect();
+    (grid.illuminance, errors, average_error.unwrap())
+}
+
+#[test]
+fn the_path_tracer_sampling_points_on_a_sensor_gives_the_same_closed_forms() {
+    let dir = folder("path-sensor");
+    // The asymmetric IES luminaire over the plane (its direct light is exact, so the noise is
+    // that of the wavelengths and of the black floor's zero indirect light).
+    let (vertical, horizontal, candela, text) = asymmetric_ies();
+    std::fs::write(dir.join("asym.ies"), text).unwrap();
+    let scene = plane_scene(
+        r#"{"type": "IesLight", "file": "asym.ies", "position": [-0.2, 1.5, 0.1], "cct": 4000}"#,
+        &dir,
+    );
+    let h: Vec<f64> = horizontal.iter().map(|c| c.to_radians()).collect();
+    let v: Vec<f64> = vertical.iter().map(|g| g.to_radians().cos()).collect();
+    let intensity = |d: [f64; 3]| {
+        let mu = -d[1];
+        let c = (-d[2]).atan2(d[0]).rem_euclid(2.0 * PI);
+        let a = (h.partition_point(|&x| x <= c).max(1) - 1).min(h.len() - 2);
+        let t = (c - h[a]) / (h[a + 1] - h[a]);
+        let b = (v.partition_point(|&x| x >= mu).max(1) - 1).min(v.len() - 2);
+        let s = (mu - v[b]) / (v[b + 1] - v[b]);
+        let row = |k: usize| candela[k][b] * (1.0 - s) + candela[k][b + 1] * s;
+        row(a) * (1.0 - t) + row(a + 1) * t
+    };
+    let want = expected([-0.2, 1.5, 0.1], &intensity);
+    let (got, errors, average_error) = measure_path(&scene, 4000);
+    assert_cells_agree("path, IES luminaire", &got, &errors, &want, average_error);
+    // The integrating sphere: all of it is interreflected light, found by the cosine rays.
+    let json = r#"{
+  "camera": {"position": [0, 0, 0.5], "look_at": [0, 0, -1], "fov": 40, "width": 4, "height": 4},
+  "objects": [{"shape": {"type": "Sphere", "center": [0, 0, 0], "radius": 1},
+               "material": {"type": "Diffuse", "reflectance": 0.8}}],
+  "lights": [{"type": "PointLight", "position": [0, 0, 0], "power": 10,
+              "spd": {"type": "CieIlluminant", "name": "D65"}}],
+  "settings": {"max_depth": 200, "rr_depth": 50},
+  "sensors": [{"type": "IrradianceSensor", "name": "inside", "corner": [-0.1, -0.5, -0.1],
+               "edge_u": [0.2, 0, 0], "edge_v": [0, 0, 0.2], "cells": [2, 2]}]
+}"#;
+    let scene = Scene::from_json(json, &dir.join("sphere.json")).unwrap();
+    let lumens = 10.0 * luminous_efficacy(&CieIlluminant::new("D65").unwrap());
+    let want = 0.8 * lumens / (4.0 * PI * (1.0 - 0.8));
+    let (got, _, average_error) = measure_path(&scene, 20_000);
+    let mean = got.iter().sum::<f64>() / got.len() as f64;
+    assert!(
+        (mean - want).abs() < 4.0 * average_error * mean,
+        "{mean} vs {want} (relative se {average_error})"
+    );
+    assert!(average_error < 0.01, "the check is sharp to 1%: {average_error}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -47,15 +47,15 @@ pub use files::{
 pub use output::{EncodedImage, OUTPUT_BYTES_PER_PIXEL, encode_image, write_exr, write_png};
 pub use part::{PARTIAL_VERSION, PartialFilm};
 pub use scene::{
-    DEFAULT_SPP, EffectsSettings, LoadOptions, Object, OutputSettings, Scene, SceneError,
-    SceneFile, Settings, check_target_error,
+    DEFAULT_SENSOR_SPP, DEFAULT_SPP, EffectsSettings, LoadOptions, Object, OutputSettings, Scene,
+    SceneError, SceneFile, SensorIntegrator, Settings, check_target_error,
 };
 pub use sensor_output::{
     MAX_SENSOR_CELLS, SensorGrid, SensorSummary, sensor_colour, write_sensor_files,
 };
 pub use sensors::{
     SensorReport, SensorSource, check_sensor_names, planned_sensor_outputs, sensor_grid,
-    sensor_pass, sensor_plan, sensor_summary, write_sensors,
+    sensor_pass, sensor_pass_path, sensor_plan, sensor_summary, write_sensors,
 };
 
 /// Command-line overrides of a scene's settings.
@@ -924,11 +924,21 @@ fn render_with(
             filled_by: "image beams (light tracer)",
         };
         write_sensors(scene, &options.out_dir, source)?
-    } else {
+    } else if scene.settings.sensor_integrator == SensorIntegrator::Light {
         let (film, beams, seconds) =
             sensor_pass(scene, &sensor_plan(scene, plan.threads), effects)?;
         let source =
             SensorSource { film: &film, beams, seconds, filled_by: "sensor pass (light tracer)" };
+        write_sensors(scene, &options.out_dir, source)?
+    } else {
+        let passes = scene.settings.sensor_spp.unwrap_or(DEFAULT_SENSOR_SPP);
+        let (film, beams, seconds) = sensor_pass_path(scene, passes, plan.threads, effects)?;
+        let source = SensorSource {
+            film: &film,
+            beams,
+            seconds,
+            filled_by: "points sampled on the sensor (path tracer)",
+        };
         write_sensors(scene, &options.out_dir, source)?
     };
     for r in &sensors {

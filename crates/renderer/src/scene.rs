@@ -87,9 +87,15 @@ pub struct Settings {
     pub rr_depth: u32,
     /// Beams per work chunk (the unit of random streams and of sharding).
     pub chunk_beams: u64,
-    /// Beams of the sensor pass that fills the sensors when a camera integrator renders the
-    /// image (default: `beams`); the light tracer fills them with the image's own beams.
+    /// Beams of a light-tracer sensor pass (default: `beams`).
     pub sensor_beams: Option<u64>,
+    /// Samples per sensor cell of a path-tracer sensor pass (default 64).
+    pub sensor_spp: Option<u64>,
+    /// How sensors are filled when the image is rendered by a camera integrator: `"path"` (the
+    /// default: the path tracer samples points on the sensors, `sensor_spp` per cell) or
+    /// `"light"` (a light-tracer pass of `sensor_beams`). The light tracer always fills them
+    /// with the image's own beams.
+    pub sensor_integrator: SensorIntegrator,
     /// The estimator: `"auto"` (the effects analysis chooses), `"light"`, `"path"` or `"bdpt"`.
     pub integrator: IntegratorChoice,
     /// Camera samples per pixel for the camera integrators (`path`, `bdpt`); the upper limit
@@ -118,6 +124,8 @@ impl Default for Settings {
             rr_depth: 4,
             chunk_beams: DEFAULT_CHUNK_BEAMS,
             sensor_beams: None,
+            sensor_spp: None,
+            sensor_integrator: SensorIntegrator::Path,
             integrator: IntegratorChoice::Auto,
             spp: DEFAULT_SPP,
             camera_wavelengths: CameraWavelengths::Visible,
@@ -126,6 +134,20 @@ impl Default for Settings {
         }
     }
 }
+
+/// How sensors are filled beside a camera integrator's image (`settings.sensor_integrator`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SensorIntegrator {
+    /// The path tracer sampling points on the sensors.
+    #[default]
+    Path,
+    /// A light-tracer pass.
+    Light,
+}
+
+/// Samples per sensor cell of a path-tracer sensor pass when a scene does not say.
+pub const DEFAULT_SENSOR_SPP: u64 = 64;
 
 /// Camera samples per pixel when a scene does not say (`settings.spp`).
 pub const DEFAULT_SPP: u64 = 64;
@@ -363,6 +385,9 @@ impl Scene {
         }
         if s.spp == 0 {
             return Err(scene_error("settings.spp", "must be at least 1".to_owned()));
+        }
+        if s.sensor_spp == Some(0) {
+            return Err(scene_error("settings.sensor_spp", "must be at least 1".to_owned()));
         }
         if s.sensor_beams == Some(0) {
             return Err(scene_error("settings.sensor_beams", "must be at least 1".to_owned()));

@@ -1,13 +1,14 @@
 //! Illuminance sensors in a render: where their values come from, how accurate they are, and
 //! the files and sidecar figures they become.
 //!
-//! Light paths fill sensors (see `spectrace_tracer::IrradianceSensor`). When the light tracer
-//! renders the image, the image's own beams fill them at no extra tracing. When a camera
-//! integrator (path tracer, BDPT) renders the image, a *sensor pass* follows: the light tracer
-//! again, with `settings.sensor_beams` beams (default: `settings.beams`), connected to no camera.
-//! Either way the sums become irradiance and illuminance per cell, with the relative standard
-//! error of the sensor's average from the spread of the beams' contributions, and a prediction
-//! of the beams and time a 1% average would take.
+//! When the light tracer renders the image, the image's own beams fill the sensors at no extra
+//! tracing. When a camera integrator (path tracer, BDPT) renders it, a *sensor pass* follows:
+//! by default `spectrace_tracer::SensorPathTracer`, the path tracer from points sampled on the
+//! sensors (`settings.sensor_spp` per cell), or with `settings.sensor_integrator: "light"` the
+//! light tracer again with `settings.sensor_beams` beams, connected to no camera. Either way the
+//! sums become irradiance and illuminance per cell, with the relative standard error of the
+//! sensor's average from the spread of the samples, and a prediction of the time a 1% average
+//! would take.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -15,7 +16,8 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 use spectrace_lights::LightSource;
 use spectrace_tracer::{
-    Effects, Film, LightTracer, RenderPlan, SensorSet, SensorSums, render as render_plan,
+    Effects, Film, LightTracer, PathTracer, RenderPlan, SensorPathTracer, SensorSet, SensorSums,
+    render as render_plan,
 };
 
 use crate::sensor_output::{SensorGrid, write_sensor_files};
@@ -101,6 +103,40 @@ pub fn sensor_pass(
         render_plan(&tracer, &plan, &|_| {}).map_err(|e| RenderError::Options(e.to_string()))?;
     scene.lights.reset_count();
     Ok((output.film, output.beams, started.elapsed().as_secs_f64()))
+}
+
+/// Runs a sensor pass with the path tracer sampling points on the sensors: `passes` samples of
+/// every cell. Returns the film (its sensor cells), the passes done (the `N` of
+/// [`sensor_grid`]) and the seconds it took.
+///
+/// # Errors
+/// [`RenderError::Options`] if the film cannot be made.
+pub fn sensor_pass_path(
+    scene: &Scene,
+    passes: u64,
+    threads: usize,
+    effects: Effects,
+) -> Result<(Film, u64, f64), RenderError> {
+    let started = Instant::now();
+    let traced = tracer_scene(scene);
+    let tracer = SensorPathTracer::new(
+        PathTracer::new(&traced, scene.path_settings(), effects),
+        &scene.sensors,
+    );
+    let cells = u64::from(scene.sensors.total_cells()).max(1);
+    let plan = RenderPlan {
+        beams: passes.saturating_mul(cells),
+        chunk_beams: cells,
+        seed: scene.settings.seed,
+        threads,
+        shard: None,
+        time_budget: None,
+        error_estimate: false,
+        target_error: None,
+    };
+    let output =
+        render_plan(&tracer, &plan, &|_| {}).map_err(|e| RenderError::Options(e.to_string()))?;
+    Ok((output.film, output.beams / cells, started.elapsed().as_secs_f64()))
 }
 
 /// The plan of a sensor pass: `settings.sensor_beams` beams (default `settings.beams`), the

@@ -50,7 +50,7 @@ pub use light_tracer::{
     trace_chunk, trace_chunk_until,
 };
 pub use object_light::{ObjectEmission, ObjectLight};
-pub use path_tracer::{PathTracer, PathTracerSettings};
+pub use path_tracer::{PathTracer, PathTracerSettings, SensorPathTracer};
 pub use render::{
     DEFAULT_CHUNK_BEAMS, FALLBACK_MEMORY_LIMIT, MemoryLimit, Progress, RenderOutput, RenderPlan,
     render, render_observed,

@@ -539,3 +539,152 @@ impl Integrator for PathTracer<'_> {
         camera_image_scale(self.scene.lights.power(), self.pass_samples(), samples_done)
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+
+/// The path tracer estimating the scene's illuminance sensors by sampling points on them (no
+/// image): a work item is one sample of one sensor cell, a chunk one pass over every cell of
+/// every sensor.
+///
+/// # Estimator
+/// At a point `x` drawn uniformly in the cell, with the sensor's front normal `n`, the
+/// irradiance is `E = integral of L_i(x, w) (w . n) dw` over the front hemisphere. Point and
+/// spot lights (which no ray can hit) add exactly `I(w) cos / d^2` when visible; everything else
+/// arrives along one cosine-weighted direction, `E = pi L` in expectation, with `L` the path
+/// tracer's radiance estimate along that ray (emitters it hits count fully, since nothing else
+/// samples them at `x`). Wavelengths are drawn from the lights' own spectrum, [`HERO`] of them
+/// stratified, each weighted by one over its density, so the radiant and the luminous sums are
+/// both unbiased over the lights' whole range. The sensor blocks nothing: rays start at `x`.
+/// The film keeps `E x cell area / P` per sample (`P` the lights' power) in the cell's
+/// `[radiant, luminous, luminous^2]`, so that the light tracer's normalisation (`P / N / area`,
+/// with `N` the passes) gives the mean irradiance.
+#[derive(Debug, Clone)]
+pub struct SensorPathTracer<'a> {
+    tracer: PathTracer<'a>,
+    sensors: &'a crate::SensorSet,
+}
+
+impl<'a> SensorPathTracer<'a> {
+    /// Its [`Integrator::name`].
+    pub const NAME: &'static str = "path (sensors)";
+
+    /// The path tracer `tracer`, estimating `sensors`.
+    pub fn new(tracer: PathTracer<'a>, sensors: &'a crate::SensorSet) -> Self {
+        Self { tracer, sensors }
+    }
+
+    /// One sample of the cell `cell` (numbered over all sensors): `[radiant, luminous]`
+    /// irradiance times the cell's area over the lights' power.
+    fn sample_cell(&self, cell: u32, rng: &mut dyn rand::Rng, stats: &mut TraceStats) -> [f64; 2] {
+        let scene = self.tracer.scene;
+        let sensors = self.sensors.sensors();
+        let Some(index) = (0..sensors.len()).rev().find(|&i| self.sensors.offset(i) <= cell) else {
+            return [0.0; 2];
+        };
+        let sensor = &sensors[index];
+        let local = cell - self.sensors.offset(index);
+        let [nu, nv] = sensor.cells();
+        let (iu, iv) = (local % nu, local / nu);
+        let (a, b) = (uniform(rng), uniform(rng));
+        let x = sensor.corner()
+            + sensor.edge_u() * ((f64::from(iu) + a) / f64::from(nu))
+            + sensor.edge_v() * ((f64::from(iv) + b) / f64::from(nv));
+        let n = sensor.front();
+        // Wavelengths from the lights' spectrum, stratified.
+        let spectrum = LightSource::spd(scene.lights);
+        let u = uniform(rng);
+        let mut lambdas = [0.0; HERO];
+        let mut weights = [0.0; HERO];
+        for j in 0..HERO {
+            let lambda = spectrum.sample_lambda(((j as f64 + u) / HERO as f64).min(0.999_999_999));
+            let q = spectrum.value(lambda);
+            lambdas[j] = lambda;
+            weights[j] = if q > 0.0 { 1.0 / (HERO as f64 * q) } else { 0.0 };
+        }
+        let mut irradiance = [0.0; HERO];
+        // Point and spot lights, exactly.
+        for &id in &self.tracer.delta_lights {
+            let Some(light) = scene.lights.light(id) else { continue };
+            let Some(s) = light.sample_towards(x, [0.5, 0.5]) else { continue };
+            let cos = -s.direction.dot(n);
+            if !(cos > 0.0 && s.intensity > 0.0) {
+                continue;
+            }
+            let shadow = Ray { origin: s.position, direction: s.direction };
+            if scene.world.occluded(&shadow, s.distance * (1.0 - 1e-9)) {
+                continue;
+            }
+            let Some(spd) = scene.light_spd(id) else { continue };
+            let e = s.intensity * cos / (s.distance * s.distance);
+            for j in 0..HERO {
+                irradiance[j] += e * spd.value(lambdas[j]);
+            }
+        }
+        // Everything else along one cosine-weighted direction: E = pi L.
+        let local_dir = spectrace_sampling::sample_cosine_hemisphere([uniform(rng), uniform(rng)]);
+        let direction = spectrace_sampling::Frame::from_normal(n).to_world(local_dir).normalize();
+        let ray = Ray { origin: x, direction };
+        let radiance = self.tracer.radiance(ray, &mut lambdas, &mut weights, rng, stats);
+        for j in 0..HERO {
+            irradiance[j] += std::f64::consts::PI * radiance[j];
+        }
+        let scale = sensor.cell_area() / LightSource::power(scene.lights);
+        let (mut radiant, mut luminous) = (0.0, 0.0);
+        for j in 0..HERO {
+            if weights[j] > 0.0 && irradiance[j] != 0.0 {
+                radiant += irradiance[j] * weights[j];
+                luminous +=
+                    irradiance[j] * weights[j] * spectrace_spectrum::lumens_per_watt(lambdas[j]);
+            }
+        }
+        [radiant * scale, luminous * scale]
+    }
+}
+
+impl Integrator for SensorPathTracer<'_> {
+    fn name(&self) -> &'static str {
+        Self::NAME
+    }
+
+    /// No image: a film of one pixel, which stays black.
+    fn resolution(&self) -> (u32, u32) {
+        (1, 1)
+    }
+
+    /// One pass: item `i` samples cell `(i + pass_start(chunk)) mod cells`.
+    fn render_chunk(
+        &self,
+        seed: u64,
+        chunk: u64,
+        samples: u64,
+        _deadline: Option<Instant>,
+        film: &mut dyn Splat,
+    ) -> TraceStats {
+        let mut rng = ChunkSampler::new(self.tracer.scene.sampler(), seed, chunk);
+        let mut stats = TraceStats::default();
+        let cells = u64::from(self.sensors.total_cells()).max(1);
+        let start = pass_start(chunk, cells);
+        for i in 0..samples {
+            let cell = ((i + start) % cells) as u32;
+            rng.start_path(u64::from(cell), chunk);
+            let [radiant, luminous] = self.sample_cell(cell, &mut rng, &mut stats);
+            stats.beams += 1;
+            if radiant != 0.0 || luminous != 0.0 {
+                film.splat_sensor(cell, [radiant, luminous, luminous * luminous]);
+            }
+        }
+        stats
+    }
+
+    fn image_scale(&self, samples_done: u64) -> f64 {
+        camera_image_scale(
+            LightSource::power(self.tracer.scene.lights),
+            u64::from(self.sensors.total_cells()),
+            samples_done,
+        )
+    }
+
+    fn sensor_cells(&self) -> u32 {
+        self.sensors.total_cells()
+    }
+}
