@@ -402,3 +402,40 @@ fn the_path_tracer_sampling_points_on_a_sensor_gives_the_same_closed_forms() {
     assert!(average_error < 0.01, "the check is sharp to 1%: {average_error}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn sensors_leave_the_image_of_an_interreflecting_scene_bit_for_bit_unchanged() {
+    let dir = folder("unchanged");
+    // Two walls that light each other: beams go on after diffuse hits with or without sensors.
+    let with = r#"{
+  "camera": {"position": [0, 1, 4], "look_at": [0, 0.5, 0], "fov": 40, "width": 16, "height": 12},
+  "objects": [
+    {"shape": {"type": "Rectangle", "corner": [-2, 0, 2], "edge_u": [4, 0, 0], "edge_v": [0, 0, -4]},
+     "material": {"type": "Diffuse", "reflectance": 0.7}},
+    {"shape": {"type": "Rectangle", "corner": [-2, 0, -1], "edge_u": [4, 0, 0], "edge_v": [0, 2, 0]},
+     "material": {"type": "Diffuse", "reflectance": 0.7}}],
+  "lights": [{"type": "PointLight", "position": [0, 1.5, 0.5], "power": 10,
+              "spd": {"type": "CieIlluminant", "name": "D65"}}],
+  "sensors": [{"type": "IrradianceSensor", "name": "s", "corner": [-1, 0.5, 1], "edge_u": [2, 0, 0],
+               "edge_v": [0, 0, -2], "cells": [4, 4]}]
+}"#;
+    let mut v: serde_json::Value = serde_json::from_str(with).unwrap();
+    v.as_object_mut().unwrap().remove("sensors");
+    let without = v.to_string();
+    let image = |json: &str| {
+        let scene = Scene::from_json(json, &dir.join("s.json")).unwrap();
+        let options = RenderOptions {
+            beams: Some(50_000),
+            threads: Some(2),
+            integrator: Some(IntegratorChoice::Light),
+            ..RenderOptions::default()
+        };
+        let out = render_in_memory(&scene, &options).unwrap();
+        (out.image, out.output.film.sensor_sums(1.0))
+    };
+    let (a, cells) = image(with);
+    let (b, none) = image(&without);
+    assert!(cells.iter().any(|c| c[1] > 0.0) && none.is_empty());
+    assert!(a.iter().zip(&b).all(|(p, q)| p == q), "the image changed with a sensor");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
