@@ -455,3 +455,30 @@ fn a_eulumdat_luminaire_is_absolute_oriented_and_lit_by_its_lamps_colour() {
     assert!(e.contains("EulumdatLight.file") && e.contains("cut.ldt:"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn lumens_scale_the_table_to_the_luminaires_flux() {
+    let (vertical, horizontal, candela) = asymmetric();
+    let dir = folder("scale");
+    std::fs::write(dir.join("lum.ies"), ies_text(&vertical, &horizontal, &candela)).unwrap();
+    let light = load(
+        &dir,
+        r#"{"type": "IesLight", "file": "lum.ies", "position": [0, 3, 0], "lumens": 5000, "cct": 3000}"#,
+    )
+    .unwrap();
+    let k = luminous_efficacy(light.spd().as_ref());
+    assert!((light.power() * k - 5000.0).abs() < 1e-9 * 5000.0, "{}", light.power() * k);
+    // The shape is the table's: straight down, 5000 / (the table's flux) times the file's value.
+    let h: Vec<f64> = horizontal.iter().map(|c| c.to_radians()).collect();
+    let v: Vec<f64> = vertical.iter().map(|g| g.to_radians().cos()).collect();
+    let scale = 5000.0 / flux_of(&h, &v, &candela);
+    let below = light.sample_towards(DVec3::ZERO, [0.5, 0.5]).unwrap();
+    assert!((below.intensity * k - scale * candela[0][0]).abs() < 1e-6 * candela[0][0]);
+    for bad in [r#""lumens": 5000, "multiplier": 2"#, r#""lumens": -1"#, r#""lumens": 0"#] {
+        let json =
+            format!(r#"{{"type": "IesLight", "file": "lum.ies", "position": [0, 3, 0], {bad}}}"#);
+        let e = load(&dir, &json).unwrap_err();
+        assert!(e.contains("IesLight.lumens"), "{bad}: {e}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -11,6 +11,7 @@
 //! | `spd` | SPD | see below | spectrum of the light |
 //! | `cct` | K | | instead of `spd`: a blackbody at this colour temperature |
 //! | `multiplier` | | 1 | scales every candela value (and so the flux) |
+//! | `lumens` | lm | | instead of `multiplier`: scales the table so the luminaire emits this flux |
 //! | `wavelength_sampling` | | `"importance"` | as for every light |
 //!
 //! ```json
@@ -316,6 +317,7 @@ impl Luminaire {
             spd: Some(spd),
             cct: None,
             multiplier,
+            lumens: None,
             wavelength_sampling: sampling,
         };
         Ok((luminaire, repr))
@@ -479,8 +481,30 @@ pub(crate) struct LuminaireRepr {
     cct: Option<f64>,
     #[serde(default = "one")]
     multiplier: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    lumens: Option<f64>,
     #[serde(default)]
     wavelength_sampling: WavelengthSampling,
+}
+
+impl LuminaireRepr {
+    /// The multiplier that gives the luminaire `lumens` when the table at multiplier 1 gives
+    /// `table_lumens`; `self.multiplier` without `lumens`.
+    fn multiplier_for(&self, light: &'static str, table_lumens: f64) -> Result<f64, LightError> {
+        let Some(lumens) = self.lumens else { return Ok(self.multiplier) };
+        if self.multiplier != 1.0 {
+            return Err(LightError::parameter(
+                light,
+                "lumens",
+                lumens,
+                "give `lumens` (the luminaire's flux) or `multiplier`, not both",
+            ));
+        }
+        if !(lumens > 0.0 && lumens.is_finite()) {
+            return Err(LightError::parameter(light, "lumens", lumens, "must be finite and > 0"));
+        }
+        Ok(lumens / table_lumens)
+    }
 }
 
 pub(crate) fn default_nadir() -> DVec3 {
@@ -523,8 +547,18 @@ impl TryFrom<LuminaireRepr> for IesLight {
             LightError::File { light: LIGHT, field: "file", message: e.to_string() }
         })?;
         let spd = Luminaire::spectrum(LIGHT, r.spd.clone(), r.cct, None)?;
+        let at_one = Self::new(
+            ies.clone(),
+            r.position,
+            r.nadir,
+            r.c0,
+            spd.clone(),
+            1.0,
+            r.wavelength_sampling,
+        )?;
+        let multiplier = r.multiplier_for(LIGHT, at_one.lumens())?;
         let light =
-            Self::new(ies, r.position, r.nadir, r.c0, spd, r.multiplier, r.wavelength_sampling)?;
+            Self::new(ies, r.position, r.nadir, r.c0, spd, multiplier, r.wavelength_sampling)?;
         Ok(Self { repr: Arc::new(r), ..light })
     }
 }
@@ -620,8 +654,18 @@ impl TryFrom<LuminaireRepr> for EulumdatLight {
         })?;
         let default_cct = ldt.lamp_sets.first().and_then(|l| lamp_cct(&l.colour_temperature));
         let spd = Luminaire::spectrum(LIGHT, r.spd.clone(), r.cct, default_cct)?;
+        let at_one = Self::new(
+            ldt.clone(),
+            r.position,
+            r.nadir,
+            r.c0,
+            spd.clone(),
+            1.0,
+            r.wavelength_sampling,
+        )?;
+        let multiplier = r.multiplier_for(LIGHT, at_one.lumens())?;
         let light =
-            Self::new(ldt, r.position, r.nadir, r.c0, spd, r.multiplier, r.wavelength_sampling)?;
+            Self::new(ldt, r.position, r.nadir, r.c0, spd, multiplier, r.wavelength_sampling)?;
         Ok(Self { repr: Arc::new(r), ..light })
     }
 }
