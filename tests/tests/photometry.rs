@@ -439,3 +439,21 @@ fn sensors_leave_the_image_of_an_interreflecting_scene_bit_for_bit_unchanged() {
     assert!(a.iter().zip(&b).all(|(p, q)| p == q), "the image changed with a sensor");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn sensors_beside_a_camera_integrator_use_light_paths_when_a_point_cannot_sample_a_light() {
+    use spectrace_renderer::{SensorIntegrator, sensor_integrator};
+    let dir = folder("auto");
+    let point = plane_scene(
+        r#"{"type": "PointLight", "position": [0, 1, 0], "power": 1, "spd": {"type": "CieIlluminant", "name": "D65"}}"#,
+        &dir,
+    );
+    assert_eq!(sensor_integrator(&point), SensorIntegrator::Path);
+    let sky = plane_scene(
+        r#"{"type": "Sky", "corner": [-1, 2, -1], "edge_u": [2, 0, 0], "edge_v": [0, 0, 2],
+            "direction": [0, -1, 0], "power": 1, "spd": {"type": "CieIlluminant", "name": "D65"}}"#,
+        &dir,
+    );
+    assert_eq!(sensor_integrator(&sky), SensorIntegrator::Light);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

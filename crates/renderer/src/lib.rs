@@ -830,6 +830,18 @@ fn render_with(
     let Setup { choice, reason, effects, plan, name } = *setup;
     let name = name.to_owned();
     warnings.extend(integrator_warnings(scene, choice));
+    let unreachable =
+        |f: spectrace_tracer::SceneFeatures| f.delta_direction_lights + f.beam_only_lights > 0;
+    if !scene.sensors.is_empty()
+        && scene.settings.sensor_integrator == SensorIntegrator::Path
+        && unreachable(tracer_scene(scene).features(&scene.non_convex))
+    {
+        warnings.push(
+            "settings.sensor_integrator \"path\": lasers, skies and beam-only lights cannot be \
+             sampled from a point, so the sensors miss their light; use \"light\" or \"auto\""
+                .to_owned(),
+        );
+    }
     if !scene.sensors.is_empty() && plan.shard.is_some() {
         warnings.push(
             "sensors are written by unsharded renders only (merge-parts writes the image): \
@@ -924,7 +936,7 @@ fn render_with(
             filled_by: "image beams (light tracer)",
         };
         write_sensors(scene, &options.out_dir, source)?
-    } else if scene.settings.sensor_integrator == SensorIntegrator::Light {
+    } else if sensor_integrator(scene) == SensorIntegrator::Light {
         let (film, beams, seconds) =
             sensor_pass(scene, &sensor_plan(scene, plan.threads), effects)?;
         let source =
@@ -951,6 +963,22 @@ fn render_with(
     report.sensors = sensors;
     write_sidecar(&options.out_dir, &name, &report)?;
     Ok(report)
+}
+
+/// How a camera integrator's render fills the sensors: the setting, with `auto` resolved (the
+/// path tracer when every light can be sampled from a point, else light paths).
+pub fn sensor_integrator(scene: &Scene) -> SensorIntegrator {
+    match scene.settings.sensor_integrator {
+        SensorIntegrator::Auto => {
+            let f = tracer_scene(scene).features(&scene.non_convex);
+            if f.beam_only_lights == 0 && f.delta_direction_lights == 0 {
+                SensorIntegrator::Path
+            } else {
+                SensorIntegrator::Light
+            }
+        }
+        other => other,
+    }
 }
 
 /// What [`write_outputs`] wrote.

@@ -91,10 +91,11 @@ pub struct Settings {
     pub sensor_beams: Option<u64>,
     /// Samples per sensor cell of a path-tracer sensor pass (default 64).
     pub sensor_spp: Option<u64>,
-    /// How sensors are filled when the image is rendered by a camera integrator: `"path"` (the
-    /// default: the path tracer samples points on the sensors, `sensor_spp` per cell) or
-    /// `"light"` (a light-tracer pass of `sensor_beams`). The light tracer always fills them
-    /// with the image's own beams.
+    /// How sensors are filled when the image is rendered by a camera integrator: `"auto"` (the
+    /// default: `"path"` when every light can be sampled from a point, else `"light"`), `"path"`
+    /// (the path tracer samples points on the sensors, `sensor_spp` per cell) or `"light"` (a
+    /// light-tracer pass of `sensor_beams`). The light tracer always fills them with the
+    /// image's own beams.
     pub sensor_integrator: SensorIntegrator,
     /// The estimator: `"auto"` (the effects analysis chooses), `"light"`, `"path"` or `"bdpt"`.
     pub integrator: IntegratorChoice,
@@ -125,7 +126,7 @@ impl Default for Settings {
             chunk_beams: DEFAULT_CHUNK_BEAMS,
             sensor_beams: None,
             sensor_spp: None,
-            sensor_integrator: SensorIntegrator::Path,
+            sensor_integrator: SensorIntegrator::Auto,
             integrator: IntegratorChoice::Auto,
             spp: DEFAULT_SPP,
             camera_wavelengths: CameraWavelengths::Visible,
@@ -139,8 +140,11 @@ impl Default for Settings {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SensorIntegrator {
-    /// The path tracer sampling points on the sensors.
+    /// `Path` when every light can be sampled from a point (no laser, sky or beam-only light),
+    /// else `Light`.
     #[default]
+    Auto,
+    /// The path tracer sampling points on the sensors.
     Path,
     /// A light-tracer pass.
     Light,
