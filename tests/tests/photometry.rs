@@ -157,6 +157,28 @@ fn asymmetric_ies() -> (Vec<f64>, Vec<f64>, Vec<Vec<f64>>, String) {
     (vertical, horizontal, candela, text)
 }
 
+/// The intensity (cd) of a type C table towards a unit direction `d`, interpolated as documented
+/// (linear in C and in cos gamma), for the default orientation: nadir -y, C 0 along +x, C 90
+/// along c0 x nadir = -z. Written here from the definition, independently of the light.
+fn table_intensity<'a>(
+    vertical: &[f64],
+    horizontal: &[f64],
+    candela: &'a [Vec<f64>],
+) -> impl Fn([f64; 3]) -> f64 + 'a {
+    let h: Vec<f64> = horizontal.iter().map(|c| c.to_radians()).collect();
+    let v: Vec<f64> = vertical.iter().map(|g| g.to_radians().cos()).collect();
+    move |d: [f64; 3]| {
+        let mu = -d[1];
+        let c = (-d[2]).atan2(d[0]).rem_euclid(2.0 * PI);
+        let a = (h.partition_point(|&x| x <= c).max(1) - 1).min(h.len() - 2);
+        let t = (c - h[a]) / (h[a + 1] - h[a]);
+        let b = (v.partition_point(|&x| x >= mu).max(1) - 1).min(v.len() - 2);
+        let s = (mu - v[b]) / (v[b + 1] - v[b]);
+        let row = |k: usize| candela[k][b] * (1.0 - s) + candela[k][b + 1] * s;
+        row(a) * (1.0 - t) + row(a + 1) * t
+    }
+}
+
 #[test]
 fn an_asymmetric_ies_luminaire_over_a_sensor_gives_its_candela_table() {
     let dir = folder("ies");
@@ -168,18 +190,7 @@ fn an_asymmetric_ies_luminaire_over_a_sensor_gives_its_candela_table() {
     );
     // The table, interpolated as documented (linear in C and in cos gamma), in the default
     // orientation: nadir -y, C 0 along +x, C 90 along c0 x nadir = -z.
-    let h: Vec<f64> = horizontal.iter().map(|c| c.to_radians()).collect();
-    let v: Vec<f64> = vertical.iter().map(|g| g.to_radians().cos()).collect();
-    let intensity = |d: [f64; 3]| {
-        let mu = -d[1];
-        let c = (-d[2]).atan2(d[0]).rem_euclid(2.0 * PI);
-        let a = (h.partition_point(|&x| x <= c).max(1) - 1).min(h.len() - 2);
-        let t = (c - h[a]) / (h[a + 1] - h[a]);
-        let b = (v.partition_point(|&x| x >= mu).max(1) - 1).min(v.len() - 2);
-        let s = (mu - v[b]) / (v[b + 1] - v[b]);
-        let row = |k: usize| candela[k][b] * (1.0 - s) + candela[k][b + 1] * s;
-        row(a) * (1.0 - t) + row(a + 1) * t
-    };
+    let intensity = table_intensity(&vertical, &horizontal, &candela);
     let want = expected([-0.2, 1.5, 0.1], &intensity);
     let (got, errors, average_error) = measure(&scene, 3_000_000, 2);
     assert_cells_agree("IES luminaire", &got, &errors, &want, average_error);
@@ -364,18 +375,7 @@ fn the_path_tracer_sampling_points_on_a_sensor_gives_the_same_closed_forms() {
         r#"{"type": "IesLight", "file": "asym.ies", "position": [-0.2, 1.5, 0.1], "cct": 4000}"#,
         &dir,
     );
-    let h: Vec<f64> = horizontal.iter().map(|c| c.to_radians()).collect();
-    let v: Vec<f64> = vertical.iter().map(|g| g.to_radians().cos()).collect();
-    let intensity = |d: [f64; 3]| {
-        let mu = -d[1];
-        let c = (-d[2]).atan2(d[0]).rem_euclid(2.0 * PI);
-        let a = (h.partition_point(|&x| x <= c).max(1) - 1).min(h.len() - 2);
-        let t = (c - h[a]) / (h[a + 1] - h[a]);
-        let b = (v.partition_point(|&x| x >= mu).max(1) - 1).min(v.len() - 2);
-        let s = (mu - v[b]) / (v[b + 1] - v[b]);
-        let row = |k: usize| candela[k][b] * (1.0 - s) + candela[k][b + 1] * s;
-        row(a) * (1.0 - t) + row(a + 1) * t
-    };
+    let intensity = table_intensity(&vertical, &horizontal, &candela);
     let want = expected([-0.2, 1.5, 0.1], &intensity);
     let (got, errors, average_error) = measure_path(&scene, 4000);
     assert_cells_agree("path, IES luminaire", &got, &errors, &want, average_error);

@@ -488,6 +488,21 @@ pub(crate) struct LuminaireRepr {
 }
 
 impl LuminaireRepr {
+    /// Builds a light with `make(multiplier)`: with `lumens`, first at multiplier 1 to learn the
+    /// table's flux (`flux` of the light), then scaled to the flux asked for.
+    fn scaled<L>(
+        &self,
+        light: &'static str,
+        make: impl Fn(f64) -> Result<L, LightError>,
+        flux: impl Fn(&L) -> f64,
+    ) -> Result<L, LightError> {
+        if self.lumens.is_none() {
+            return make(self.multiplier);
+        }
+        let at_one = make(1.0)?;
+        make(self.multiplier_for(light, flux(&at_one))?)
+    }
+
     /// The multiplier that gives the luminaire `lumens` when the table at multiplier 1 gives
     /// `table_lumens`; `self.multiplier` without `lumens`.
     fn multiplier_for(&self, light: &'static str, table_lumens: f64) -> Result<f64, LightError> {
@@ -547,18 +562,21 @@ impl TryFrom<LuminaireRepr> for IesLight {
             LightError::File { light: LIGHT, field: "file", message: e.to_string() }
         })?;
         let spd = Luminaire::spectrum(LIGHT, r.spd.clone(), r.cct, None)?;
-        let at_one = Self::new(
-            ies.clone(),
-            r.position,
-            r.nadir,
-            r.c0,
-            spd.clone(),
-            1.0,
-            r.wavelength_sampling,
+        let light = r.scaled(
+            LIGHT,
+            |m| {
+                Self::new(
+                    ies.clone(),
+                    r.position,
+                    r.nadir,
+                    r.c0,
+                    spd.clone(),
+                    m,
+                    r.wavelength_sampling,
+                )
+            },
+            Self::lumens,
         )?;
-        let multiplier = r.multiplier_for(LIGHT, at_one.lumens())?;
-        let light =
-            Self::new(ies, r.position, r.nadir, r.c0, spd, multiplier, r.wavelength_sampling)?;
         Ok(Self { repr: Arc::new(r), ..light })
     }
 }
@@ -654,18 +672,21 @@ impl TryFrom<LuminaireRepr> for EulumdatLight {
         })?;
         let default_cct = ldt.lamp_sets.first().and_then(|l| lamp_cct(&l.colour_temperature));
         let spd = Luminaire::spectrum(LIGHT, r.spd.clone(), r.cct, default_cct)?;
-        let at_one = Self::new(
-            ldt.clone(),
-            r.position,
-            r.nadir,
-            r.c0,
-            spd.clone(),
-            1.0,
-            r.wavelength_sampling,
+        let light = r.scaled(
+            LIGHT,
+            |m| {
+                Self::new(
+                    ldt.clone(),
+                    r.position,
+                    r.nadir,
+                    r.c0,
+                    spd.clone(),
+                    m,
+                    r.wavelength_sampling,
+                )
+            },
+            Self::lumens,
         )?;
-        let multiplier = r.multiplier_for(LIGHT, at_one.lumens())?;
-        let light =
-            Self::new(ldt, r.position, r.nadir, r.c0, spd, multiplier, r.wavelength_sampling)?;
         Ok(Self { repr: Arc::new(r), ..light })
     }
 }
