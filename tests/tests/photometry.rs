@@ -457,3 +457,24 @@ fn sensors_beside_a_camera_integrator_use_light_paths_when_a_point_cannot_sample
     assert_eq!(sensor_integrator(&sky), SensorIntegrator::Light);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn the_three_estimators_agree_on_a_floor_under_an_asymmetric_luminaire() {
+    // Next-event estimation (path), emission densities (BDPT) and beams (light) of one IES
+    // luminaire, tilted, over a coloured floor.
+    let dir = folder("agree");
+    let (.., text) = asymmetric_ies();
+    std::fs::write(dir.join("asym.ies"), text).unwrap();
+    let json = r#"{
+  "camera": {"position": [0, 2.5, 2.5], "look_at": [0, 0, 0], "fov": 50, "width": 32, "height": 32},
+  "objects": [{"shape": {"type": "Rectangle", "corner": [-3, 0, 3], "edge_u": [6, 0, 0], "edge_v": [0, 0, -6]},
+               "material": {"type": "Diffuse", "reflectance": {"nm": [400, 700], "values": [0.2, 0.8]}}}],
+  "lights": [{"type": "IesLight", "file": "asym.ies", "position": [0.2, 1.4, 0],
+              "nadir": [0.2, -1, 0.1], "c0": [1, 0, 0], "cct": 3500}]
+}"#;
+    let scene = Scene::from_json(json, &dir.join("agree.json")).unwrap();
+    let light = (IntegratorChoice::Light, 200_000);
+    crate::integrators::assert_agree(&scene, light, (IntegratorChoice::Path, 32 * 32 * 8), 8);
+    crate::integrators::assert_agree(&scene, light, (IntegratorChoice::Bdpt, 32 * 32 * 4), 8);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
