@@ -309,7 +309,8 @@ fn status() -> ExitCode {
          Run the benchmarks:         cargo xtask bench\n\n\
          Estimators: light tracer, path tracer, BDPT (--integrator auto|light|path|bdpt; auto by default).\n\
          Materials: diffuse, mirror, glass, conductors (measured metals), rough glass, plastic, fluorescent.\n\
-         Not built yet: measured luminaires (IES, EULUMDAT), illuminance sensors."
+         Lighting design: IES and EULUMDAT luminaires, lumens and candela, illuminance sensors\n\
+         (scenes/office.json writes workplane.csv/.exr/.png; scenes/README.md, \"sensors\")."
     );
     ExitCode::SUCCESS
 }
