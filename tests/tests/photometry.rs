@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use spectrace_lights::LightSource;
 use spectrace_renderer::{RenderOptions, Scene, render_in_memory, sensor_grid};
 use spectrace_spectrum::{CieIlluminant, luminous_efficacy};
-use spectrace_tracer::IntegratorChoice;
+use spectrace_tracer::{Film, IntegratorChoice};
 
 /// A folder of its own for a test's files.
 fn folder(name: &str) -> PathBuf {
@@ -30,18 +30,15 @@ fn measure(scene: &Scene, beams: u64, seed: u64) -> (Vec<f64>, Vec<f64>, f64) {
         ..RenderOptions::default()
     };
     let out = render_in_memory(scene, &options).unwrap();
-    let sums = out.output.film.sensor_sums(1.0);
-    let (grid, average_error, _) =
-        sensor_grid(&scene.sensors, 0, &sums, scene.lights.power(), out.output.beams);
-    // Per-cell standard error from the same sums.
-    let sensor = &scene.sensors.sensors()[0];
-    let per_beam = scene.lights.power() / out.output.beams as f64;
-    let n = out.output.beams as f64;
-    let errors = sums[..sensor.cell_count() as usize]
-        .iter()
-        .map(|c| (c[2] - c[1] * c[1] / n).max(0.0).sqrt() * per_beam / sensor.cell_area())
-        .collect();
-    (grid.illuminance, errors, average_error.unwrap())
+    illuminance_of(scene, &out.output.film, out.output.beams)
+}
+
+/// Sensor 0's illuminance per cell, its standard errors and the relative error of its average,
+/// from a film filled with `n` independent samples.
+fn illuminance_of(scene: &Scene, film: &Film, n: u64) -> (Vec<f64>, Vec<f64>, f64) {
+    let sums = film.sensor_sums(1.0);
+    let e = sensor_grid(&scene.sensors, 0, &sums, scene.lights.power(), n);
+    (e.grid.illuminance, e.illuminance_errors, e.average_relative_error.unwrap())
 }
 
 /// A scene with a black floor below a 2 m x 2 m sensor of 8 x 8 cells at y = 0 facing up,
@@ -182,16 +179,9 @@ fn table_intensity<'a>(
 #[test]
 fn an_asymmetric_ies_luminaire_over_a_sensor_gives_its_candela_table() {
     let dir = folder("ies");
-    let (vertical, horizontal, candela, text) = asymmetric_ies();
-    std::fs::write(dir.join("asym.ies"), text).unwrap();
-    let scene = plane_scene(
-        r#"{"type": "IesLight", "file": "asym.ies", "position": [-0.2, 1.5, 0.1], "cct": 4000}"#,
-        &dir,
-    );
     // The table, interpolated as documented (linear in C and in cos gamma), in the default
     // orientation: nadir -y, C 0 along +x, C 90 along c0 x nadir = -z.
-    let intensity = table_intensity(&vertical, &horizontal, &candela);
-    let want = expected([-0.2, 1.5, 0.1], &intensity);
+    let (scene, want) = ies_over_plane(&dir);
     let (got, errors, average_error) = measure(&scene, 3_000_000, 2);
     assert_cells_agree("IES luminaire", &got, &errors, &want, average_error);
     // The asymmetry is visible: the -z half (towards C 90) is brighter than the +z half.
@@ -202,14 +192,12 @@ fn an_asymmetric_ies_luminaire_over_a_sensor_gives_its_candela_table() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-#[test]
-fn a_sensor_in_a_closed_white_sphere_reads_the_integrating_sphere_formula() {
-    let dir = folder("sphere");
-    // A point light at the centre of a sphere of radius 1 and reflectance 0.8; the sensor
-    // faces away from the light, so it reads only the walls: E = rho Phi / (A (1 - rho)).
+/// A point light at the centre of a sphere of radius 1 and reflectance 0.8, and a sensor
+/// inside that faces away from the light, so it reads only the walls; and what it must read,
+/// `E = rho Phi / (A (1 - rho))`.
+fn integrating_sphere(dir: &Path) -> (Scene, f64) {
     let json = r#"{
-  "camera": {"position": [0, 0, 0.5], "look_at": [0, 0, -1], "fov": 40,
-             "width": 4, "height": 4},
+  "camera": {"position": [0, 0, 0.5], "look_at": [0, 0, -1], "fov": 40, "width": 4, "height": 4},
   "objects": [{"shape": {"type": "Sphere", "center": [0, 0, 0], "radius": 1},
                "material": {"type": "Diffuse", "reflectance": 0.8}}],
   "lights": [{"type": "PointLight", "position": [0, 0, 0], "power": 10,
@@ -219,19 +207,42 @@ fn a_sensor_in_a_closed_white_sphere_reads_the_integrating_sphere_formula() {
                "edge_u": [0.2, 0, 0], "edge_v": [0, 0, 0.2], "cells": [2, 2]}]
 }"#;
     let scene = Scene::from_json(json, &dir.join("sphere.json")).unwrap_or_else(|e| panic!("{e}"));
-    let d65 = CieIlluminant::new("D65").unwrap();
-    let lumens = 10.0 * luminous_efficacy(&d65);
-    let want = 0.8 * lumens / (4.0 * PI * (1.0 - 0.8));
-    let (got, errors, average_error) = measure(&scene, 600_000, 3);
+    let lumens = 10.0 * luminous_efficacy(&CieIlluminant::new("D65").unwrap());
+    (scene, 0.8 * lumens / (4.0 * PI * (1.0 - 0.8)))
+}
+
+/// The sphere's sensor: its average within 4 standard errors of `want`, known to 1%, and every
+/// cell within 5 of its own.
+fn assert_sphere(got: &[f64], errors: &[f64], average_error: f64, want: f64) {
     let mean = got.iter().sum::<f64>() / got.len() as f64;
     assert!(
         (mean - want).abs() < 4.0 * average_error * mean,
         "{mean} vs {want} (relative se {average_error})"
     );
     assert!(average_error < 0.01, "the check is sharp to 1%: {average_error}");
-    for (g, e) in got.iter().zip(&errors) {
+    for (g, e) in got.iter().zip(errors) {
         assert!((g - want).abs() < 5.0 * e, "{g} vs {want}");
     }
+}
+
+/// The asymmetric IES luminaire over the plane sensor, and each cell's expected illuminance.
+fn ies_over_plane(dir: &Path) -> (Scene, Vec<f64>) {
+    let (vertical, horizontal, candela, text) = asymmetric_ies();
+    std::fs::write(dir.join("asym.ies"), text).unwrap();
+    let scene = plane_scene(
+        r#"{"type": "IesLight", "file": "asym.ies", "position": [-0.2, 1.5, 0.1], "cct": 4000}"#,
+        dir,
+    );
+    let intensity = table_intensity(&vertical, &horizontal, &candela);
+    (scene, expected([-0.2, 1.5, 0.1], &intensity))
+}
+
+#[test]
+fn a_sensor_in_a_closed_white_sphere_reads_the_integrating_sphere_formula() {
+    let dir = folder("sphere");
+    let (scene, want) = integrating_sphere(&dir);
+    let (got, errors, average_error) = measure(&scene, 600_000, 3);
+    assert_sphere(&got, &errors, average_error, want);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -353,15 +364,7 @@ fn measure_path(scene: &Scene, passes: u64) -> (Vec<f64>, Vec<f64>, f64) {
     use spectrace_renderer::{decide_effects, sensor_pass_path};
     let (film, n, _) = sensor_pass_path(scene, passes, 2, decide_effects(scene, None)).unwrap();
     assert_eq!(n, passes);
-    let sums = film.sensor_sums(1.0);
-    let (grid, average_error, _) = sensor_grid(&scene.sensors, 0, &sums, scene.lights.power(), n);
-    let sensor = &scene.sensors.sensors()[0];
-    let per = scene.lights.power() / n as f64;
-    let errors = sums[..sensor.cell_count() as usize]
-        .iter()
-        .map(|c| (c[2] - c[1] * c[1] / n as f64).max(0.0).sqrt() * per / sensor.cell_area())
-        .collect();
-    (grid.illuminance, errors, average_error.unwrap())
+    illuminance_of(scene, &film, n)
 }
 
 #[test]
@@ -369,37 +372,13 @@ fn the_path_tracer_sampling_points_on_a_sensor_gives_the_same_closed_forms() {
     let dir = folder("path-sensor");
     // The asymmetric IES luminaire over the plane (its direct light is exact, so the noise is
     // that of the wavelengths and of the black floor's zero indirect light).
-    let (vertical, horizontal, candela, text) = asymmetric_ies();
-    std::fs::write(dir.join("asym.ies"), text).unwrap();
-    let scene = plane_scene(
-        r#"{"type": "IesLight", "file": "asym.ies", "position": [-0.2, 1.5, 0.1], "cct": 4000}"#,
-        &dir,
-    );
-    let intensity = table_intensity(&vertical, &horizontal, &candela);
-    let want = expected([-0.2, 1.5, 0.1], &intensity);
+    let (scene, want) = ies_over_plane(&dir);
     let (got, errors, average_error) = measure_path(&scene, 4000);
     assert_cells_agree("path, IES luminaire", &got, &errors, &want, average_error);
     // The integrating sphere: all of it is interreflected light, found by the cosine rays.
-    let json = r#"{
-  "camera": {"position": [0, 0, 0.5], "look_at": [0, 0, -1], "fov": 40, "width": 4, "height": 4},
-  "objects": [{"shape": {"type": "Sphere", "center": [0, 0, 0], "radius": 1},
-               "material": {"type": "Diffuse", "reflectance": 0.8}}],
-  "lights": [{"type": "PointLight", "position": [0, 0, 0], "power": 10,
-              "spd": {"type": "CieIlluminant", "name": "D65"}}],
-  "settings": {"max_depth": 200, "rr_depth": 50},
-  "sensors": [{"type": "IrradianceSensor", "name": "inside", "corner": [-0.1, -0.5, -0.1],
-               "edge_u": [0.2, 0, 0], "edge_v": [0, 0, 0.2], "cells": [2, 2]}]
-}"#;
-    let scene = Scene::from_json(json, &dir.join("sphere.json")).unwrap();
-    let lumens = 10.0 * luminous_efficacy(&CieIlluminant::new("D65").unwrap());
-    let want = 0.8 * lumens / (4.0 * PI * (1.0 - 0.8));
-    let (got, _, average_error) = measure_path(&scene, 20_000);
-    let mean = got.iter().sum::<f64>() / got.len() as f64;
-    assert!(
-        (mean - want).abs() < 4.0 * average_error * mean,
-        "{mean} vs {want} (relative se {average_error})"
-    );
-    assert!(average_error < 0.01, "the check is sharp to 1%: {average_error}");
+    let (scene, want) = integrating_sphere(&dir);
+    let (got, errors, average_error) = measure_path(&scene, 20_000);
+    assert_sphere(&got, &errors, average_error, want);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

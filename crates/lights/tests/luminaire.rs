@@ -365,6 +365,13 @@ fn scene_file_errors_name_the_file_the_line_and_the_field() {
     )
     .unwrap_err();
     assert!(e.contains("either"), "{e}");
+    for bad in ["-5", "0"] {
+        let json = format!(
+            r#"{{"type": "IesLight", "file": "lum.ies", "position": [0, 1, 0], "cct": {bad}}}"#
+        );
+        let e = load(&dir, &json).unwrap_err();
+        assert!(e.contains("IesLight.cct"), "{bad}: {e}");
+    }
     // Without `spd` or `cct`: CIE illuminant A.
     let a =
         load(&dir, r#"{"type": "IesLight", "file": "lum.ies", "position": [0, 1, 0]}"#).unwrap();

@@ -54,8 +54,8 @@ pub use sensor_output::{
     MAX_SENSOR_CELLS, SensorGrid, SensorSummary, sensor_colour, write_sensor_files,
 };
 pub use sensors::{
-    SensorReport, SensorSource, check_sensor_names, planned_sensor_outputs, sensor_grid,
-    sensor_pass, sensor_pass_path, sensor_plan, sensor_summary, write_sensors,
+    SensorEstimate, SensorReport, SensorSource, check_sensor_names, planned_sensor_outputs,
+    sensor_grid, sensor_pass, sensor_pass_path, sensor_plan, sensor_summary, write_sensors,
 };
 
 /// Command-line overrides of a scene's settings.

@@ -155,42 +155,54 @@ pub fn sensor_plan(scene: &Scene, threads: usize) -> RenderPlan {
     }
 }
 
-/// A sensor's grid and its estimated errors from the film's sums, given the beams traced and
-/// the light power: each cell's `radiant x P / N / area` and `luminous x P / N / area`.
+/// A sensor's values and how well they are known.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SensorEstimate {
+    /// Irradiance and illuminance per cell.
+    pub grid: SensorGrid,
+    /// One-sigma standard error of each cell's illuminance (lux), same indexing.
+    pub illuminance_errors: Vec<f64>,
+    /// Relative standard error of the average illuminance; `None` when no light arrived.
+    pub average_relative_error: Option<f64>,
+    /// Median over the lit cells of each cell's relative standard error.
+    pub median_cell_relative_error: Option<f64>,
+}
+
+/// Sensor `index`'s grid and errors from the film's sums, given `n` independent samples (light
+/// paths, or passes over the cells) and the light power: each cell's `radiant x P / n / area`
+/// and `luminous x P / n / area`, and the variance of a sum of `n` independent samples,
+/// `sum x^2 - (sum x)^2 / n`.
 pub fn sensor_grid(
     set: &SensorSet,
     index: usize,
     sums: &[SensorSums],
     light_power: f64,
-    beams: u64,
-) -> (SensorGrid, Option<f64>, Option<f64>) {
+    n: u64,
+) -> SensorEstimate {
     let sensor = &set.sensors()[index];
     let offset = set.offset(index) as usize;
-    let n = sensor.cell_count() as usize;
-    let cells = &sums[offset..offset + n];
-    let per_beam = if beams > 0 { light_power / beams as f64 } else { 0.0 };
-    let area = sensor.cell_area();
-    let irradiance: Vec<f64> = cells.iter().map(|c| c[0] * per_beam / area).collect();
-    let illuminance: Vec<f64> = cells.iter().map(|c| c[1] * per_beam / area).collect();
-    // Variance of a sum of N independent beams' contributions: sum x^2 - (sum x)^2 / N.
-    let variance = |sum: f64, squares: f64| (squares - sum * sum / beams.max(1) as f64).max(0.0);
+    let cells = &sums[offset..offset + sensor.cell_count() as usize];
+    let scale = if n > 0 { light_power / n as f64 / sensor.cell_area() } else { 0.0 };
+    let variance = |sum: f64, squares: f64| (squares - sum * sum / n.max(1) as f64).max(0.0);
     let total: f64 = cells.iter().map(|c| c[1]).sum();
     let total_variance: f64 = cells.iter().map(|c| variance(c[1], c[2])).sum();
-    let average_error = (total > 0.0).then(|| total_variance.sqrt() / total);
-    let mut cell_errors: Vec<f64> =
+    let mut relative: Vec<f64> =
         cells.iter().filter(|c| c[1] > 0.0).map(|c| variance(c[1], c[2]).sqrt() / c[1]).collect();
-    cell_errors.sort_by(f64::total_cmp);
-    let median = (!cell_errors.is_empty()).then(|| cell_errors[cell_errors.len() / 2]);
-    let grid = SensorGrid {
-        name: sensor.name().to_owned(),
-        corner: sensor.corner(),
-        edge_u: sensor.edge_u(),
-        edge_v: sensor.edge_v(),
-        cells: sensor.cells(),
-        irradiance,
-        illuminance,
-    };
-    (grid, average_error, median)
+    relative.sort_by(f64::total_cmp);
+    SensorEstimate {
+        grid: SensorGrid {
+            name: sensor.name().to_owned(),
+            corner: sensor.corner(),
+            edge_u: sensor.edge_u(),
+            edge_v: sensor.edge_v(),
+            cells: sensor.cells(),
+            irradiance: cells.iter().map(|c| c[0] * scale).collect(),
+            illuminance: cells.iter().map(|c| c[1] * scale).collect(),
+        },
+        illuminance_errors: cells.iter().map(|c| variance(c[1], c[2]).sqrt() * scale).collect(),
+        average_relative_error: (total > 0.0).then(|| total_variance.sqrt() / total),
+        median_cell_relative_error: relative.get(relative.len() / 2).copied(),
+    }
 }
 
 /// How a sensor was filled, for [`write_sensors`].
@@ -218,8 +230,12 @@ pub fn write_sensors(
     let sums = source.film.sensor_sums(1.0);
     let mut reports = Vec::new();
     for index in 0..scene.sensors.sensors().len() {
-        let (grid, average_error, median) =
-            sensor_grid(&scene.sensors, index, &sums, scene.lights.power(), source.beams);
+        let SensorEstimate {
+            grid,
+            average_relative_error: average_error,
+            median_cell_relative_error: median,
+            ..
+        } = sensor_grid(&scene.sensors, index, &sums, scene.lights.power(), source.beams);
         let files = write_sensor_files(dir, &grid, &scene.inputs).map_err(|message| {
             RenderError::File { path: dir.join(format!("{}.*", grid.name)), message }
         })?;

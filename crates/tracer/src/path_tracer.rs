@@ -562,6 +562,8 @@ impl Integrator for PathTracer<'_> {
 pub struct SensorPathTracer<'a> {
     tracer: PathTracer<'a>,
     sensors: &'a crate::SensorSet,
+    /// The lights' spectrum, which the wavelengths are drawn from.
+    spectrum: std::sync::Arc<dyn spectrace_spectrum::SpectralPowerDistribution>,
 }
 
 impl<'a> SensorPathTracer<'a> {
@@ -570,7 +572,8 @@ impl<'a> SensorPathTracer<'a> {
 
     /// The path tracer `tracer`, estimating `sensors`.
     pub fn new(tracer: PathTracer<'a>, sensors: &'a crate::SensorSet) -> Self {
-        Self { tracer, sensors }
+        let spectrum = LightSource::spd(tracer.scene.lights);
+        Self { tracer, sensors, spectrum }
     }
 
     /// One sample of the cell `cell` (numbered over all sensors): `[radiant, luminous]`
@@ -591,13 +594,13 @@ impl<'a> SensorPathTracer<'a> {
             + sensor.edge_v() * ((f64::from(iv) + b) / f64::from(nv));
         let n = sensor.front();
         // Wavelengths from the lights' spectrum, stratified.
-        let spectrum = LightSource::spd(scene.lights);
         let u = uniform(rng);
         let mut lambdas = [0.0; HERO];
         let mut weights = [0.0; HERO];
         for j in 0..HERO {
-            let lambda = spectrum.sample_lambda(((j as f64 + u) / HERO as f64).min(0.999_999_999));
-            let q = spectrum.value(lambda);
+            let stratum = ((j as f64 + u) / HERO as f64).min(spectrace_sampling::ONE_MINUS_EPSILON);
+            let lambda = self.spectrum.sample_lambda(stratum);
+            let q = self.spectrum.value(lambda);
             lambdas[j] = lambda;
             weights[j] = if q > 0.0 { 1.0 / (HERO as f64 * q) } else { 0.0 };
         }

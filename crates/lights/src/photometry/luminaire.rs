@@ -295,18 +295,40 @@ impl Luminaire {
     }
 
     /// A luminaire of the stored table `planes.0` with every value times `planes.1` (a file's
-    /// own factor) and `multiplier`, placed at `(position, nadir, c0)`, and its scene-file form.
+    /// own factor), scaled by `scale`, placed at `(position, nadir, c0)`, and its scene-file
+    /// form.
     pub(crate) fn placed(
         light: &'static str,
         planes: (&CandelaPlanes, f64),
         (position, nadir, c0): (DVec3, DVec3, DVec3),
         spd: Arc<dyn SpectralPowerDistribution>,
-        multiplier: f64,
+        scale: Scale,
         sampling: WavelengthSampling,
     ) -> Result<(Self, LuminaireRepr), LightError> {
-        let multiplier = check_multiplier(light, multiplier)?;
+        let multiplier = check_multiplier(light, scale.multiplier)?;
         let orientation = Orientation::new(light, nadir, c0)?;
-        let distribution = distribution_of(light, planes.0, multiplier * planes.1)?;
+        let mut distribution = distribution_of(light, planes.0, multiplier * planes.1)?;
+        if let Some(lumens) = scale.lumens {
+            if multiplier != 1.0 {
+                return Err(LightError::parameter(
+                    light,
+                    "lumens",
+                    lumens,
+                    "give `lumens` (the luminaire's flux) or `multiplier`, not both",
+                ));
+            }
+            if !(lumens > 0.0 && lumens.is_finite()) {
+                return Err(LightError::parameter(
+                    light,
+                    "lumens",
+                    lumens,
+                    "must be finite and > 0",
+                ));
+            }
+            // Flux is linear in the table: rescale the one at factor `planes.1`.
+            let factor = planes.1 * lumens / distribution.lumens();
+            distribution = distribution_of(light, planes.0, factor)?;
+        }
         let luminaire =
             Self::new(light, position, orientation, distribution, spd.clone(), sampling)?;
         let repr = LuminaireRepr {
@@ -317,7 +339,7 @@ impl Luminaire {
             spd: Some(spd),
             cct: None,
             multiplier,
-            lumens: None,
+            lumens: scale.lumens,
             wavelength_sampling: sampling,
         };
         Ok((luminaire, repr))
@@ -336,6 +358,12 @@ impl Luminaire {
                 Err(LightError::parameter(light, "cct", k, "give either `spd` or `cct`, not both"))
             }
             (Some(spd), None) => Ok(spd),
+            (None, Some(k)) if !(k > 0.0 && k.is_finite()) => Err(LightError::parameter(
+                light,
+                "cct",
+                k,
+                "must be a positive, finite colour temperature in kelvin",
+            )),
             (None, Some(k)) => Blackbody::new(k)
                 .map(|b| Arc::new(b) as Arc<dyn SpectralPowerDistribution>)
                 .map_err(|source| LightError::Spectrum { light, source }),
@@ -488,37 +516,23 @@ pub(crate) struct LuminaireRepr {
 }
 
 impl LuminaireRepr {
-    /// Builds a light with `make(multiplier)`: with `lumens`, first at multiplier 1 to learn the
-    /// table's flux (`flux` of the light), then scaled to the flux asked for.
-    fn scaled<L>(
-        &self,
-        light: &'static str,
-        make: impl Fn(f64) -> Result<L, LightError>,
-        flux: impl Fn(&L) -> f64,
-    ) -> Result<L, LightError> {
-        if self.lumens.is_none() {
-            return make(self.multiplier);
-        }
-        let at_one = make(1.0)?;
-        make(self.multiplier_for(light, flux(&at_one))?)
+    /// The scene file's `multiplier` and `lumens`.
+    fn scale(&self) -> Scale {
+        Scale { multiplier: self.multiplier, lumens: self.lumens }
     }
+}
 
-    /// The multiplier that gives the luminaire `lumens` when the table at multiplier 1 gives
-    /// `table_lumens`; `self.multiplier` without `lumens`.
-    fn multiplier_for(&self, light: &'static str, table_lumens: f64) -> Result<f64, LightError> {
-        let Some(lumens) = self.lumens else { return Ok(self.multiplier) };
-        if self.multiplier != 1.0 {
-            return Err(LightError::parameter(
-                light,
-                "lumens",
-                lumens,
-                "give `lumens` (the luminaire's flux) or `multiplier`, not both",
-            ));
-        }
-        if !(lumens > 0.0 && lumens.is_finite()) {
-            return Err(LightError::parameter(light, "lumens", lumens, "must be finite and > 0"));
-        }
-        Ok(lumens / table_lumens)
+/// How a luminaire's table is scaled: by `multiplier`, or (with `lumens`) to that flux.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Scale {
+    multiplier: f64,
+    lumens: Option<f64>,
+}
+
+impl Scale {
+    /// Scaled by `multiplier` alone.
+    fn by(multiplier: f64) -> Self {
+        Self { multiplier, lumens: None }
     }
 }
 
@@ -562,21 +576,8 @@ impl TryFrom<LuminaireRepr> for IesLight {
             LightError::File { light: LIGHT, field: "file", message: e.to_string() }
         })?;
         let spd = Luminaire::spectrum(LIGHT, r.spd.clone(), r.cct, None)?;
-        let light = r.scaled(
-            LIGHT,
-            |m| {
-                Self::new(
-                    ies.clone(),
-                    r.position,
-                    r.nadir,
-                    r.c0,
-                    spd.clone(),
-                    m,
-                    r.wavelength_sampling,
-                )
-            },
-            Self::lumens,
-        )?;
+        let light =
+            Self::build(ies, (r.position, r.nadir, r.c0), spd, r.scale(), r.wavelength_sampling)?;
         Ok(Self { repr: Arc::new(r), ..light })
     }
 }
@@ -604,13 +605,23 @@ impl IesLight {
         multiplier: f64,
         sampling: WavelengthSampling,
     ) -> Result<Self, LightError> {
+        Self::build(ies, (position, nadir, c0), spd, Scale::by(multiplier), sampling)
+    }
+
+    fn build(
+        ies: IesFile,
+        placement: (DVec3, DVec3, DVec3),
+        spd: Arc<dyn SpectralPowerDistribution>,
+        scale: Scale,
+        sampling: WavelengthSampling,
+    ) -> Result<Self, LightError> {
         let planes = ies.candela_planes();
         let (luminaire, repr) = Luminaire::placed(
             "IesLight",
             (&planes, ies.ballast_factor),
-            (position, nadir, c0),
+            placement,
             spd,
-            multiplier,
+            scale,
             sampling,
         )?;
         Ok(Self { luminaire, repr: Arc::new(repr), file: Arc::new(ies) })
@@ -672,21 +683,8 @@ impl TryFrom<LuminaireRepr> for EulumdatLight {
         })?;
         let default_cct = ldt.lamp_sets.first().and_then(|l| lamp_cct(&l.colour_temperature));
         let spd = Luminaire::spectrum(LIGHT, r.spd.clone(), r.cct, default_cct)?;
-        let light = r.scaled(
-            LIGHT,
-            |m| {
-                Self::new(
-                    ldt.clone(),
-                    r.position,
-                    r.nadir,
-                    r.c0,
-                    spd.clone(),
-                    m,
-                    r.wavelength_sampling,
-                )
-            },
-            Self::lumens,
-        )?;
+        let light =
+            Self::build(ldt, (r.position, r.nadir, r.c0), spd, r.scale(), r.wavelength_sampling)?;
         Ok(Self { repr: Arc::new(r), ..light })
     }
 }
@@ -712,15 +710,19 @@ impl EulumdatLight {
         multiplier: f64,
         sampling: WavelengthSampling,
     ) -> Result<Self, LightError> {
+        Self::build(ldt, (position, nadir, c0), spd, Scale::by(multiplier), sampling)
+    }
+
+    fn build(
+        ldt: LdtFile,
+        placement: (DVec3, DVec3, DVec3),
+        spd: Arc<dyn SpectralPowerDistribution>,
+        scale: Scale,
+        sampling: WavelengthSampling,
+    ) -> Result<Self, LightError> {
         let planes = ldt.candela_planes();
-        let (luminaire, repr) = Luminaire::placed(
-            "EulumdatLight",
-            (&planes, 1.0),
-            (position, nadir, c0),
-            spd,
-            multiplier,
-            sampling,
-        )?;
+        let (luminaire, repr) =
+            Luminaire::placed("EulumdatLight", (&planes, 1.0), placement, spd, scale, sampling)?;
         Ok(Self { luminaire, repr: Arc::new(repr), file: Arc::new(ldt) })
     }
 
