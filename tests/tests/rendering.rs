@@ -289,7 +289,8 @@ fn the_light_tracer_integrator_is_trace_chunk_normalised_by_power_over_beams() {
         3000,
         &mut direct,
     );
-    let b = tracer.render_chunk(5, 2, 3000, None, &mut through);
+    let work = spectrace_tracer::ChunkWork { seed: 5, chunk: 2, items: 3000, deadline: None };
+    let b = tracer.render_chunk(work, &mut through);
     assert!(direct.accepted() > 100, "{}", direct.accepted());
     assert_eq!((a, &direct), (b, &through));
     assert_eq!(tracer.image_scale(3000), s.lights.power() / 3000.0);

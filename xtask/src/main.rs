@@ -5,8 +5,10 @@
 //!
 //! Commands today:
 //! - `cargo xtask` / `cargo xtask status`: what Spectrace contains so far and how to use it.
-//! - `cargo xtask bench`: runs every crate's benchmarks in release mode.
-//! - `cargo xtask ci`: runs the same checks as `.ci/run` (tests, rustfmt, clippy).
+//! - `cargo xtask bench`: runs every crate's benchmarks (sampling, spectrum, lights, geometry) in
+//!   release mode.
+//! - `cargo xtask ci`: runs `.ci/run` itself (rustfmt, clippy, the tests, the fuzz run, the
+//!   status page), so the two can never differ.
 //! - `cargo xtask render [SCENE] [options]`: builds the renderer in release mode and renders a
 //!   scene (default `scenes/showcase.json`); options go to `spectrace render`.
 //! - `cargo xtask estimate SCENE --target-error E [options]`: predicts the render time to E for
@@ -90,12 +92,10 @@ fn main() -> ExitCode {
         "bench" => run_all(&[
             &["bench", "-p", "spectrace-sampling"],
             &["bench", "-p", "spectrace-spectrum"],
+            &["bench", "-p", "spectrace-lights"],
+            &["bench", "-p", "spectrace-geometry"],
         ]),
-        "ci" => run_all(&[
-            &["test", "--workspace"],
-            &["fmt", "--all", "--check"],
-            &["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"],
-        ]),
+        "ci" => ci(),
         "help" | "-h" | "--help" => {
             print_help();
             ExitCode::SUCCESS
@@ -285,7 +285,7 @@ fn print_help() {
          peer --materials [--spp N] [--seeds K] [--cases A,B] [--no-docs]\n           \
                   the materials cross-check against Mitsuba 3 (docs/materials-peer.md)\n  \
          bench    run every crate's benchmarks (release)\n  \
-         ci       run the checks CI runs: tests, rustfmt, clippy -D warnings\n  \
+         ci       run .ci/run: rustfmt, clippy -D warnings, tests, fuzz, status\n  \
          help     this text"
     );
 }
@@ -316,6 +316,23 @@ fn status() -> ExitCode {
 }
 
 /// Runs `cargo <args>` for each argument list in turn; stops at the first failure.
+/// `cargo xtask ci`: `bash .ci/run` from the workspace root.
+fn ci() -> ExitCode {
+    let root = workspace_root();
+    eprintln!("$ bash .ci/run");
+    match Command::new("bash").arg(".ci/run").current_dir(&root).status() {
+        Ok(s) if s.success() => ExitCode::SUCCESS,
+        Ok(s) => {
+            eprintln!("`.ci/run` failed ({s})");
+            ExitCode::FAILURE
+        }
+        Err(e) => {
+            eprintln!("could not run bash .ci/run: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
 fn run_all(commands: &[&[&str]]) -> ExitCode {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
     for args in commands {

@@ -35,9 +35,9 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 use spectrace_lights::LightSource;
 use spectrace_tracer::{
-    Bdpt, Effects, EffectsMode, Film, FilmError, Integrator, IntegratorChoice, LightTracer,
-    LightTracerScene, MemoryLimit, PathTracer, RenderOutput, RenderPlan, SamplerKind, TraceStats,
-    image_scale, render, render_observed,
+    Bdpt, ChunkWork, Effects, EffectsMode, Film, FilmError, Integrator, IntegratorChoice,
+    LightTracer, LightTracerScene, MemoryLimit, PathTracer, RenderOutput, RenderPlan, SamplerKind,
+    TraceStats, image_scale, render, render_observed,
 };
 
 pub use files::{
@@ -554,7 +554,8 @@ pub fn probe_with(
     let mut timed_out = false;
     for beam in 0..max_beams {
         // One beam per chunk, so that the probe can stop after any beam.
-        stats.merge(&tracer.render_chunk(u64::MAX, beam, 1, None, &mut sink));
+        let work = ChunkWork { seed: u64::MAX, chunk: beam, items: 1, deadline: None };
+        stats.merge(&tracer.render_chunk(work, &mut sink));
         if sink.lit {
             break;
         }

@@ -28,8 +28,7 @@ use std::sync::{Mutex, PoisonError};
 use serde::{Deserialize, Serialize};
 use spectrace_spectrum::Xyz;
 
-use crate::FilmError;
-use crate::film::film_pixels;
+use crate::raster::{FilmError, film_pixels, raster_bytes};
 
 /// Chunks (batches) a render needs before its error estimate is trusted to stop it.
 pub const MIN_BATCHES: u64 = 16;
@@ -100,9 +99,7 @@ impl Moments {
 
     /// Bytes the moments of a `width x height` film occupy (72 per pixel).
     pub fn bytes_for(width: u32, height: u32) -> u64 {
-        (u64::from(width) * u64::from(height))
-            .saturating_mul(MOMENT_BYTES)
-            .saturating_add(std::mem::size_of::<Moments>() as u64)
+        raster_bytes(width, height, MOMENT_BYTES, std::mem::size_of::<Moments>())
     }
 
     /// Width in pixels.

@@ -11,10 +11,10 @@
 use std::sync::{Mutex, PoisonError};
 
 use serde::{Deserialize, Serialize};
-use spectrace_geometry::human_bytes;
-use spectrace_spectrum::{Xyz, cmf};
+use spectrace_spectrum::{CIE_Y_INTEGRAL, Xyz, cmf};
 
 use crate::estimate::{ChunkTally, Moments};
+use crate::raster::{FilmError, film_pixels, pixel_index, raster_bytes};
 
 /// Fractional bits of the fixed-point sums.
 const FRAC_BITS: i32 = 64;
@@ -25,9 +25,6 @@ const MAX_CONTRIBUTION: f64 = 4_611_686_018_427_387_904.0; // 2^62
 
 /// Bytes of one pixel: three `i128` sums.
 const PIXEL_BYTES: u64 = std::mem::size_of::<[ExactSum; 3]>() as u64;
-
-/// Most pixels a film may have: 2^25 (33.5 million, e.g. 8192 x 4096), 1.6 GB of sums.
-pub const MAX_PIXELS: u64 = 1 << 25;
 
 /// `x` rounded once to fixed point, or `None` if it is NaN, infinite or larger in magnitude than
 /// 2^62.
@@ -94,41 +91,6 @@ impl ExactSum {
     }
 }
 
-/// Why a film operation failed.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[non_exhaustive]
-pub enum FilmError {
-    /// Two films of different sizes cannot be merged.
-    #[error("film sizes differ: {0}x{1} vs {2}x{3}")]
-    SizeMismatch(u32, u32, u32, u32),
-    /// A width or height of zero, or a pixel count that does not fit in memory.
-    #[error(
-        "film size {0}x{1} is invalid: both must be at least 1 and their product at most 2^25 (33.5 million pixels)"
-    )]
-    InvalidSize(u32, u32),
-    /// The render needs more memory than it may use; nothing was allocated.
-    #[error(
-        "a {width}x{height} film (camera.width x camera.height) needs {} ({}), more than the {} a render may use ({limit_source}); lower the camera's resolution",
-        human_bytes(*needed),
-        breakdown,
-        human_bytes(*limit)
-    )]
-    TooLarge {
-        /// Film width.
-        width: u32,
-        /// Film height.
-        height: u32,
-        /// Bytes the render needs.
-        needed: u64,
-        /// What those bytes are.
-        breakdown: String,
-        /// Bytes it may use.
-        limit: u64,
-        /// Where the limit comes from.
-        limit_source: String,
-    },
-}
-
 /// Where contributions go: a [`Film`] directly, or a [`FilmWriter`] that buffers them for a
 /// film shared between threads. The light tracer ([`crate::trace_chunk`]) writes through it.
 pub trait Splat {
@@ -144,6 +106,33 @@ pub trait Splat {
         let _ = (cell, sums);
         false
     }
+
+    /// Adds spectral samples to pixel `(x, y)`: `values[j]` at wavelength `lambdas[j]` (nm),
+    /// turned into the film's XYZ by [`spectral_xyz`]. Nothing is added (and `false` returned)
+    /// when every value is zero; otherwise as [`splat`](Self::splat).
+    #[inline]
+    fn splat_spectral(&mut self, x: u32, y: u32, lambdas: &[f64], values: &[f64]) -> bool {
+        let xyz = spectral_xyz(lambdas, values);
+        if xyz.x == 0.0 && xyz.y == 0.0 && xyz.z == 0.0 {
+            return false;
+        }
+        self.splat(x, y, xyz)
+    }
+}
+
+/// The film's XYZ of spectral samples, the one place colour is made: `sum_j cmf(lambda_j)
+/// values[j]` over the integral of `ybar`, so that a spectral radiance of 1 W m^-2 sr^-1 nm^-1
+/// at every wavelength gives `Y = 1`. Zero values are skipped (a wavelength outside the
+/// matching functions' table contributes nothing).
+#[inline]
+pub fn spectral_xyz(lambdas: &[f64], values: &[f64]) -> Xyz {
+    let mut xyz = Xyz::default();
+    for (&lambda, &v) in lambdas.iter().zip(values) {
+        if v != 0.0 {
+            xyz += cmf(lambda) * v;
+        }
+    }
+    xyz * (1.0 / *CIE_Y_INTEGRAL)
 }
 
 /// A film of `width x height` pixels, each accumulating X, Y, Z exactly, followed by the cells
@@ -222,9 +211,7 @@ impl Film {
 
     /// Bytes a `width x height` film occupies: 48 per pixel (three `i128` sums) plus the struct.
     pub fn bytes_for(width: u32, height: u32) -> u64 {
-        (u64::from(width) * u64::from(height))
-            .saturating_mul(PIXEL_BYTES)
-            .saturating_add(std::mem::size_of::<Film>() as u64)
+        raster_bytes(width, height, PIXEL_BYTES, std::mem::size_of::<Film>())
     }
 
     /// Width in pixels.
@@ -323,26 +310,6 @@ impl Film {
     pub fn accepted(&self) -> u64 {
         self.accepted
     }
-}
-
-/// The pixel count of a `width x height` film (or of its error-estimate moments).
-///
-/// # Errors
-/// [`FilmError::InvalidSize`] for a zero dimension or more than [`MAX_PIXELS`] pixels.
-pub(crate) fn film_pixels(width: u32, height: u32) -> Result<usize, FilmError> {
-    let n = u64::from(width) * u64::from(height);
-    if width == 0 || height == 0 || n > MAX_PIXELS {
-        return Err(FilmError::InvalidSize(width, height));
-    }
-    // At most 2^25: fits in usize.
-    Ok(n as usize)
-}
-
-/// The row-major index of pixel `(x, y)`, if it lies on a `width x height` film.
-#[inline]
-fn pixel_index(x: u32, y: u32, width: u32, height: u32) -> Option<usize> {
-    // Films have at most 2^25 pixels, so the index fits in u32 and usize.
-    (x < width && y < height).then(|| (y * width + x) as usize)
 }
 
 impl Splat for Film {

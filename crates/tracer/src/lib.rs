@@ -23,40 +23,48 @@
 //! a new wavelength before it connects a vertex), reports it, and can be overridden. Because chunks are independent, the render loop also estimates the image's error
 //! as it goes, from the spread between chunks ([`Moments`]), with no reference.
 
-mod bdpt;
 mod camera;
 mod effects;
 mod estimate;
 mod film;
-mod integrator;
-mod light_tracer;
+mod integrators;
+mod light_sampler;
 mod object_light;
-mod path_tracer;
+mod raster;
 mod render;
 mod sampler;
+mod scene;
 mod sensor;
+mod stats;
 mod wavelengths;
 
-pub use bdpt::{Bdpt, BdptSettings, MisVertex, mis_weight};
 pub use camera::{
     CameraError, CameraRay, CameraRepr, CameraSample, FovAxis, PinholeCamera, Projection,
 };
 pub use effects::{BUNDLE, Effects, EffectsMode, IntegratorChoice, SceneFeatures};
 pub use estimate::{ErrorEstimate, MIN_BATCHES, Moments};
-pub use film::{ExactSum, Film, FilmError, FilmWriter, MAX_PIXELS, Splat};
-pub use integrator::{Integrator, LightTracer};
-pub use light_tracer::{
-    Emitter, LightTracerScene, LightTracerSettings, MAX_DEPTH, TraceStats, chunk_rng, image_scale,
-    trace_chunk, trace_chunk_until,
+pub use film::{ExactSum, Film, FilmWriter, Splat, spectral_xyz};
+pub use integrators::bdpt::{Bdpt, BdptSettings, MisVertex, mis_weight};
+pub use integrators::light_tracer::{
+    LightTracer, LightTracerSettings, MAX_DEPTH, image_scale, trace_chunk, trace_chunk_until,
 };
+pub use integrators::path_tracer::{PathTracer, PathTracerSettings};
+pub use integrators::sensor_path::SensorPathTracer;
+pub use integrators::{
+    ChunkWork, INTEGRATORS, Integrator, IntegratorSettings, RegisteredIntegrator, build_integrator,
+    registered,
+};
+pub use light_sampler::{LightSampler, PowerLightSampler, SampledLight};
 pub use object_light::{ObjectEmission, ObjectLight};
-pub use path_tracer::{PathTracer, PathTracerSettings, SensorPathTracer};
+pub use raster::{FilmError, MAX_PIXELS};
 pub use render::{
     DEFAULT_CHUNK_BEAMS, FALLBACK_MEMORY_LIMIT, MemoryLimit, Progress, RenderOutput, RenderPlan,
     render, render_observed,
 };
-pub use sampler::{ChunkSampler, SamplerKind};
+pub use sampler::{ChunkSampler, SamplerKind, chunk_rng};
+pub use scene::{Emitter, LightTracerScene};
 pub use sensor::{
     IrradianceSensor, MAX_SENSOR_CELLS, MAX_SENSOR_CELLS_PER_EDGE, SensorSet, SensorSums,
 };
+pub use stats::TraceStats;
 pub use wavelengths::{CAMERA_LAMBDA_MAX, CAMERA_LAMBDA_MIN, CameraWavelengths, HERO};

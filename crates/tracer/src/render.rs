@@ -7,7 +7,9 @@ use std::time::{Duration, Instant};
 use serde::{Deserialize, Serialize};
 
 use crate::estimate::ChunkTally;
-use crate::{ErrorEstimate, Film, FilmError, FilmWriter, Integrator, Moments, TraceStats};
+use crate::{
+    ChunkWork, ErrorEstimate, Film, FilmError, FilmWriter, Integrator, Moments, TraceStats,
+};
 
 /// Beams per work chunk by default: small enough to balance threads, large enough that the
 /// per-chunk cost (a generator, a film merge) is negligible.
@@ -345,7 +347,8 @@ pub fn render_observed(
                     let i = next.fetch_add(1, Ordering::Relaxed);
                     let Some(c) = plan.shard_chunk(i) else { break };
                     let n = plan.beams_in_chunk(c);
-                    let s = integrator.render_chunk(plan.seed, c, n, deadline, &mut writer);
+                    let work = ChunkWork { seed: plan.seed, chunk: c, items: n, deadline };
+                    let s = integrator.render_chunk(work, &mut writer);
                     if s.beams < n {
                         writer.discard_chunk();
                     } else {
@@ -476,5 +479,136 @@ mod tests {
         assert_eq!(mem_available("MemTotal: 8 kB\nMemAvailable:   3 kB\n"), Some(3072));
         assert_eq!(mem_available("MemTotal: 8 kB\n"), None);
         assert!(MemoryLimit::system().bytes > 0);
+    }
+}
+
+#[cfg(test)]
+mod loop_tests {
+    //! The render loop with a trivial estimator: bit-identical for any thread count and shard
+    //! split.
+    #![allow(clippy::unwrap_used)]
+
+    use std::sync::atomic::{AtomicU64, Ordering};
+
+    use spectrace_spectrum::Xyz;
+
+    use super::*;
+    use crate::{ExactSum, Film, Integrator, Splat, TraceStats};
+
+    /// A trivial estimator: item `i` of chunk `c` splats X = 1/2 and Y = 1 / (1 + c + i) (sums of
+    /// which depend on the order in floating point, never in the exact film) into pixel
+    /// `(c % width, 0)`.
+    struct Constant {
+        width: u32,
+    }
+
+    impl Constant {
+        fn value(chunk: u64, item: u64) -> Xyz {
+            Xyz::new(0.5, 1.0 / (1.0 + chunk as f64 + item as f64), 0.0)
+        }
+    }
+
+    impl Integrator for Constant {
+        fn name(&self) -> &'static str {
+            "constant"
+        }
+
+        fn resolution(&self) -> (u32, u32) {
+            (self.width, 2)
+        }
+
+        fn render_chunk(&self, work: ChunkWork, film: &mut dyn Splat) -> TraceStats {
+            let mut stats = TraceStats::default();
+            let chunk = work.chunk;
+            for i in 0..work.items {
+                stats.beams += 1;
+                if film.splat((chunk % u64::from(self.width)) as u32, 0, Self::value(chunk, i)) {
+                    stats.splats += 1;
+                }
+            }
+            stats
+        }
+
+        fn image_scale(&self, samples_done: u64) -> f64 {
+            if samples_done == 0 { 0.0 } else { 1.0 / samples_done as f64 }
+        }
+    }
+
+    fn plan(threads: usize, shard: Option<(u64, u64)>) -> RenderPlan {
+        // 23 chunks of 1000 items, the last one of 700.
+        RenderPlan {
+            beams: 22_700,
+            chunk_beams: 1000,
+            seed: 7,
+            threads,
+            shard,
+            time_budget: None,
+            error_estimate: false,
+            target_error: None,
+        }
+    }
+
+    fn run(integrator: &dyn Integrator, plan: &RenderPlan) -> RenderOutput {
+        let progressed = AtomicU64::new(0);
+        let out = render(integrator, plan, &|done| {
+            progressed.fetch_max(done, Ordering::Relaxed);
+        })
+        .unwrap();
+        assert_eq!(progressed.load(Ordering::Relaxed), out.beams, "progress reaches the total");
+        out
+    }
+
+    #[test]
+    fn the_render_loop_is_bit_identical_for_any_estimator_thread_count_and_shard_split() {
+        let integrator = Constant { width: 5 };
+        let one = run(&integrator, &plan(1, None));
+        // The exact expected sums: every item of every chunk, added one by one.
+        let whole = plan(1, None);
+        let mut expected = [[ExactSum::default(); 2]; 5];
+        for c in 0..whole.chunks() {
+            for i in 0..whole.beams_in_chunk(c) {
+                let v = Constant::value(c, i);
+                let pixel = &mut expected[(c % 5) as usize];
+                assert!(pixel[0].add(v.x) && pixel[1].add(v.y));
+            }
+        }
+        let image = one.film.to_xyz(1.0);
+        for (x, sums) in expected.iter().enumerate() {
+            assert_eq!(image[x], Xyz::new(sums[0].value(), sums[1].value(), 0.0), "pixel {x}");
+            assert_eq!(image[5 + x], Xyz::default(), "row 1 stays black");
+        }
+        // Pixel 0 gets chunks 0, 5, 10, 15 and 20 (1000 items each): X = 5000 / 2 exactly.
+        assert_eq!(image[0].x, 2500.0);
+        // Pixel 2 gets chunk 22, the short one.
+        assert_eq!(image[2].x, 0.5 * 4000.0 + 0.5 * 700.0);
+        assert_eq!((one.beams, one.stats.beams, one.stats.splats), (22_700, 22_700, 22_700));
+        assert_eq!(one.chunks, (0..23).collect::<Vec<_>>());
+        assert_eq!(one.film.accepted(), 22_700);
+
+        for threads in [2, 3] {
+            let many = run(&integrator, &plan(threads, None));
+            assert_eq!(many.film, one.film, "{threads} threads");
+            assert_eq!((many.stats, &many.chunks), (one.stats, &one.chunks), "{threads} threads");
+        }
+        for (n, threads) in [(2, 1), (3, 2), (4, 3)] {
+            let mut merged: Option<RenderOutput> = None;
+            for k in (0..n).rev() {
+                let part = run(&integrator, &plan(threads, Some((k, n))));
+                match merged.as_mut() {
+                    None => merged = Some(part),
+                    Some(m) => m.merge(&part).unwrap(),
+                }
+            }
+            let merged = merged.unwrap();
+            assert_eq!(merged.film, one.film, "{n} shards");
+            assert_eq!((merged.beams, &merged.chunks), (one.beams, &one.chunks), "{n} shards");
+        }
+        assert_eq!(integrator.image_scale(one.beams), 1.0 / 22_700.0);
+        // The film's size is the integrator's.
+        let mut film = Film::new(5, 2).unwrap();
+        integrator
+            .render_chunk(ChunkWork { seed: 7, chunk: 3, items: 2, deadline: None }, &mut film);
+        assert_eq!(film.to_xyz(1.0)[3], Constant::value(3, 0) + Constant::value(3, 1));
+        assert!(render(&Constant { width: 0 }, &plan(1, None), &|_| {}).is_err());
     }
 }

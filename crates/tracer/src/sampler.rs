@@ -24,7 +24,16 @@ use rand_pcg::Pcg64;
 use serde::{Deserialize, Serialize};
 use spectrace_sampling::SobolSampler;
 
-use crate::chunk_rng;
+use rand::SeedableRng;
+
+/// The generator of chunk `chunk` of a render with seed `seed` (SplitMix64 of both, so nearby
+/// seeds and chunks give unrelated streams).
+pub fn chunk_rng(seed: u64, chunk: u64) -> Pcg64 {
+    let mut z = seed ^ chunk.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    Pcg64::seed_from_u64(z ^ (z >> 31))
+}
 
 /// Which random numbers the integrators draw (`settings.sampler` in scene files).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]

@@ -1,0 +1,244 @@
+//! BDPT's path vertices and the densities between them: [`Vertex`], the light end of a path
+//! ([`LightEnd`]), and pbrt's `Vertex::Pdf` ([`Bdpt::pdf`]) with the conversions to area density.
+
+use std::f64::consts::PI;
+
+use glam::DVec3;
+use spectrace_geometry::Hit;
+use spectrace_lights::{LightFlags, LightId, LightSource, LightSurface};
+use spectrace_materials::{Material, Transport, reemission_lobe};
+
+use super::Bdpt;
+use crate::integrators::common::VertexSamples;
+
+/// What a vertex is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum VertexKind {
+    /// The pinhole, or a point of a thin lens.
+    Camera,
+    /// A point on light `id` (where a beam starts, or sampled by next-event estimation).
+    Light(LightId),
+    /// A surface hit (its shape's material scatters).
+    Surface(Hit),
+}
+
+/// A vertex of a subpath (pbrt's `Vertex`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Vertex {
+    pub kind: VertexKind,
+    pub point: DVec3,
+    /// Geometric normal; zero for points not on a surface (pinhole, point lights).
+    pub ng: DVec3,
+    /// Throughput from the subpath's start up to this vertex (not including its scattering).
+    pub beta: f64,
+    /// Scatters by a delta lobe (or, for a light, emits in a delta direction).
+    pub delta: bool,
+    /// Area density of this vertex sampled from its own subpath's side.
+    pub pdf_fwd: f64,
+    /// Area density of this vertex sampled from the other side.
+    pub pdf_rev: f64,
+    /// The wavelength (nm) at which this vertex connects: the sample's own, or on a light
+    /// subpath beyond a fluorescent re-emission the re-emitted one.
+    pub lambda: f64,
+    /// This vertex re-emitted (scatters with [`reemission_lobe`] instead of its material).
+    pub reemitted: bool,
+    /// This vertex or one before it on its subpath re-emitted.
+    pub fluoresced: bool,
+    /// The vertex's uniforms, drawn when it was made: its connections use them (a light vertex
+    /// its lens point for `t = 1`, a camera vertex its light sample for `s = 1`).
+    pub u: VertexSamples,
+}
+
+impl Vertex {
+    /// The camera's vertex at `point` (the pinhole or a lens point).
+    pub(super) fn camera(point: DVec3, lambda: f64) -> Self {
+        Self::at(VertexKind::Camera, point, DVec3::ZERO, 1.0, lambda, NO_SAMPLES)
+    }
+
+    /// A vertex of `kind` at `point` with normal `ng`, throughput `beta` and uniforms `u`.
+    pub(super) fn at(
+        kind: VertexKind,
+        point: DVec3,
+        ng: DVec3,
+        beta: f64,
+        lambda: f64,
+        u: VertexSamples,
+    ) -> Self {
+        Self {
+            kind,
+            point,
+            ng,
+            beta,
+            delta: false,
+            pdf_fwd: 0.0,
+            pdf_rev: 0.0,
+            lambda,
+            reemitted: false,
+            fluoresced: false,
+            u,
+        }
+    }
+}
+
+/// The uniforms of a vertex that draws none (the camera's, and vertices sampled by a
+/// connection).
+pub(super) const NO_SAMPLES: VertexSamples = VertexSamples {
+    fluorescence: [0.5; 2],
+    light: [0.5; 2],
+    lens: [0.5; 2],
+    scatter: [0.5; 3],
+    roulette: 0.5,
+};
+
+/// A light as a path end: its id, its flags, and the probability of choosing it given the
+/// sample's wavelength.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct LightEnd {
+    pub id: LightId,
+    pub flags: LightFlags,
+    pub pmf: f64,
+}
+
+impl LightEnd {
+    /// Whether a camera path can never hit it (strategy `s = 0` impossible).
+    pub(super) fn is_delta(&self, on_surface: bool) -> bool {
+        self.flags.delta_position || self.flags.delta_direction || !on_surface
+    }
+}
+
+/// The wavelength of a sample and what depends on it.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Wavelength {
+    pub lambda: f64,
+    /// The light set's SPD at `lambda`: the density the wavelength was drawn with.
+    pub density: f64,
+}
+
+impl Bdpt<'_> {
+    /// The light `id` as a path end for wavelength `wl`.
+    pub(super) fn light_end(&self, id: LightId, wl: &Wavelength) -> Option<LightEnd> {
+        let light = self.scene.lights.light(id)?;
+        let flags =
+            light.flags().unwrap_or(LightFlags { delta_position: true, delta_direction: true });
+        let pmf = if wl.density > 0.0 {
+            self.scene.all_lights().pmf_given(id, wl.lambda, wl.density)
+        } else {
+            0.0
+        };
+        Some(LightEnd { id, flags, pmf })
+    }
+
+    /// Solid-angle density of a camera ray leaving the lens at `origin` (the pinhole for a
+    /// pinhole camera) towards `point` (over the whole image: [`crate::PinholeCamera::pdf_we`]),
+    /// 0 when it misses the image.
+    fn camera_pdf(&self, origin: DVec3, point: DVec3) -> f64 {
+        let ray = crate::CameraRay { origin, direction: point - origin };
+        self.scene.camera.pdf_we(&ray).1
+    }
+
+    /// Area density at `vertex` of a vertex at `from` that chooses the direction towards it
+    /// with solid-angle density `pdf`.
+    pub(super) fn to_area(pdf: f64, from: DVec3, vertex: &Vertex) -> f64 {
+        let to = vertex.point - from;
+        let d2 = to.length_squared();
+        if !(d2 > 0.0) {
+            return 0.0;
+        }
+        let mut p = pdf / d2;
+        if vertex.ng != DVec3::ZERO {
+            p *= (to.dot(vertex.ng) / d2.sqrt()).abs();
+        }
+        p
+    }
+
+    /// Area density with which `v`, reached from `prev`, samples `next` (pbrt's `Vertex::Pdf`).
+    /// Light vertices ignore `prev`; `light` is the light of a vertex that emits.
+    pub(super) fn pdf(
+        &self,
+        v: &Vertex,
+        prev: Option<&Vertex>,
+        next: &Vertex,
+        light: Option<LightId>,
+    ) -> f64 {
+        let solid = match v.kind {
+            VertexKind::Camera => self.camera_pdf(v.point, next.point),
+            VertexKind::Light(id) => self.light_pdfs(id, v.point, next.point - v.point).1,
+            VertexKind::Surface(hit) => {
+                if let Some(id) = light.filter(|_| prev.is_none()) {
+                    self.light_pdfs(id, v.point, next.point - v.point).1
+                } else {
+                    let Some(prev) = prev else { return 0.0 };
+                    let Some(material) = self.lobe(v, &hit) else { return 0.0 };
+                    let wp = (prev.point - v.point).normalize();
+                    let wn = (next.point - v.point).normalize();
+                    material.pdf(wp, wn, hit.shading_normal, v.lambda)
+                }
+            }
+        };
+        if solid > 0.0 { Self::to_area(solid, v.point, next) } else { 0.0 }
+    }
+
+    /// What scatters at surface vertex `v` (on `hit`): its material, or the white Lambertian
+    /// lobe of a fluorescent re-emission.
+    pub(super) fn lobe(&self, v: &Vertex, hit: &Hit) -> Option<&dyn Material> {
+        if v.reemitted {
+            return Some(reemission_lobe());
+        }
+        self.scene.materials.get(hit.primitive as usize).map(|m| m.as_ref())
+    }
+
+    /// The BSDF at surface vertex `v` for light arriving from `from` and leaving towards `to`,
+    /// with `transport`'s adjoint; 0 for other vertices.
+    pub(super) fn bsdf(&self, v: &Vertex, from: DVec3, to: DVec3, transport: Transport) -> f64 {
+        let VertexKind::Surface(hit) = v.kind else { return 0.0 };
+        let Some(material) = self.lobe(v, &hit) else { return 0.0 };
+        let wi = (from - v.point).normalize();
+        let wo = (to - v.point).normalize();
+        material.eval_with(wi, wo, hit.shading_normal, v.lambda, transport)
+    }
+
+    /// A light's `(position, direction)` emission densities from `point` along `direction`
+    /// (any length).
+    pub(super) fn light_pdfs(&self, id: LightId, point: DVec3, direction: DVec3) -> (f64, f64) {
+        let Some(light) = self.scene.lights.light(id) else { return (0.0, 0.0) };
+        let direction = direction.normalize();
+        if let Some(p) = light.pdf_emission(point, direction) {
+            return p;
+        }
+        let flags = light.flags().unwrap_or_default();
+        let position = if flags.delta_position {
+            1.0
+        } else {
+            let area = surface_area(light);
+            if area > 0.0 { 1.0 / area } else { 0.0 }
+        };
+        let dir =
+            if flags.delta_direction { 1.0 } else { light.emission_density(point, direction) };
+        (position, dir)
+    }
+}
+
+/// Area of a light's emitting surface, 0 when it has none.
+fn surface_area(light: &dyn LightSource) -> f64 {
+    match light.surface() {
+        Some(LightSurface::Rectangle { edge_u, edge_v, .. }) => edge_u.cross(edge_v).length(),
+        Some(LightSurface::Disk { radius, .. }) => PI * radius * radius,
+        _ => 0.0,
+    }
+}
+
+/// Unit normal of a light's surface at `point`, zero when it has none.
+pub(super) fn light_normal(light: &dyn LightSource, point: DVec3) -> DVec3 {
+    light.normal_at(point).unwrap_or_else(|| surface_normal(light))
+}
+
+/// Unit normal of a light's emitting surface, zero when it has none.
+fn surface_normal(light: &dyn LightSource) -> DVec3 {
+    match light.surface() {
+        Some(LightSurface::Rectangle { edge_u, edge_v, .. }) => {
+            edge_u.cross(edge_v).normalize_or_zero()
+        }
+        Some(LightSurface::Disk { normal, .. }) => normal.normalize_or_zero(),
+        _ => DVec3::ZERO,
+    }
+}

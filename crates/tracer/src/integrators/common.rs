@@ -1,0 +1,443 @@
+//! The steps every estimator shares, written once: the random numbers a vertex draws, shadow
+//! rays, connections to the camera, next-event estimation's light sample, the fluorescence
+//! choice, Russian roulette and the power heuristic.
+//!
+//! # Random numbers: a fixed budget per vertex
+//! Every scattering vertex of every path draws the same [`VertexSamples`], all of them, whether
+//! it uses them or not (pbrt's wavefront `RaySamples`). Which ones a render draws is fixed before
+//! it starts ([`SampleLayout`]: the fluorescence choice only in scenes that fluoresce, a lens
+//! point only for a thin lens, a light choice only for estimators that sample lights), so the
+//! `k`-th uniform of a path means the same thing whatever happened at earlier vertices: a Sobol
+//! dimension always feeds the same decision, and a kernel that traces many paths at once can
+//! reproduce the scalar one draw for draw. A camera sample starts with [`CameraSamples`].
+//!
+//! # Shadow rays: one epsilon policy
+//! [`unoccluded`] joins two [`End`]s. A surface point is left and reached at its robust offset
+//! ([`Hit::spawn_origin`]), so its own surface never shadows it; a point on a light is left by
+//! skipping its own surface ([`LightTracerScene::intersect_from_light`]) and reached up to
+//! [`SHADOW_EPSILON`] (relative) short of it, since an area light's surface is itself geometry;
+//! a free point (the camera's lens, a point light, a sensor) is reached the same way.
+
+use glam::DVec3;
+use spectrace_geometry::{Hit, Ray};
+use spectrace_lights::{LightId, LightSample, uniform};
+use spectrace_materials::{ExcitationSampler, Material, Reemission, Transport, reemission_lobe};
+
+use crate::{LightTracerScene, TraceStats};
+
+/// Relative distance short of a point on a light (or a free point) at which a shadow ray
+/// stops, so that the light's own surface does not count as an occluder.
+pub(crate) const SHADOW_EPSILON: f64 = 1e-9;
+
+/// Which of the optional uniforms a render's vertices draw (fixed for the whole render).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub(crate) struct SampleLayout {
+    /// Two uniforms for the fluorescence choice (scenes with a fluorescent material).
+    pub fluorescence: bool,
+    /// Two uniforms for a light sample (estimators that sample lights, when some light can be
+    /// sampled by area).
+    pub light: bool,
+    /// Two uniforms for a point on the lens (thin-lens cameras).
+    pub lens: bool,
+}
+
+impl SampleLayout {
+    /// The layout of `scene` for an estimator that samples lights (`samples_lights`) or not.
+    pub(crate) fn new(scene: &LightTracerScene<'_>, samples_lights: bool) -> Self {
+        Self {
+            fluorescence: scene.materials.iter().any(|m| m.fluorescence().is_some()),
+            light: samples_lights && !scene.area_lights().is_empty(),
+            lens: !scene.camera.is_pinhole(),
+        }
+    }
+
+    /// A pair of uniforms if `on`, else the pair's centre (drawing nothing).
+    #[inline]
+    fn pair(on: bool, rng: &mut dyn rand::Rng) -> [f64; 2] {
+        if on { [uniform(rng), uniform(rng)] } else { [0.5; 2] }
+    }
+
+    /// A point on the lens: two uniforms for a thin lens, none for a pinhole.
+    #[inline]
+    pub(crate) fn lens(&self, rng: &mut dyn rand::Rng) -> [f64; 2] {
+        Self::pair(self.lens, rng)
+    }
+}
+
+/// The uniforms of one scattering vertex, in the order they are drawn.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct VertexSamples {
+    /// Elastic or re-emitted, and the re-emitted wavelength.
+    pub fluorescence: [f64; 2],
+    /// Next-event estimation: the light (remapped for reuse) and the point on it.
+    pub light: [f64; 2],
+    /// A point on the lens for the connection to the camera.
+    pub lens: [f64; 2],
+    /// The BSDF sample.
+    pub scatter: [f64; 3],
+    /// Russian roulette.
+    pub roulette: f64,
+}
+
+impl VertexSamples {
+    /// Draws a vertex's uniforms under `layout`.
+    #[inline]
+    pub(crate) fn draw(layout: &SampleLayout, rng: &mut dyn rand::Rng) -> Self {
+        let fluorescence = SampleLayout::pair(layout.fluorescence, rng);
+        let light = SampleLayout::pair(layout.light, rng);
+        let lens = SampleLayout::pair(layout.lens, rng);
+        let scatter = [uniform(rng), uniform(rng), uniform(rng)];
+        let roulette = uniform(rng);
+        Self { fluorescence, light, lens, scatter, roulette }
+    }
+}
+
+/// The uniforms that start a camera sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct CameraSamples {
+    /// A point in the pixel.
+    pub film: [f64; 2],
+    /// A point on the lens.
+    pub lens: [f64; 2],
+    /// The hero wavelength.
+    pub wavelength: f64,
+}
+
+impl CameraSamples {
+    /// Draws a camera sample's uniforms under `layout`.
+    #[inline]
+    pub(crate) fn draw(layout: &SampleLayout, rng: &mut dyn rand::Rng) -> Self {
+        let film = [uniform(rng), uniform(rng)];
+        let lens = layout.lens(rng);
+        Self { film, lens, wavelength: uniform(rng) }
+    }
+}
+
+/// One end of a shadow ray.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum End<'h> {
+    /// A surface hit.
+    Surface(&'h Hit),
+    /// A point on a light of the set (its own surface, if it has one, is skipped).
+    Light(LightId, DVec3),
+    /// A point that is not on any surface: the lens, a point light, a sensor.
+    Point(DVec3),
+}
+
+impl End<'_> {
+    /// The point itself.
+    #[inline]
+    fn point(&self) -> DVec3 {
+        match *self {
+            End::Surface(h) => h.point,
+            End::Light(_, p) | End::Point(p) => p,
+        }
+    }
+
+    /// Where a segment towards `other` leaves or reaches this end.
+    #[inline]
+    fn offset_towards(&self, other: DVec3) -> DVec3 {
+        match *self {
+            End::Surface(h) => h.spawn_origin(other - h.point),
+            End::Light(_, p) | End::Point(p) => p,
+        }
+    }
+}
+
+/// Whether nothing blocks the segment from `from` to `to` (the one shadow ray of every
+/// estimator; see the module docs for its epsilon policy).
+pub(crate) fn unoccluded(scene: &LightTracerScene<'_>, from: End<'_>, to: End<'_>) -> bool {
+    let origin = from.offset_towards(to.point());
+    let target = to.offset_towards(from.point());
+    let d = target - origin;
+    let distance = d.length();
+    if !(distance > 0.0 && distance.is_finite()) {
+        return distance == 0.0;
+    }
+    let ray = Ray { origin, direction: d / distance };
+    let reach = match to {
+        End::Surface(_) => distance,
+        End::Light(..) | End::Point(_) => distance * (1.0 - SHADOW_EPSILON),
+    };
+    match from {
+        End::Light(id, _) => scene.intersect_from_light(&ray, id, reach).is_none(),
+        End::Surface(_) | End::Point(_) => !scene.world.occluded(&ray, reach),
+    }
+}
+
+/// A point on the camera's lens seeing a light-side point: the pixel, the importance (film
+/// units) and the direction to the lens.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct CameraConnection {
+    /// Pixel column.
+    pub x: u32,
+    /// Pixel row.
+    pub y: u32,
+    /// Unit direction from the point to the lens.
+    pub to_camera: DVec3,
+    /// The lens point.
+    pub lens: DVec3,
+    /// The camera's importance over its density (see [`crate::PinholeCamera::sample_wi`]).
+    pub importance: f64,
+}
+
+/// The camera seen from `from` through the lens point `u_lens`: `None` when the point is
+/// outside the image, behind the camera or occluded.
+pub(crate) fn connect_camera(
+    scene: &LightTracerScene<'_>,
+    from: End<'_>,
+    u_lens: [f64; 2],
+) -> Option<CameraConnection> {
+    let seen = scene.camera.sample_wi(from.point(), u_lens)?;
+    if !(seen.pdf > 0.0 && seen.importance > 0.0) {
+        return None;
+    }
+    if !unoccluded(scene, from, End::Point(seen.position)) {
+        return None;
+    }
+    Some(CameraConnection {
+        x: seen.x,
+        y: seen.y,
+        to_camera: seen.to_camera,
+        lens: seen.position,
+        importance: seen.importance,
+    })
+}
+
+/// A point `point` on light `id` seen by the camera: the connection and the light's emission
+/// density towards the lens times the importance (multiply by the light's power and spectrum
+/// for the contribution); `None` when the light does not emit that way or it is not seen.
+pub(crate) fn connect_light_to_camera(
+    scene: &LightTracerScene<'_>,
+    id: LightId,
+    point: DVec3,
+    u_lens: [f64; 2],
+) -> Option<(CameraConnection, f64)> {
+    let light = scene.lights.light(id)?;
+    let seen = scene.camera.sample_wi(point, u_lens)?;
+    let density = light.emission_density(point, seen.to_camera);
+    if !(density > 0.0 && seen.importance > 0.0) {
+        return None;
+    }
+    let connection = connect_camera(scene, End::Light(id, point), u_lens)?;
+    Some((connection, density * connection.importance))
+}
+
+/// The cosine of importance transport at `hit` for light arriving from `wi` and leaving
+/// towards `wo` (both unit, away from the surface): `|wo . n|`, with Veach's shading-normal
+/// correction `|wo . n_g| |wi . n_s| / |wi . n_g|` where the normals differ; `None` when `wi`
+/// grazes the true surface.
+#[inline]
+pub(crate) fn importance_cosine(hit: &Hit, wi: DVec3, wo: DVec3) -> Option<f64> {
+    let (ns, ng) = (hit.shading_normal, hit.geometric_normal);
+    if ns == ng {
+        return Some(wo.dot(ns).abs());
+    }
+    let cos_in = wi.dot(ng).abs();
+    (cos_in > 0.0).then(|| wo.dot(ng).abs() * wi.dot(ns).abs() / cos_in)
+}
+
+/// The factor that makes particle (importance) transport exact with shading normals:
+/// `|wi . n_s| |wo . n_g| / (|wi . n_g| |wo . n_s|)`, 1 where the normals agree (Veach 1997,
+/// section 5.3). `wi` points back to where the particle came from, `wo` where it goes.
+#[inline]
+pub(crate) fn shading_correction(hit: &Hit, wi: DVec3, wo: DVec3) -> f64 {
+    let (ns, ng) = (hit.shading_normal, hit.geometric_normal);
+    if ns == ng {
+        return 1.0;
+    }
+    let denominator = wi.dot(ng).abs() * wo.dot(ns).abs();
+    if denominator > 0.0 { wi.dot(ns).abs() * wo.dot(ng).abs() / denominator } else { 0.0 }
+}
+
+/// A light-side surface vertex seen by the camera: `f * cos * importance` per wavelength of
+/// `lambdas` into `values` (light arriving from `wi`, scattered by `material`), and the
+/// connection; `None` when nothing reaches the film.
+pub(crate) fn connect_surface_to_camera(
+    scene: &LightTracerScene<'_>,
+    hit: &Hit,
+    material: &dyn Material,
+    wi: DVec3,
+    lambdas: &[f64],
+    u_lens: [f64; 2],
+    values: &mut [f64],
+) -> Option<CameraConnection> {
+    let seen = connect_camera(scene, End::Surface(hit), u_lens)?;
+    // The camera measures area on the true surface; the reflected light uses the shading normal.
+    let cos = importance_cosine(hit, wi, seen.to_camera)?;
+    let values = &mut values[..lambdas.len()];
+    let n = hit.shading_normal;
+    material.eval_bundle(wi, seen.to_camera, n, lambdas, Transport::Importance, values);
+    let mut any = false;
+    for v in values.iter_mut() {
+        if *v > 0.0 {
+            *v *= cos * seen.importance;
+            any = true;
+        } else {
+            *v = 0.0;
+        }
+    }
+    any.then_some(seen)
+}
+
+/// A point on light `id` sampled towards `receiver` (next-event estimation), when it gives
+/// light: positive intensity at a positive distance. Visibility is the caller's
+/// ([`unoccluded`] with [`End::Light`]), after it has checked the sample is worth a ray.
+pub(crate) fn sample_light(
+    scene: &LightTracerScene<'_>,
+    id: LightId,
+    receiver: DVec3,
+    u: [f64; 2],
+) -> Option<LightSample> {
+    let sample = scene.lights.light(id)?.sample_towards(receiver, u)?;
+    (sample.intensity > 0.0 && sample.distance > 0.0 && sample.intensity.is_finite())
+        .then_some(sample)
+}
+
+/// The lobe a path scatters with at a fluorescent surface, chosen before any connection
+/// (ARCHITECTURE invariant 11).
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Lobe<'m> {
+    /// The material itself (or its elastic part).
+    Elastic(&'m dyn Material),
+    /// Re-emission at a new wavelength (nm): the white lobe scatters.
+    Reemitted(f64),
+}
+
+impl<'m> Lobe<'m> {
+    /// What scatters.
+    #[inline]
+    pub(crate) fn material(&self) -> &'m dyn Material {
+        match *self {
+            Lobe::Elastic(m) => m,
+            Lobe::Reemitted(_) => reemission_lobe(),
+        }
+    }
+}
+
+/// Which way fluorescence is decided: forwards on light paths, adjointly on camera paths with
+/// the excitation sampler of the surface.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Direction<'g> {
+    /// Light paths ([`spectrace_materials::Fluorescent::choose_forward`]).
+    Forward,
+    /// Camera paths ([`spectrace_materials::Fluorescent::choose_adjoint`]).
+    Adjoint(Option<&'g ExcitationSampler>),
+}
+
+/// The lobe at a surface of `material` for a bundle (`lambdas`, `weights`), from the vertex's
+/// fluorescence uniforms `u`: the material when it does not fluoresce; `None` when the bundle
+/// is absorbed. Re-emission updates the bundle and counts in `stats`.
+pub(crate) fn choose_lobe<'m>(
+    material: &'m dyn Material,
+    direction: Direction<'_>,
+    lambdas: &mut [f64],
+    weights: &mut [f64],
+    u: [f64; 2],
+    stats: &mut TraceStats,
+) -> Option<Lobe<'m>> {
+    let Some(fluorescent) = material.fluorescence() else {
+        return Some(Lobe::Elastic(material));
+    };
+    let choice = match direction {
+        Direction::Forward => fluorescent.choose_forward(lambdas, weights, u[0], u[1]),
+        Direction::Adjoint(guide) => {
+            fluorescent.choose_adjoint(lambdas, weights, u[0], u[1], guide)
+        }
+    };
+    match choice {
+        Reemission::Elastic => Some(Lobe::Elastic(material)),
+        Reemission::Reemitted { lambda } => {
+            stats.reemissions += 1;
+            Some(Lobe::Reemitted(lambda))
+        }
+        Reemission::Absorbed => None,
+    }
+}
+
+/// Russian roulette, the one rule of every estimator: a path whose throughput is `relative`
+/// times what it started with (the largest over its wavelengths) survives with probability
+/// `min(1, relative)`. Returns the survival probability to divide by, or `None` when the path
+/// ends (counted in `stats`).
+#[inline]
+pub(crate) fn roulette(relative: f64, u: f64, stats: &mut TraceStats) -> Option<f64> {
+    let survive = if relative > 0.0 { relative.min(1.0) } else { 0.0 };
+    if u < survive {
+        Some(survive)
+    } else {
+        stats.roulette_kills += 1;
+        None
+    }
+}
+
+/// The largest of `weights[j] / start[j]` over the wavelengths that started with weight.
+#[inline]
+pub(crate) fn relative_throughput(weights: &[f64], start: &[f64]) -> f64 {
+    weights.iter().zip(start).filter(|(_, s)| **s > 0.0).map(|(w, s)| w / s).fold(0.0, f64::max)
+}
+
+/// The power heuristic (exponent 2) weight of a strategy with density `a` against one with
+/// density `b`.
+#[inline]
+pub(crate) fn power_heuristic(a: f64, b: f64) -> f64 {
+    let (a2, b2) = (a * a, b * b);
+    if !(a2 > 0.0) {
+        return 0.0;
+    }
+    if !b2.is_finite() {
+        return 0.0;
+    }
+    if !a2.is_finite() {
+        return 1.0;
+    }
+    a2 / (a2 + b2)
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::SeedableRng;
+    use rand_pcg::Pcg64;
+
+    use super::*;
+
+    #[test]
+    fn a_vertex_draws_the_same_count_whatever_it_uses() {
+        // 4 always, 2 more per optional group: the k-th draw of a path keeps its meaning.
+        for (layout, count) in [
+            (SampleLayout::default(), 4),
+            (SampleLayout { lens: true, ..SampleLayout::default() }, 6),
+            (SampleLayout { fluorescence: true, light: true, lens: true }, 10),
+        ] {
+            let mut a = Pcg64::seed_from_u64(3);
+            let mut b = Pcg64::seed_from_u64(3);
+            let _ = VertexSamples::draw(&layout, &mut a);
+            for _ in 0..count {
+                let _ = uniform(&mut b);
+            }
+            assert_eq!(uniform(&mut a), uniform(&mut b), "{layout:?}");
+        }
+    }
+
+    #[test]
+    fn roulette_keeps_the_expected_weight() {
+        let mut stats = TraceStats::default();
+        // Survival 0.25: u below survives and is divided by 0.25, so E[weight] is kept.
+        assert_eq!(roulette(0.25, 0.1, &mut stats), Some(0.25));
+        assert_eq!(roulette(0.25, 0.3, &mut stats), None);
+        assert_eq!(roulette(3.0, 0.999, &mut stats), Some(1.0));
+        assert_eq!(roulette(0.0, 0.0, &mut stats), None);
+        assert_eq!(roulette(f64::NAN, 0.0, &mut stats), None);
+        assert_eq!(stats.roulette_kills, 3);
+        assert_eq!(relative_throughput(&[0.5, 0.0, 2.0], &[1.0, 0.0, 4.0]), 0.5);
+        assert_eq!(relative_throughput(&[1.0], &[0.0]), 0.0);
+    }
+
+    #[test]
+    fn the_power_heuristic_handles_deltas_and_infinities() {
+        assert_eq!(power_heuristic(1.0, 1.0), 0.5);
+        assert_eq!(power_heuristic(0.0, 1.0), 0.0);
+        assert_eq!(power_heuristic(1.0, f64::INFINITY), 0.0);
+        assert_eq!(power_heuristic(f64::INFINITY, 1.0), 1.0);
+        assert!((power_heuristic(3.0, 1.0) - 0.9).abs() < 1e-15);
+    }
+}

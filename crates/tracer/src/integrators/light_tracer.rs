@@ -1,0 +1,372 @@
+//! The light tracer (seed section 2.4.4): beams from the lights, followed through the scene, every
+//! non-specular hit connected to the camera.
+//!
+//! # Estimator
+//! A beam of power `P_b = Phi / N * scale` (the light's power over the beams of the whole render)
+//! that reaches a non-specular surface point `x` from direction `wi` adds, to the pixel `x`
+//! projects into, the estimate `P_b * f(wi, wo) * cos(theta_x) * importance` of the pixel's mean
+//! spectral radiance (see [`crate::PinholeCamera`] for `importance`), weighted by the CIE 1931
+//! functions at the beam's wavelength and divided by the integral of `ybar`: the film's XYZ, in
+//! which a constant spectral radiance of 1 W m^-2 sr^-1 nm^-1 gives `Y = 1`. The beam then
+//! continues by sampling the material (its weight multiplied by `f cos / pdf`); mirrors and glass
+//! reflect and refract it, so caustics and dispersion appear. After `rr_depth` bounces Russian
+//! roulette ends a beam by the shared rule (survival `min(1, max_j w_j / w_j,0)` over the
+//! bundle's wavelengths) and divides survivors by the survival probability, which keeps the
+//! estimator unbiased.
+//!
+//! The film accumulates the contributions without the factor `Phi / N`; [`image_scale`] gives it.
+//!
+//! # Determinism
+//! Work comes in chunks of beams; chunk `c` draws all its random numbers from a generator seeded
+//! by `(seed, c)`, and the film adds in exact fixed point, so an image depends only on the seed
+//! and the chunks rendered, never on thread count or order.
+
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+use spectrace_geometry::Ray;
+use spectrace_lights::{Beam, LightSource, uniform};
+use spectrace_materials::Transport;
+use spectrace_spectrum::lumens_per_watt;
+
+use super::common::{
+    Direction, SampleLayout, VertexSamples, choose_lobe, connect_light_to_camera,
+    connect_surface_to_camera, relative_throughput, roulette, shading_correction,
+};
+use crate::{
+    ChunkSampler, ChunkWork, Effects, EffectsMode, Integrator, LightTracerScene, SensorSet, Splat,
+    TraceStats,
+};
+
+/// Largest `max_depth` a scene may ask for (the renderer refuses more; the tracer clamps
+/// nothing). Russian roulette ends almost every beam long before: only a lossless closed scene
+/// (mirrors or white walls all round) keeps beams going, and there a path that keeps even 99.9%
+/// of its power per bounce has kept 4.5e-5 of it after 10,000 bounces, so deeper paths add
+/// nothing visible. The bound also keeps one beam short (10,000 bounces take about 3 ms), which
+/// is the granularity at which a time budget and the pre-render probe can stop.
+pub const MAX_DEPTH: u32 = 10_000;
+
+/// Work units (beams and surface hits) traced between two looks at the clock when a chunk has
+/// a deadline: a few microseconds of work, so the look (~25 ns) costs under 1%.
+const DEADLINE_CHECK_WORK: u64 = 64;
+
+/// Largest wavelength bundle a path can carry.
+const MAX_BUNDLE: usize = 8;
+
+/// Settings of the light tracer.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightTracerSettings {
+    /// Most bounces a beam may make (0: only direct illumination of the first surface hit);
+    /// scenes may ask for at most [`MAX_DEPTH`].
+    pub max_depth: u32,
+    /// Bounces after which Russian roulette may end a beam.
+    pub rr_depth: u32,
+}
+
+impl Default for LightTracerSettings {
+    fn default() -> Self {
+        Self { max_depth: 64, rr_depth: 4 }
+    }
+}
+
+/// The factor that turns film sums into the image: the lights' power over the beams of the
+/// whole render.
+pub fn image_scale(light_power: f64, total_beams: u64) -> f64 {
+    if total_beams == 0 { 0.0 } else { light_power / total_beams as f64 }
+}
+
+/// The light tracer as an [`Integrator`]: beams from the lights, every non-specular hit
+/// connected to the camera (see [`crate::trace_chunk`]); a work item is one beam.
+#[derive(Debug, Clone)]
+pub struct LightTracer<'a> {
+    scene: &'a LightTracerScene<'a>,
+    settings: LightTracerSettings,
+    effects: Effects,
+}
+
+impl<'a> LightTracer<'a> {
+    /// The light tracer's [`Integrator::name`].
+    pub const NAME: &'static str = "light";
+
+    /// A light tracer of `scene` with `settings`, following the `effects` decision.
+    pub fn new(
+        scene: &'a LightTracerScene<'a>,
+        settings: LightTracerSettings,
+        effects: Effects,
+    ) -> Self {
+        Self { scene, settings, effects }
+    }
+
+    /// The scene it traces.
+    pub fn scene(&self) -> &'a LightTracerScene<'a> {
+        self.scene
+    }
+
+    /// Its settings.
+    pub fn settings(&self) -> &LightTracerSettings {
+        &self.settings
+    }
+
+    /// The effects decision it follows.
+    pub fn effects(&self) -> &Effects {
+        &self.effects
+    }
+}
+
+impl Integrator for LightTracer<'_> {
+    fn name(&self) -> &'static str {
+        Self::NAME
+    }
+
+    fn resolution(&self) -> (u32, u32) {
+        (self.scene.camera.width(), self.scene.camera.height())
+    }
+
+    fn render_chunk(&self, work: ChunkWork, film: &mut dyn Splat) -> TraceStats {
+        trace_chunk_until(self.scene, &self.settings, &self.effects, work, film)
+    }
+
+    fn image_scale(&self, samples_done: u64) -> f64 {
+        image_scale(self.scene.lights.power(), samples_done)
+    }
+
+    fn sensor_cells(&self) -> u32 {
+        self.scene.sensors().map_or(0, SensorSet::total_cells)
+    }
+}
+
+/// Traces `beams` beams of chunk `chunk` into `film` (a [`crate::Film`] or a
+/// [`crate::FilmWriter`]), following `effects`.
+pub fn trace_chunk<S: Splat + ?Sized>(
+    scene: &LightTracerScene<'_>,
+    settings: &LightTracerSettings,
+    effects: &Effects,
+    seed: u64,
+    chunk: u64,
+    beams: u64,
+    film: &mut S,
+) -> TraceStats {
+    let work = ChunkWork { seed, chunk, items: beams, deadline: None };
+    trace_chunk_until(scene, settings, effects, work, film)
+}
+
+/// As [`trace_chunk`] (`work.items` beams), but stops early once `work.deadline` has passed: the clock is read every
+/// few microseconds of work, between beams (a beam is never cut), and at least one beam is
+/// traced. The returned `stats.beams` is the number of beams traced, which the image's
+/// normalisation must use; the beams traced are the first ones of the chunk's random stream.
+pub fn trace_chunk_until<S: Splat + ?Sized>(
+    scene: &LightTracerScene<'_>,
+    settings: &LightTracerSettings,
+    effects: &Effects,
+    work: ChunkWork,
+    film: &mut S,
+) -> TraceStats {
+    let mut rng = ChunkSampler::new(scene.sampler(), work.seed, work.chunk);
+    let mut stats = TraceStats::default();
+    let tracer = BeamTracer {
+        scene,
+        settings,
+        effects,
+        layout: SampleLayout::new(scene, false),
+        bundle: effects.wavelengths_per_path.clamp(1, MAX_BUNDLE),
+    };
+    let mut next_check = DEADLINE_CHECK_WORK;
+    for i in 0..work.items {
+        if let Some(deadline) = work.deadline {
+            let done = stats.beams + stats.hits;
+            if done >= next_check {
+                next_check = done + DEADLINE_CHECK_WORK;
+                if Instant::now() >= deadline {
+                    break;
+                }
+            }
+        }
+        rng.start_path(work.chunk, i);
+        stats.beams += 1;
+        tracer.trace_beam(&mut rng, film, &mut stats);
+    }
+    stats
+}
+
+/// What one beam's trace needs, fixed for the chunk.
+struct BeamTracer<'s, 'a> {
+    scene: &'s LightTracerScene<'a>,
+    settings: &'s LightTracerSettings,
+    effects: &'s Effects,
+    layout: SampleLayout,
+    /// Wavelengths per beam.
+    bundle: usize,
+}
+
+/// A beam's wavelengths and their weights (each an independent estimate; all share the path).
+struct Bundle {
+    lambdas: [f64; MAX_BUNDLE],
+    weights: [f64; MAX_BUNDLE],
+    /// The weights the beam started with (for Russian roulette).
+    start: [f64; MAX_BUNDLE],
+    len: usize,
+}
+
+impl BeamTracer<'_, '_> {
+    /// The bundle of `beam`: its own wavelength and weight, plus `bundle - 1` wavelengths drawn
+    /// (stratified) as the beam's light draws its companions, with the weight of that density.
+    fn bundle(&self, beam: &Beam, rng: &mut dyn rand::Rng) -> Bundle {
+        let k = self.bundle;
+        let mut b = Bundle {
+            lambdas: [beam.lambda; MAX_BUNDLE],
+            weights: [0.0; MAX_BUNDLE],
+            start: [0.0; MAX_BUNDLE],
+            len: k,
+        };
+        b.weights[0] = beam.scale / k as f64;
+        if k > 1 {
+            let own = self.scene.lights.light(beam.parent);
+            for j in 1..k {
+                let u = ((j - 1) as f64 + uniform(rng)) / (k - 1) as f64;
+                let u = u.min(spectrace_sampling::ONE_MINUS_EPSILON);
+                let (lambda, scale) = own.map_or((beam.lambda, 0.0), |l| l.sample_wavelength(u));
+                b.lambdas[j] = lambda;
+                b.weights[j] = scale / k as f64;
+            }
+        }
+        b.start = b.weights;
+        b
+    }
+
+    /// Traces one beam: its emission point seen by the camera, then every non-specular hit.
+    fn trace_beam<S: Splat + ?Sized>(
+        &self,
+        rng: &mut ChunkSampler,
+        film: &mut S,
+        stats: &mut TraceStats,
+    ) {
+        let scene = self.scene;
+        let light: &dyn LightSource = scene.lights;
+        let beam = light.next_beam(rng);
+        let mut b = self.bundle(&beam, rng);
+        let u_lens = self.layout.lens(rng);
+        if !scene.is_sensors_only()
+            && let Some((seen, value)) =
+                connect_light_to_camera(scene, beam.parent, beam.origin, u_lens)
+        {
+            let values = b.weights.map(|w| w * value);
+            if film.splat_spectral(seen.x, seen.y, &b.lambdas[..b.len], &values[..b.len]) {
+                stats.splats += 1;
+            }
+        }
+        let mut ray = Ray { origin: beam.origin, direction: beam.direction };
+        let mut next_hit = scene.intersect_from_light(&ray, beam.parent, f64::INFINITY);
+        self.fill_sensors(&ray, next_hit.as_ref().map(|h| h.t), &b, film);
+        let mut depth = 0u32;
+        while let Some(hit) = next_hit.take() {
+            stats.hits += 1;
+            let Some(material) = scene.materials.get(hit.primitive as usize) else { break };
+            let u = VertexSamples::draw(&self.layout, rng);
+            let (lambdas, weights) = (&mut b.lambdas[..b.len], &mut b.weights[..b.len]);
+            let Some(lobe) = choose_lobe(
+                material.as_ref(),
+                Direction::Forward,
+                lambdas,
+                weights,
+                u.fluorescence,
+                stats,
+            ) else {
+                break;
+            };
+            let material = lobe.material();
+            if !material.is_specular() {
+                if !scene.is_sensors_only() {
+                    let mut values = [0.0; MAX_BUNDLE];
+                    let wi = -ray.direction;
+                    if let Some(seen) = connect_surface_to_camera(
+                        scene,
+                        &hit,
+                        material,
+                        wi,
+                        lambdas,
+                        u.lens,
+                        &mut values,
+                    ) {
+                        for (v, w) in values.iter_mut().zip(weights.iter()) {
+                            *v *= w;
+                        }
+                        let values = &values[..lambdas.len()];
+                        if film.splat_spectral(seen.x, seen.y, lambdas, values) {
+                            stats.splats += 1;
+                        }
+                    }
+                }
+                if self.stops_after_diffuse() {
+                    break;
+                }
+            }
+            if depth >= self.settings.max_depth {
+                stats.depth_limited += 1;
+                break;
+            }
+            // One scatter for the whole bundle: without dispersion every wavelength takes the
+            // same direction, each with its own weight; a wavelength the surface absorbs drops
+            // out alone, and a dispersive surface keeps only the first live one.
+            let Some(scattered) = material.scatter_bundle(
+                ray.direction,
+                hit.shading_normal,
+                lambdas,
+                weights,
+                u.scatter,
+                Transport::Importance,
+            ) else {
+                break;
+            };
+            // Shading normals: the adjoint correction for particles (Veach 1997, section 5.3).
+            let correction = shading_correction(&hit, -ray.direction, scattered.direction);
+            for w in weights.iter_mut() {
+                *w *= correction;
+            }
+            depth += 1;
+            if depth > self.settings.rr_depth {
+                let relative = relative_throughput(weights, &b.start[..b.len]);
+                let Some(survive) = roulette(relative, u.roulette, stats) else { break };
+                for w in weights.iter_mut() {
+                    *w /= survive;
+                }
+            }
+            if weights.iter().all(|&w| w <= 0.0) {
+                break;
+            }
+            ray = hit.spawn_ray(scattered.direction);
+            next_hit = scene.world.intersect(&ray, f64::INFINITY);
+            self.fill_sensors(&ray, next_hit.as_ref().map(|h| h.t), &b, film);
+        }
+    }
+
+    /// Whether a beam ends at its first non-specular hit: when no interreflection can reach
+    /// the camera, unless sensors may still see light leaving that surface (and the user did
+    /// not ask for direct light only).
+    fn stops_after_diffuse(&self) -> bool {
+        !self.effects.continue_after_diffuse
+            && (self.scene.sensors().is_none() || self.effects.mode == EffectsMode::DirectOnly)
+    }
+
+    /// Adds a path segment's bundle (reaching `reach`, or infinity) to every sensor cell it
+    /// crosses on the front side: the radiant weight, the luminous weight (times `683 ybar`)
+    /// and its square.
+    #[inline]
+    fn fill_sensors<S: Splat + ?Sized>(
+        &self,
+        ray: &Ray,
+        reach: Option<f64>,
+        b: &Bundle,
+        film: &mut S,
+    ) {
+        let Some(sensors) = self.scene.sensors() else { return };
+        let (lambdas, weights) = (&b.lambdas[..b.len], &b.weights[..b.len]);
+        let reach = reach.unwrap_or(f64::INFINITY);
+        sensors.crossings(ray.origin, ray.direction, reach, |cell| {
+            let radiant: f64 = weights.iter().sum();
+            let luminous: f64 =
+                lambdas.iter().zip(weights).map(|(&l, &w)| w * lumens_per_watt(l)).sum();
+            film.splat_sensor(cell, [radiant, luminous, luminous * luminous]);
+        });
+    }
+}

@@ -1,0 +1,436 @@
+//! The path tracer: paths from the camera, with next-event estimation and multiple importance
+//! sampling (pbrt's `PathIntegrator`, spectral with hero wavelengths).
+//!
+//! # Estimator
+//! A camera sample for pixel `p` is a ray through a uniform point of the pixel (and of the lens),
+//! carrying [`HERO`] wavelengths drawn by [`CameraWavelengths`]. At every surface hit `x`:
+//! - **Emission**: if `x` emits (an area light's surface or a glowing object), its radiance is
+//!   added, weighted by the power heuristic against the density with which next-event
+//!   estimation would have chosen `x` ([`LightTracerScene::emitter_pdf`]; full weight for the
+//!   camera's own ray and after a specular bounce, which next-event estimation cannot produce).
+//! - **Next-event estimation** (at non-specular surfaces): every delta-position light (points,
+//!   spots) once, fully weighted (only this strategy reaches them, and sampling each instead of
+//!   choosing one removes the variance of the choice for a shadow ray per light); and one of the
+//!   other lights chosen by the scene's light sampler ([`LightTracerScene::area_lights`]), a
+//!   point on it by its `sample_towards`, weighted by the power heuristic against BSDF sampling.
+//! - **BSDF sampling** chooses the next direction ([`spectrace_materials::Transport::Radiance`]:
+//!   refraction scales radiance by `(n_i / n_t)^2`); specular chains are followed, so glass and
+//!   mirrors show what they reflect and refract.
+//! - After `rr_depth` bounces, Russian roulette by the shared rule (survival
+//!   `min(1, max_j beta_j)`).
+//! - **Fluorescence**: at a fluorescent surface the path first chooses between the elastic part
+//!   and re-emission ([`spectrace_materials::Fluorescent::choose_adjoint`]). Re-emission draws the
+//!   wavelength the light had before it was absorbed from the absorption spectrum, half the time
+//!   times the lights' spectrum ([`ExcitationSampler`]: where light is both absorbed and
+//!   emitted); every hero wavelength then *travels* at it (the kernel is separable) while the
+//!   film still records each at its own wavelength, and next-event estimation and the next
+//!   direction use the white re-emission lobe.
+//!
+//! The film holds the sum of the samples' XYZ (`sum_j cmf(lambda_j) L_j / (HERO p(lambda_j))`,
+//! divided by the integral of `ybar`, as the light tracer's units) relative to the lights' total
+//! power; [`Integrator::image_scale`] multiplies by the power and divides by the samples per
+//! pixel.
+//!
+//! # Work items and determinism
+//! A work item is one camera sample; a chunk is one *pass* (see `pass`): one sample of every
+//! pixel, never cut short, so every pixel has had the same number of samples and the image is
+//! the plain mean, bit-identical for any thread count or shard split.
+//!
+//! # What it cannot see
+//! Lights that have no `sample_towards` (lasers, parallel skies, lights that only implement the
+//! seed's beam generator) are never reached by a camera path: their light is missing from a
+//! path-traced image. The effects analysis does not choose this integrator for such scenes.
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+use spectrace_geometry::{Hit, Ray};
+use spectrace_lights::{LightId, LightSource};
+use spectrace_materials::{ExcitationSampler, Material, ScatterKind, Transport};
+
+use super::common::{
+    CameraSamples, Direction, End, SampleLayout, VertexSamples, choose_lobe,
+    connect_light_to_camera, power_heuristic, relative_throughput, roulette, sample_light,
+    unoccluded,
+};
+use super::pass::{PassEstimator, pixel_of};
+use crate::light_sampler::LightSampler;
+use crate::{CameraWavelengths, ChunkSampler, Effects, HERO, LightTracerScene, Splat, TraceStats};
+
+/// Settings of the path tracer.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PathTracerSettings {
+    /// Most bounces a path may make, counted as the light tracer counts them: at most
+    /// `max_depth + 1` scattering vertices (0: direct light on the first surface the camera sees).
+    pub max_depth: u32,
+    /// Bounces after which Russian roulette may end a path.
+    pub rr_depth: u32,
+    /// How camera paths draw their wavelengths.
+    pub wavelengths: CameraWavelengths,
+}
+
+impl Default for PathTracerSettings {
+    fn default() -> Self {
+        Self { max_depth: 64, rr_depth: 4, wavelengths: CameraWavelengths::Visible }
+    }
+}
+
+/// The path tracer as an [`Integrator`]; a work item is one camera sample, a chunk one pass over
+/// the image.
+#[derive(Debug, Clone)]
+pub struct PathTracer<'a> {
+    scene: &'a LightTracerScene<'a>,
+    settings: PathTracerSettings,
+    effects: Effects,
+    layout: SampleLayout,
+    /// Per material (by shape index), for fluorescent ones: the sampler of the wavelength light
+    /// had before re-emission, guided by the lights' spectrum (empty without fluorescence).
+    excitation: Vec<Option<ExcitationSampler>>,
+}
+
+/// The state of one camera path between bounces.
+struct PathState {
+    ray: Ray,
+    /// Throughput per hero wavelength.
+    beta: [f64; HERO],
+    /// Radiance gathered so far per hero wavelength.
+    radiance: [f64; HERO],
+    /// The wavelengths light travels at along the path; they differ from the film's beyond a
+    /// fluorescent re-emission.
+    transport: [f64; HERO],
+    /// The previous vertex and the density of the direction that left it (for MIS on emission).
+    prev_point: DVec3,
+    prev_pdf: f64,
+    /// The direction that reached this vertex came from a delta lobe (or the camera).
+    specular: bool,
+    depth: u32,
+    /// Only the emission the next ray hits is still wanted.
+    last_bounce: bool,
+    /// A dispersive surface has left the hero alone.
+    collapsed: bool,
+}
+
+impl PathState {
+    fn new(ray: Ray, lambdas: &[f64; HERO]) -> Self {
+        Self {
+            ray,
+            beta: [1.0; HERO],
+            radiance: [0.0; HERO],
+            transport: *lambdas,
+            prev_point: ray.origin,
+            prev_pdf: 0.0,
+            specular: true,
+            depth: 0,
+            last_bounce: false,
+            collapsed: false,
+        }
+    }
+
+    /// Adds `le` (whole spectrum, times light `light`'s SPD) weighted by `weight`.
+    fn add_emission(&mut self, scene: &LightTracerScene<'_>, light: LightId, le: f64, weight: f64) {
+        let Some(spd) = scene.light_spd(light) else { return };
+        if weight > 0.0 {
+            for j in 0..HERO {
+                if self.beta[j] != 0.0 {
+                    self.radiance[j] += self.beta[j] * le * spd.value(self.transport[j]) * weight;
+                }
+            }
+        }
+    }
+
+    /// At a dispersive surface: the hero alone continues (its film weight times [`HERO`]).
+    fn collapse(&mut self, lambda_weights: &mut [f64; HERO]) {
+        self.collapsed = true;
+        lambda_weights[0] *= HERO as f64;
+        lambda_weights[1..].fill(0.0);
+        self.beta[1..].fill(0.0);
+    }
+}
+
+impl<'a> PathTracer<'a> {
+    /// The path tracer's [`Integrator::name`].
+    pub const NAME: &'static str = "path";
+
+    /// A path tracer of `scene`, following the `effects` decision (interreflection or not).
+    pub fn new(
+        scene: &'a LightTracerScene<'a>,
+        settings: PathTracerSettings,
+        effects: Effects,
+    ) -> Self {
+        let excitation = if scene.materials.iter().any(|m| m.fluorescence().is_some()) {
+            let lights = LightSource::spd(scene.lights);
+            let spectrum = |l: f64| lights.value(l);
+            scene
+                .materials
+                .iter()
+                .map(|m| m.fluorescence().map(|f| f.excitation_sampler(&spectrum)))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let layout = SampleLayout::new(scene, true);
+        Self { scene, settings, effects, layout, excitation }
+    }
+
+    /// Pixels in the image: the work items of one pass (one chunk).
+    pub fn pass_samples(&self) -> u64 {
+        u64::from(self.scene.camera.width()) * u64::from(self.scene.camera.height())
+    }
+
+    /// The radiance estimate of one camera ray at the path's wavelengths, added to the film.
+    fn sample_pixel(
+        &self,
+        px: u32,
+        py: u32,
+        rng: &mut ChunkSampler,
+        film: &mut dyn Splat,
+        stats: &mut TraceStats,
+    ) {
+        let u = CameraSamples::draw(&self.layout, rng);
+        let camera_ray = self.scene.camera.generate_ray(px, py, u.film, u.lens);
+        let ray = Ray { origin: camera_ray.origin, direction: camera_ray.direction };
+        let (lambdas, mut lambda_weights) = self.settings.wavelengths.sample_hero(u.wavelength);
+        let radiance = self.radiance(ray, &lambdas, &mut lambda_weights, rng, stats);
+        // The film holds radiance relative to the lights' total power (see `image_scale`).
+        let inv_power = 1.0 / self.scene.lights.power();
+        let values: [f64; HERO] =
+            std::array::from_fn(|j| radiance[j] * lambda_weights[j] * inv_power);
+        film.splat_spectral(px, py, &lambdas, &values);
+    }
+
+    /// Radiance arriving along `ray` at each of the path's wavelengths (spectral, W m^-2 sr^-1
+    /// nm^-1). A dispersive surface collapses the wavelengths to the hero (`lambda_weights[0]`
+    /// multiplied by [`HERO`], the others set to 0).
+    pub(crate) fn radiance(
+        &self,
+        ray: Ray,
+        lambdas: &[f64; HERO],
+        lambda_weights: &mut [f64; HERO],
+        rng: &mut dyn rand::Rng,
+        stats: &mut TraceStats,
+    ) -> [f64; HERO] {
+        let scene = self.scene;
+        let mut p = PathState::new(ray, lambdas);
+        while let Some(hit) = scene.world.intersect(&p.ray, f64::INFINITY) {
+            stats.hits += 1;
+            let wo = -p.ray.direction;
+            if let Some((light, le)) = scene.emitted(&hit, wo) {
+                let weight = if p.specular {
+                    1.0
+                } else {
+                    power_heuristic(p.prev_pdf, scene.emitter_pdf(p.prev_point, &hit))
+                };
+                p.add_emission(scene, light, le, weight);
+            }
+            if p.last_bounce {
+                break;
+            }
+            let Some(material) = scene.materials.get(hit.primitive as usize) else { break };
+            let u = VertexSamples::draw(&self.layout, rng);
+            let guide = self.excitation.get(hit.primitive as usize).and_then(Option::as_ref);
+            let direction = Direction::Adjoint(guide);
+            let Some(lobe) = choose_lobe(
+                material.as_ref(),
+                direction,
+                &mut p.transport,
+                &mut p.beta,
+                u.fluorescence,
+                stats,
+            ) else {
+                break;
+            };
+            let material = lobe.material();
+            if material.is_dispersive() && !p.collapsed {
+                p.collapse(lambda_weights);
+            }
+            if !self.bounce(&mut p, &hit, wo, material, &u, stats) {
+                break;
+            }
+        }
+        p.radiance
+    }
+
+    /// Next-event estimation at a non-specular vertex, then the BSDF sample and Russian
+    /// roulette; `false` when the path ends here.
+    fn bounce(
+        &self,
+        p: &mut PathState,
+        hit: &Hit,
+        wo: DVec3,
+        material: &dyn Material,
+        u: &VertexSamples,
+        stats: &mut TraceStats,
+    ) -> bool {
+        if !material.is_specular() {
+            self.next_event(p, hit, wo, material, u.light, stats);
+            if !self.effects.continue_after_diffuse {
+                // No light can come back to a non-specular surface by interreflection: only
+                // an emitter seen by the BSDF-sampled ray remains (for MIS).
+                p.last_bounce = true;
+            }
+        }
+        if p.depth >= self.settings.max_depth && !p.last_bounce {
+            // The deepest vertex: one more ray, only for the emission it may hit (the BSDF
+            // half of this vertex's MIS pair), as the light tracer's deepest connection.
+            stats.depth_limited += 1;
+            p.last_bounce = true;
+        }
+        let Some(scattered) = material.scatter_bundle(
+            p.ray.direction,
+            hit.shading_normal,
+            &p.transport[..],
+            &mut p.beta,
+            u.scatter,
+            Transport::Radiance,
+        ) else {
+            return false;
+        };
+        p.specular = scattered.kind == ScatterKind::Specular;
+        p.prev_pdf = scattered.pdf;
+        p.prev_point = hit.point;
+        p.depth += 1;
+        if p.depth > self.settings.rr_depth && !p.last_bounce {
+            let relative = relative_throughput(&p.beta, &[1.0; HERO]);
+            let Some(survive) = roulette(relative, u.roulette, stats) else { return false };
+            for b in &mut p.beta {
+                *b /= survive;
+            }
+        }
+        if p.beta.iter().all(|&b| b == 0.0) {
+            return false;
+        }
+        p.ray = hit.spawn_ray(scattered.direction);
+        true
+    }
+
+    /// Next-event estimation at a non-specular `hit` seen from `wo`: every delta-position light
+    /// (points, spots) once, and one area light chosen by the scene's light sampler, weighted by
+    /// the power heuristic against BSDF sampling; added to the path's radiance.
+    fn next_event(
+        &self,
+        p: &mut PathState,
+        hit: &Hit,
+        wo: DVec3,
+        material: &dyn Material,
+        u: [f64; 2],
+        stats: &mut TraceStats,
+    ) {
+        for &id in self.scene.delta_lights() {
+            self.connect_light(p, hit, wo, material, id, 1.0, [0.5, 0.5], stats);
+        }
+        if let Some(chosen) = self.scene.area_lights().sample(u[0]) {
+            self.connect_light(
+                p,
+                hit,
+                wo,
+                material,
+                chosen.id,
+                chosen.pmf,
+                [chosen.u, u[1]],
+                stats,
+            );
+        }
+    }
+
+    /// One light sample of light `id` (chosen with probability `pmf`) seen from `hit`, weighted
+    /// by the power heuristic against BSDF sampling (fully for a delta light), added to the
+    /// path's radiance.
+    #[allow(clippy::too_many_arguments)]
+    fn connect_light(
+        &self,
+        p: &mut PathState,
+        hit: &Hit,
+        wo: DVec3,
+        material: &dyn Material,
+        id: LightId,
+        pmf: f64,
+        u: [f64; 2],
+        stats: &mut TraceStats,
+    ) {
+        let scene = self.scene;
+        let Some(sample) = sample_light(scene, id, hit.point, u) else { return };
+        let wi = -sample.direction;
+        let n = hit.shading_normal;
+        let cos = wi.dot(n).abs();
+        if !(cos > 0.0 && pmf > 0.0) {
+            return;
+        }
+        let weight = if sample.delta {
+            1.0
+        } else {
+            power_heuristic(pmf * sample.pdf, material.pdf(wo, wi, n, p.transport[0]))
+        };
+        if !(weight > 0.0) || !unoccluded(scene, End::Surface(hit), End::Light(id, sample.position))
+        {
+            return;
+        }
+        stats.splats += 1;
+        let Some(spd) = scene.light_spd(id) else { return };
+        let g = sample.intensity * cos / (sample.distance * sample.distance * pmf) * weight;
+        let mut f = [0.0; HERO];
+        material.eval_bundle(wi, wo, n, &p.transport, Transport::Radiance, &mut f);
+        for (j, f) in f.into_iter().enumerate() {
+            if p.beta[j] != 0.0 && f > 0.0 {
+                p.radiance[j] += p.beta[j] * f * g * spd.value(p.transport[j]);
+            }
+        }
+    }
+
+    /// Point and spot lights seen directly: a camera ray never hits a point, but the pixel a
+    /// point light projects into receives its intensity towards the camera times the camera's
+    /// importance (a finite pixel value, as the light tracer and BDPT show it). Once per pass,
+    /// exactly (the light's colour is its SPD's XYZ integral, not a sampled wavelength), or with
+    /// one lens sample per pass for a thin lens.
+    fn splat_delta_lights(
+        &self,
+        rng: &mut dyn rand::Rng,
+        film: &mut dyn Splat,
+        stats: &mut TraceStats,
+    ) {
+        let scene = self.scene;
+        let inv_y = 1.0 / *spectrace_spectrum::CIE_Y_INTEGRAL;
+        for &id in scene.delta_lights() {
+            let u_lens = self.layout.lens(rng);
+            let (Some(light), Some(spd)) = (scene.lights.light(id), scene.light_spd(id)) else {
+                continue;
+            };
+            let Some(origin) = light.sample_emission([0.5; 4]).map(|e| e.position) else {
+                continue;
+            };
+            let Some((seen, value)) = connect_light_to_camera(scene, id, origin, u_lens) else {
+                continue;
+            };
+            // Relative to the lights' total power, as every sample of this film.
+            let value = value * light.power() / scene.lights.power() * inv_y;
+            if film.splat(seen.x, seen.y, spectrace_spectrum::xyz_of(spd.as_ref()) * value) {
+                stats.splats += 1;
+            }
+        }
+    }
+}
+
+impl PassEstimator for PathTracer<'_> {
+    const NAME: &'static str = PathTracer::NAME;
+    type Scratch = ();
+
+    fn scene(&self) -> &LightTracerScene<'_> {
+        self.scene
+    }
+
+    fn scratch(&self) {}
+
+    fn start_pass(&self, rng: &mut ChunkSampler, film: &mut dyn Splat, stats: &mut TraceStats) {
+        self.splat_delta_lights(rng, film, stats);
+    }
+
+    fn sample(
+        &self,
+        item: u64,
+        _: &mut (),
+        rng: &mut ChunkSampler,
+        film: &mut dyn Splat,
+        stats: &mut TraceStats,
+    ) {
+        let (px, py) = pixel_of(item, u64::from(self.scene.camera.width()));
+        self.sample_pixel(px, py, rng, film, stats);
+    }
+}

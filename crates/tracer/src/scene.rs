@@ -1,0 +1,297 @@
+//! The scene every estimator traces, [`LightTracerScene`]: geometry, one material per shape,
+//! the lights with the samplers that choose among them, what each shape emits ([`Emitter`]),
+//! the camera and the sensors. It answers the questions estimators share: what a hit emits and
+//! with what density next-event estimation would have picked it, the first hit of a ray leaving
+//! a light's own surface, and what the scene contains (for the effects analysis).
+
+use std::sync::Arc;
+
+use glam::DVec3;
+use spectrace_geometry::{Hit, Ray, World};
+use spectrace_lights::{LightId, LightSet};
+use spectrace_materials::Material;
+use spectrace_spectrum::SpectralPowerDistribution;
+
+use crate::light_sampler::{LightSampler, PowerLightSampler};
+use crate::{PinholeCamera, SamplerKind, SceneFeatures, SensorSet};
+
+/// What a light tracer traces: geometry, one material per shape, the lights and the camera.
+#[derive(Debug, Clone)]
+pub struct LightTracerScene<'a> {
+    /// All shapes, in one BVH.
+    pub world: &'a World,
+    /// The material of each shape, indexed like the shapes given to the world.
+    pub materials: &'a [Arc<dyn Material>],
+    /// The lights the beams come from.
+    pub lights: &'a LightSet,
+    /// The camera that receives the connections.
+    pub camera: &'a PinholeCamera,
+    /// The spectrum of each light of the set, cached (bundled wavelengths are drawn from the
+    /// spectrum of the beam's own light).
+    spds: Vec<Arc<dyn SpectralPowerDistribution>>,
+    /// What each shape emits, indexed like `materials` (empty: nothing emits).
+    emitters: Vec<Option<Emitter>>,
+    /// The shape that is the surface of each light of the set, if any.
+    light_shapes: Vec<Option<u32>>,
+    /// How many of the shapes are the scene's objects (the first ones); the rest are the
+    /// surfaces of area lights, which the effects analysis does not count.
+    object_shapes: usize,
+    /// Where the integrators' random numbers come from.
+    sampler: SamplerKind,
+    /// The illuminance sensors the light paths fill (see [`crate::IrradianceSensor`]).
+    sensors: Option<&'a SensorSet>,
+    /// Fill only the sensors: no connections to the camera (a sensor pass beside a camera
+    /// integrator's image).
+    sensors_only: bool,
+    /// Next-event estimation's choice among the lights camera paths can sample by area (not
+    /// delta in position or direction), by power.
+    area_lights: PowerLightSampler,
+    /// Every light, by power: the choice of a light vertex given a wavelength (BDPT).
+    all_lights: PowerLightSampler,
+    /// The lights with a delta position and a spread of directions (points, spots): sampled
+    /// one by one, never chosen, since no ray can hit them.
+    delta_lights: Vec<LightId>,
+}
+
+/// Light leaving a shape's surface: which light of the set it belongs to, so that camera paths
+/// that hit the shape see it and weigh it against next-event estimation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Emitter {
+    /// The surface of an area light of the set (see [`spectrace_lights::LightSource::surface`]):
+    /// its radiance is the light's [`spectrace_lights::LightSource::emitted_radiance`].
+    Light(LightId),
+    /// An object made to glow (`objects[i].emission`): a Lambertian emitter of `radiance`
+    /// (W m^-2 sr^-1, whole spectrum: times the light's SPD) on the outward side of its
+    /// geometric normal (both sides when `two_sided`), sampled uniformly over its `area` (m^2)
+    /// by light `light` of the set.
+    Object {
+        /// The light of the set that emits beams from this shape.
+        light: LightId,
+        /// Radiance (whole spectrum).
+        radiance: f64,
+        /// Whether both sides emit.
+        two_sided: bool,
+        /// Area (m^2).
+        area: f64,
+    },
+}
+
+impl Emitter {
+    /// The light of the set this emitter belongs to.
+    pub fn light(&self) -> LightId {
+        match *self {
+            Emitter::Light(id) | Emitter::Object { light: id, .. } => id,
+        }
+    }
+}
+
+impl<'a> LightTracerScene<'a> {
+    /// Assembles a scene.
+    pub fn new(
+        world: &'a World,
+        materials: &'a [Arc<dyn Material>],
+        lights: &'a LightSet,
+        camera: &'a PinholeCamera,
+    ) -> Self {
+        let spds = lights.lights().iter().map(|l| l.spd()).collect();
+        let area_lights = PowerLightSampler::new(lights, |l| {
+            l.flags().is_some_and(|f| !f.delta_position && !f.delta_direction)
+        });
+        let delta_lights = lights
+            .lights()
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| l.flags().is_some_and(|f| f.delta_position && !f.delta_direction))
+            .map(|(i, _)| LightId(i as u32))
+            .collect();
+        Self {
+            world,
+            materials,
+            lights,
+            camera,
+            spds,
+            emitters: Vec::new(),
+            light_shapes: Vec::new(),
+            object_shapes: materials.len(),
+            sampler: SamplerKind::Independent,
+            sensors: None,
+            sensors_only: false,
+            area_lights,
+            all_lights: PowerLightSampler::new(lights, |_| true),
+            delta_lights,
+        }
+    }
+
+    /// The same scene with illuminance sensors, which the light tracer fills (through
+    /// [`Splat::splat_sensor`], into cells after the film's pixels: see
+    /// [`crate::Film::with_sensor_cells`]).
+    pub fn with_sensors(mut self, sensors: &'a SensorSet) -> Self {
+        self.sensors = (!sensors.is_empty()).then_some(sensors);
+        self
+    }
+
+    /// The same scene traced for its sensors only: beams are not connected to the camera, so
+    /// the image stays black and the sensors fill at less cost.
+    pub fn sensors_only(mut self) -> Self {
+        self.sensors_only = true;
+        self
+    }
+
+    /// Whether only the sensors are filled (no connections to the camera).
+    pub fn is_sensors_only(&self) -> bool {
+        self.sensors_only
+    }
+
+    /// Next-event estimation's light sampler: the lights that camera paths sample by area
+    /// (area lights, glowing objects, luminaires with a surface), by power.
+    pub fn area_lights(&self) -> &PowerLightSampler {
+        &self.area_lights
+    }
+
+    /// Every light by power, for choices given a wavelength
+    /// ([`PowerLightSampler::sample_given`]).
+    pub fn all_lights(&self) -> &PowerLightSampler {
+        &self.all_lights
+    }
+
+    /// The lights with a delta position (points, spots, measured luminaires): next-event
+    /// estimation samples each of them at every vertex.
+    pub fn delta_lights(&self) -> &[LightId] {
+        &self.delta_lights
+    }
+
+    /// The scene's sensors (none if it has none).
+    pub fn sensors(&self) -> Option<&'a SensorSet> {
+        self.sensors
+    }
+
+    /// The same scene, rendered with random numbers from `sampler`.
+    pub fn with_sampler(mut self, sampler: SamplerKind) -> Self {
+        self.sampler = sampler;
+        self
+    }
+
+    /// Where the integrators' random numbers come from.
+    pub fn sampler(&self) -> SamplerKind {
+        self.sampler
+    }
+
+    /// The same scene where shape `i` emits `emitters[i]` (missing entries emit nothing), and
+    /// only the first `object_shapes` shapes are the scene's objects (the rest are the surfaces
+    /// of area lights).
+    pub fn with_emitters(mut self, emitters: Vec<Option<Emitter>>, object_shapes: usize) -> Self {
+        let mut light_shapes = vec![None; self.lights.lights().len()];
+        for (shape, e) in emitters.iter().enumerate() {
+            if let Some(e) = e
+                && let Some(slot) = light_shapes.get_mut(e.light().0 as usize)
+            {
+                *slot = Some(shape as u32);
+            }
+        }
+        self.light_shapes = light_shapes;
+        self.emitters = emitters;
+        self.object_shapes = object_shapes.min(self.materials.len());
+        self
+    }
+
+    /// The first hit of a ray that starts on the surface of light `light` (a beam's emission
+    /// point): a hit of the light's own surface within rounding distance of the start is the
+    /// start itself, and is skipped by continuing from it with the geometry's robust offset.
+    pub fn intersect_from_light(&self, ray: &Ray, light: LightId, t_max: f64) -> Option<Hit> {
+        let hit = self.world.intersect(ray, t_max)?;
+        let own = self.light_shapes.get(light.0 as usize).copied().flatten();
+        let scale = 1.0 + ray.origin.abs().max_element();
+        if own == Some(hit.primitive) && hit.t <= 1e-9 * scale {
+            let next = hit.spawn_ray(ray.direction);
+            let travelled = (next.origin - ray.origin).length();
+            return self.world.intersect(&next, t_max - travelled);
+        }
+        Some(hit)
+    }
+
+    /// What shape `primitive` emits.
+    #[inline]
+    pub fn emitter(&self, primitive: u32) -> Option<&Emitter> {
+        self.emitters.get(primitive as usize).and_then(Option::as_ref)
+    }
+
+    /// The spectrum of light `id` of the set.
+    #[inline]
+    pub fn light_spd(&self, id: LightId) -> Option<&Arc<dyn SpectralPowerDistribution>> {
+        self.spds.get(id.0 as usize)
+    }
+
+    /// Radiance (whole spectrum; times the light's SPD) leaving `hit` towards the unit
+    /// `direction`, with the light it belongs to; `None` where the shape does not emit.
+    pub fn emitted(&self, hit: &Hit, direction: DVec3) -> Option<(LightId, f64)> {
+        let emitter = self.emitter(hit.primitive)?;
+        let radiance = match *emitter {
+            Emitter::Light(id) => self.lights.light(id)?.emitted_radiance(hit.point, direction),
+            Emitter::Object { radiance, two_sided, .. } => {
+                let c = direction.dot(hit.geometric_normal);
+                if c > 0.0 || (two_sided && c < 0.0) { radiance } else { 0.0 }
+            }
+        };
+        (radiance > 0.0).then_some((emitter.light(), radiance))
+    }
+
+    /// Solid-angle density (at `receiver`) with which next-event estimation (a light chosen by
+    /// [`Self::area_lights`], then a point by its `sample_towards`) picks the emitting point
+    /// `hit`; 0 where the shape does not emit or the light is not among the area lights.
+    pub fn emitter_pdf(&self, receiver: DVec3, hit: &Hit) -> f64 {
+        let Some(emitter) = self.emitter(hit.primitive) else { return 0.0 };
+        let pmf = self.area_lights.pmf(emitter.light());
+        if !(pmf > 0.0) {
+            return 0.0;
+        }
+        match *emitter {
+            Emitter::Light(id) => {
+                self.lights.light(id).map_or(0.0, |l| pmf * l.pdf_towards(receiver, hit.point))
+            }
+            Emitter::Object { area, .. } => {
+                let to = receiver - hit.point;
+                let d2 = to.length_squared();
+                let cos = (to.dot(hit.geometric_normal) / d2.sqrt()).abs();
+                if cos > 0.0 && area > 0.0 { pmf * d2 / (area * cos) } else { 0.0 }
+            }
+        }
+    }
+
+    /// What the scene contains, for the effects analysis.
+    pub fn features(&self, shapes_non_convex: &[bool]) -> SceneFeatures {
+        let mut f = SceneFeatures {
+            light_spectra_vary: self.lights.lights().iter().any(|l| !l.uniform_spectrum()),
+            ..SceneFeatures::default()
+        };
+        for light in self.lights.lights() {
+            match light.flags() {
+                None => f.beam_only_lights += 1,
+                Some(flags) if flags.delta_direction => f.delta_direction_lights += 1,
+                Some(flags) if flags.delta_position => f.delta_position_lights += 1,
+                Some(_) => f.area_lights += 1,
+            }
+            let spd = light.spd();
+            let (lo, hi) = spd.range();
+            f.line_spectra |= !(hi > lo)
+                || (spectrace_spectrum::integrate_panels(
+                    &|l| spd.value(l),
+                    lo,
+                    hi,
+                    &spd.breakpoints(),
+                ) - 1.0)
+                    .abs()
+                    > 1e-6;
+        }
+        for (i, m) in self.materials.iter().enumerate().take(self.object_shapes) {
+            f.dispersive |= m.is_dispersive();
+            f.fluorescent |= m.fluorescence().is_some();
+            if m.is_specular() {
+                f.specular = true;
+            } else {
+                f.non_specular_shapes += 1;
+                f.non_convex_non_specular |= shapes_non_convex.get(i).copied().unwrap_or(true);
+            }
+        }
+        f
+    }
+}
