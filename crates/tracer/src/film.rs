@@ -154,7 +154,7 @@ impl Film {
     /// An empty film.
     ///
     /// # Errors
-    /// [`FilmError::InvalidSize`] for a zero dimension or more than [`MAX_PIXELS`] pixels (each
+    /// [`FilmError::InvalidSize`] for a zero dimension or more than [`crate::MAX_PIXELS`] pixels (each
     /// pixel takes 48 bytes; see [`Film::bytes_for`]).
     pub fn new(width: u32, height: u32) -> Result<Self, FilmError> {
         Self::with_sensor_cells(width, height, 0)

@@ -4,24 +4,36 @@
 //! This crate sits on all the others (sampling, spectrum, lights, geometry, materials) and under
 //! the renderer. A [`LightTracerScene`] holds what every estimator needs: the
 //! [`spectrace_geometry::World`], one [`spectrace_materials::Material`] per shape, the
-//! [`spectrace_lights::LightSet`] (also the light sampler), what each shape emits ([`Emitter`]:
-//! area lights' own surfaces and glowing objects, [`ObjectLight`]) and the [`PinholeCamera`]
-//! (a pinhole or a thin lens). [`LightTracer`] follows beams from the lights and connects them to
-//! the camera; [`PathTracer`] follows camera paths with next-event estimation and multiple
-//! importance sampling, carrying [`HERO`] wavelengths; [`Bdpt`] joins a camera path and a light
-//! path in every way and weighs the strategies by MIS. [`IntegratorChoice::decide`] picks one from
-//! what the scene holds. The render loop ([`render`]) drives any of them.
+//! [`spectrace_lights::LightSet`] with the one light sampler every estimator asks
+//! ([`PowerLightSampler`]), what each shape emits ([`Emitter`]: area lights' own surfaces and
+//! glowing objects, [`ObjectLight`]) and the [`PinholeCamera`] (a pinhole or a thin lens).
+//! [`LightTracer`] follows beams from the lights and connects them to the camera; [`PathTracer`]
+//! follows camera paths with next-event estimation and multiple importance sampling, carrying
+//! [`HERO`] wavelengths; [`Bdpt`] joins a camera path and a light path in every way and weighs the
+//! strategies by MIS. [`IntegratorChoice::decide`] picks one from what the scene holds, the
+//! registry ([`INTEGRATORS`], [`build_integrator`]) builds it, and the render loop ([`render`])
+//! drives any of them.
+//!
+//! The layout follows the jobs: `scene` (what is traced), `integrators` (one module per estimator,
+//! over `integrators/common`, the transport steps they share, and `integrators/pass`, the camera
+//! estimators' pass loop), `film` and `raster` (exact sums and their size rules), `estimate`
+//! (the error from the spread between chunks), `render` (threads, chunks, memory), `sampler` (the
+//! random streams), `effects` (what the scene needs).
 //!
 //! The key design decisions: the film adds contributions in exact fixed point ([`ExactSum`]), so
 //! an image is bit-identical whatever the thread count, chunk order or number of machines
 //! ([`render`] splits work into chunks with their own random streams; sharded renders merge
 //! exactly), and every estimator writes the same film units, so their images can be compared
-//! pixel by pixel; and an [`Effects`] analysis decides, before rendering, what the scene needs
-//! (which estimator, a bundle of wavelengths per path when nothing is dispersive, beams that stop
-//! at the first diffuse hit when no interreflection is possible, and whether any surface
-//! fluoresces, which makes every estimator choose between elastic scattering and re-emission at
-//! a new wavelength before it connects a vertex), reports it, and can be overridden. Because chunks are independent, the render loop also estimates the image's error
-//! as it goes, from the spread between chunks ([`Moments`]), with no reference.
+//! pixel by pixel; every transport step (a shadow ray, a connection to the camera, a light
+//! sample, the fluorescence choice, Russian roulette) is written once and shared, and every
+//! vertex draws a fixed set of uniforms, so that the estimators differ only in how they combine
+//! the steps; and an [`Effects`] analysis decides, before rendering, what the scene needs (which
+//! estimator, a bundle of wavelengths per path when nothing is dispersive, beams that stop at the
+//! first diffuse hit when no interreflection is possible, and whether any surface fluoresces,
+//! which makes every estimator choose between elastic scattering and re-emission at a new
+//! wavelength before it connects a vertex), reports it, and can be overridden. Because chunks
+//! are independent, the render loop also estimates the image's error as it goes, from the spread
+//! between chunks ([`Moments`]), with no reference.
 
 mod camera;
 mod effects;
@@ -38,13 +50,21 @@ mod sensor;
 mod stats;
 mod wavelengths;
 
+// The scene and what it is made of.
 pub use camera::{
     CameraError, CameraRay, CameraRepr, CameraSample, FovAxis, PinholeCamera, Projection,
 };
+pub use light_sampler::{LightSampler, PowerLightSampler, SampledLight};
+pub use object_light::{ObjectEmission, ObjectLight};
+pub use scene::{Emitter, LightTracerScene};
+pub use sensor::{
+    IrradianceSensor, MAX_SENSOR_CELLS, MAX_SENSOR_CELLS_PER_EDGE, SensorSet, SensorSums,
+};
+pub use wavelengths::{CAMERA_LAMBDA_MAX, CAMERA_LAMBDA_MIN, CameraWavelengths, HERO};
+
+// The estimators, their settings and their registry.
 pub use effects::{BUNDLE, Effects, EffectsMode, IntegratorChoice, SceneFeatures};
-pub use estimate::{ErrorEstimate, MIN_BATCHES, Moments};
-pub use film::{ExactSum, Film, FilmWriter, Splat, spectral_xyz};
-pub use integrators::bdpt::{Bdpt, BdptSettings, MisVertex, mis_weight};
+pub use integrators::bdpt::{Bdpt, BdptSettings};
 pub use integrators::light_tracer::{
     LightTracer, LightTracerSettings, MAX_DEPTH, image_scale, trace_chunk, trace_chunk_until,
 };
@@ -54,17 +74,14 @@ pub use integrators::{
     ChunkWork, INTEGRATORS, Integrator, IntegratorSettings, RegisteredIntegrator, build_integrator,
     registered,
 };
-pub use light_sampler::{LightSampler, PowerLightSampler, SampledLight};
-pub use object_light::{ObjectEmission, ObjectLight};
+
+// The film, the render loop and its error estimate.
+pub use estimate::{ErrorEstimate, MIN_BATCHES, Moments};
+pub use film::{ExactSum, Film, FilmWriter, Splat, spectral_xyz};
 pub use raster::{FilmError, MAX_PIXELS};
 pub use render::{
     DEFAULT_CHUNK_BEAMS, FALLBACK_MEMORY_LIMIT, MemoryLimit, Progress, RenderOutput, RenderPlan,
     render, render_observed,
 };
-pub use sampler::{ChunkSampler, SamplerKind, chunk_rng};
-pub use scene::{Emitter, LightTracerScene};
-pub use sensor::{
-    IrradianceSensor, MAX_SENSOR_CELLS, MAX_SENSOR_CELLS_PER_EDGE, SensorSet, SensorSums,
-};
+pub use sampler::{ChunkSampler, SamplerKind};
 pub use stats::TraceStats;
-pub use wavelengths::{CAMERA_LAMBDA_MAX, CAMERA_LAMBDA_MIN, CameraWavelengths, HERO};

@@ -13,7 +13,7 @@
 //!
 //! Both depend only on the seed and the chunk, so images stay bit-identical for any thread count
 //! or shard split. Draws past the sampler's table (256 dimensions), the low bits of every draw
-//! and draws outside a path come from the chunk's independent stream ([`crate::chunk_rng`]).
+//! and draws outside a path come from the chunk's independent stream (`chunk_rng`).
 //! Lights that draw a variable number of uniforms (rejection loops) shift the dimensions of the
 //! rest of their path: unbiased, but those draws lose their stratification.
 
@@ -28,7 +28,7 @@ use rand::SeedableRng;
 
 /// The generator of chunk `chunk` of a render with seed `seed` (SplitMix64 of both, so nearby
 /// seeds and chunks give unrelated streams).
-pub fn chunk_rng(seed: u64, chunk: u64) -> Pcg64 {
+pub(crate) fn chunk_rng(seed: u64, chunk: u64) -> Pcg64 {
     let mut z = seed ^ chunk.wrapping_mul(0x9E37_79B9_7F4A_7C15);
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
@@ -59,9 +59,9 @@ impl SamplerKind {
 /// The generator of one chunk: the chunk's independent stream, or Sobol points over it.
 #[derive(Debug, Clone)]
 pub enum ChunkSampler {
-    /// [`crate::chunk_rng`] alone.
+    /// `chunk_rng` alone.
     Independent(Pcg64),
-    /// Sobol points; [`crate::chunk_rng`] for the low bits and beyond the table.
+    /// Sobol points; `chunk_rng` for the low bits and beyond the table.
     Sobol(SobolSampler<Pcg64>),
 }
 

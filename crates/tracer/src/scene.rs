@@ -123,7 +123,7 @@ impl<'a> LightTracerScene<'a> {
     }
 
     /// The same scene with illuminance sensors, which the light tracer fills (through
-    /// [`Splat::splat_sensor`], into cells after the film's pixels: see
+    /// [`crate::Splat::splat_sensor`], into cells after the film's pixels: see
     /// [`crate::Film::with_sensor_cells`]).
     pub fn with_sensors(mut self, sensors: &'a SensorSet) -> Self {
         self.sensors = (!sensors.is_empty()).then_some(sensors);

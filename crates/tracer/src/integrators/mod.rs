@@ -10,7 +10,7 @@
 //! the memory check, but not which estimator runs. An integrator supplies the rest:
 //! - [`Integrator::render_chunk`]: the unit of work, `samples` work items of chunk `chunk`
 //!   (light paths for the light tracer; camera samples for the path tracer and BDPT, whose
-//!   samples each trace a light path too), drawn from the chunk's own random stream ([`crate::chunk_rng`]`(seed, chunk)`) and
+//!   samples each trace a light path too), drawn from the chunk's own random stream (`sampler::chunk_rng(seed, chunk)`) and
 //!   splatted into the film through [`Splat`];
 //! - [`Integrator::image_scale`]: the normalisation, the factor that turns the film's exact sums
 //!   into the image once `samples_done` work items have been done (for the light tracer, the

@@ -28,7 +28,7 @@
 //!
 //! The film holds the sum of the samples' XYZ (`sum_j cmf(lambda_j) L_j / (HERO p(lambda_j))`,
 //! divided by the integral of `ybar`, as the light tracer's units) relative to the lights' total
-//! power; [`Integrator::image_scale`] multiplies by the power and divides by the samples per
+//! power; [`crate::Integrator::image_scale`] multiplies by the power and divides by the samples per
 //! pixel.
 //!
 //! # Work items and determinism
@@ -74,7 +74,7 @@ impl Default for PathTracerSettings {
     }
 }
 
-/// The path tracer as an [`Integrator`]; a work item is one camera sample, a chunk one pass over
+/// The path tracer as an [`crate::Integrator`]; a work item is one camera sample, a chunk one pass over
 /// the image.
 #[derive(Debug, Clone)]
 pub struct PathTracer<'a> {
@@ -147,7 +147,7 @@ impl PathState {
 }
 
 impl<'a> PathTracer<'a> {
-    /// The path tracer's [`Integrator::name`].
+    /// The path tracer's [`crate::Integrator::name`].
     pub const NAME: &'static str = "path";
 
     /// A path tracer of `scene`, following the `effects` decision (interreflection or not).

@@ -4,10 +4,10 @@
 
 use spectrace_materials::Transport;
 
+use super::MisVertex;
 use super::mis::{Sampled, build_mis_path, mis_weight};
 use super::vertex::{LightEnd, NO_SAMPLES, Vertex, VertexKind, Wavelength, light_normal};
 use super::{Bdpt, Strategy};
-use crate::MisVertex;
 use crate::integrators::common::{
     End, connect_light_to_camera, connect_surface_to_camera, importance_cosine, sample_light,
     unoccluded,

@@ -11,17 +11,17 @@ use super::vertex::{LightEnd, Vertex};
 
 /// One vertex of a full path, as the MIS weight sees it (see [`mis_weight`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct MisVertex {
+pub(super) struct MisVertex {
     /// Area density (m^-2; for a point, solid-angle density over distance squared) with which
     /// the light side generates this vertex from the vertices before it; for the first vertex,
     /// the density of choosing it on the light. 0 through a specular vertex.
-    pub from_light: f64,
+    pub(super) from_light: f64,
     /// Area density with which the camera side generates this vertex from the vertices after
     /// it. 0 through a specular vertex.
-    pub from_camera: f64,
+    pub(super) from_camera: f64,
     /// Whether the vertex scatters by a Dirac delta (a specular surface), so that no connection
     /// can end at it; for the first vertex, a light with a delta direction.
-    pub delta: bool,
+    pub(super) delta: bool,
 }
 
 /// The power-heuristic weight of strategy `s` (the first `s` vertices from the light, the others
@@ -30,7 +30,7 @@ pub struct MisVertex {
 /// when `light_is_delta` (a light a camera path cannot hit), nor `t = 0` (the camera, pinhole or
 /// lens, is not part of the scene: paths never hit it). Zero densities (delta vertices) count as 1, so deltas cancel. `s` must be a valid
 /// strategy; the result is in `[0, 1]`.
-pub fn mis_weight(path: &[MisVertex], s: usize, light_is_delta: bool) -> f64 {
+pub(super) fn mis_weight(path: &[MisVertex], s: usize, light_is_delta: bool) -> f64 {
     let n = path.len();
     if n < 2 || s >= n {
         return 0.0;

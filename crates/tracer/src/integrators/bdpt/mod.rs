@@ -48,7 +48,7 @@
 //! items), as for the [`crate::PathTracer`]. As the path tracer's, the film holds the estimates
 //! divided by the lights' total power `Phi` (the renderer's normalisation of camera integrators,
 //! which keeps lights of any power in the film's fixed-point range), normalised per pixel sample:
-//! [`Integrator::image_scale`] `= Phi * pixels / samples`. Camera strategies (`t >= 2`) estimate the
+//! [`crate::Integrator::image_scale`] `= Phi * pixels / samples`. Camera strategies (`t >= 2`) estimate the
 //! pixel of their camera sample directly. A `t = 1` connection estimates the pixel it lands in,
 //! and one light path is traced per camera sample: a pass traces `pixels` light paths, which
 //! together make *one* light-tracing estimate of the whole image (each path's splat divided by
@@ -109,7 +109,7 @@ mod subpath;
 mod tests;
 mod vertex;
 
-pub use mis::{MisVertex, mis_weight};
+use mis::MisVertex;
 
 /// Settings of the bidirectional path tracer.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -17,7 +17,7 @@ use crate::integrators::common::{
 pub(crate) struct Buffers {
     pub(super) light: Vec<Vertex>,
     pub(super) camera: Vec<Vertex>,
-    pub(super) mis: Vec<crate::MisVertex>,
+    pub(super) mis: Vec<super::MisVertex>,
 }
 
 /// How a walk continues: the transport it follows, whether it may re-emit, and its length.

@@ -16,6 +16,7 @@ use spectrace_geometry::Ray;
 use spectrace_lights::{LightId, LightSource};
 use spectrace_spectrum::CIE_Y_INTEGRAL;
 
+use super::mis::mis_weight;
 use super::subpath::Buffers;
 use super::vertex::Wavelength;
 use super::*;
