@@ -29,9 +29,11 @@ use crate::{Beam, BeamCounter, LightError, LightFlags, LightId, LightSample, Lig
 /// (`lights()[parent].power() / lights()[parent].number_of_beams() * scale`) or, equivalently in
 /// expectation, from the set (`power() / number_of_beams() * scale`).
 ///
-/// For next-event estimation and bidirectional methods, choose a light with
-/// [`sample_light`](Self::sample_light) (probability [`pmf`](Self::pmf)) and ask that light,
-/// [`light(id)`](Self::light), for its densities: the set itself keeps the trait's defaults for
+/// Estimators that connect to lights (next-event estimation, bidirectional methods) choose a
+/// light with a light sampler (the renderer's is `spectrace_tracer::PowerLightSampler`, the same
+/// power choice as [`pmf`](Self::pmf)) and ask that light, [`light(id)`](Self::light), for its
+/// densities; [`sample_light`](Self::sample_light) is the set's own choice, which its
+/// [`sample_towards`](LightSource::sample_towards) uses. The set itself keeps the trait's defaults for
 /// the per-light methods (`emission_density`, `pdf_towards` and `emitted_radiance` 0,
 /// `sample_emission`, `pdf_emission` and `surface` `None`), since its lights differ in kind.
 /// Only [`sample_towards`](LightSource::sample_towards) is offered on the set, choosing the light
@@ -139,7 +141,8 @@ impl LightSet {
         self.lights.get(id.0 as usize).map(|l| l.as_ref())
     }
 
-    /// The light sampler for next-event estimation: chooses a light with probability
+    /// The set's own choice of a light (for its [`sample_towards`](LightSource::sample_towards)):
+    /// chooses a light with probability
     /// proportional to its power from a uniform `u`, and returns it with its probability mass
     /// ([`pmf`](Self::pmf)) and `u` remapped to a fresh uniform in `[0, 1)` for the light's own
     /// use. A `u` outside `[0, 1)` or NaN is clamped into it.
