@@ -21,9 +21,10 @@ use serde::{Deserialize, Serialize};
 use spectrace_lights::LightSource;
 use spectrace_tracer::{IntegratorChoice, MIN_BATCHES, Progress, RenderPlan, render_observed};
 
+use crate::warnings::integrator_warnings;
 use crate::{
-    RenderError, RenderOptions, Scene, choose_integrator, decide_effects, duration,
-    integrator_warnings, plan_with, with_integrator,
+    RenderError, RenderOptions, Scene, choose_integrator, decide_effects, duration, plan_with,
+    with_integrator,
 };
 
 /// Fewest chunks a live estimate of the pilot needs to enter the slope fit.

@@ -21,7 +21,7 @@ use spectrace_tracer::{
 };
 
 use crate::sensor_output::{SensorGrid, write_sensor_files};
-use crate::{RenderError, Scene, tracer_scene};
+use crate::{RenderError, Scene, SensorIntegrator, tracer_scene};
 
 /// One sensor's figures in the sidecar.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -270,4 +270,20 @@ pub fn sensor_summary(r: &SensorReport) -> String {
         "sensor {}: average {:.1} lx, min {:.1} lx, max {:.1} lx, U0 {:.2} ({error}, {} by {} beams)",
         r.name, r.average_lux, r.minimum_lux, r.maximum_lux, r.uniformity, r.filled_by, r.beams
     )
+}
+
+/// How a camera integrator's render fills the sensors: the setting, with `auto` resolved (the
+/// path tracer when every light can be sampled from a point, else light paths).
+pub fn sensor_integrator(scene: &Scene) -> SensorIntegrator {
+    match scene.settings.sensor_integrator {
+        SensorIntegrator::Auto => {
+            let f = tracer_scene(scene).features(&scene.non_convex);
+            if f.beam_only_lights == 0 && f.delta_direction_lights == 0 {
+                SensorIntegrator::Path
+            } else {
+                SensorIntegrator::Light
+            }
+        }
+        other => other,
+    }
 }

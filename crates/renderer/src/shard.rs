@@ -1,0 +1,155 @@
+//! Merging the partial films of a sharded render into the outputs one machine would write.
+
+use std::path::{Path, PathBuf};
+
+use spectrace_tracer::{Film, MemoryLimit, RenderOutput, TraceStats};
+
+use crate::report::report;
+use crate::write::{planned_outputs, write_sidecar};
+use crate::{PartialFilm, RenderError, RenderReport, normalisation, write_outputs};
+
+/// Merges the partial films of a sharded render into the final outputs, bit-identical to a
+/// one-machine render with the same seed.
+///
+/// Every part is read with a size limit and validated field by field ([`PartialFilm::decode`]);
+/// parts must come from the same render, may not share a chunk, and (without a time budget) must
+/// cover every chunk. Outputs go into `out_dir` under the parts' validated name and never replace
+/// a part file.
+///
+/// # Errors
+/// [`RenderError::File`] for an unreadable or invalid part (naming the file and the field);
+/// [`RenderError::Options`] when the parts do not belong together, overlap, miss chunks, or their
+/// counts overflow.
+pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, RenderError> {
+    let read = |path: &PathBuf| {
+        PartialFilm::read(path).map_err(|message| RenderError::File { path: path.clone(), message })
+    };
+    let Some(first_path) = parts.first() else {
+        return Err(RenderError::Options("merge needs at least one partial film".to_owned()));
+    };
+    // Parts are read one at a time: memory holds the merged film and one part, whatever their
+    // number. The first part's film becomes the merged film.
+    let mut first = read(first_path)?;
+    let (w, h) = (first.output.film.width(), first.output.film.height());
+    let limit = MemoryLimit::system();
+    let needed = Film::bytes_for(w, h).saturating_mul(2);
+    if needed > limit.bytes {
+        return Err(RenderError::Options(format!(
+            "merging {w}x{h} films needs {} (the merged film and one part), more than the {} \
+             this machine may use ({})",
+            spectrace_geometry::human_bytes(needed),
+            spectrace_geometry::human_bytes(limit.bytes),
+            limit.source
+        )));
+    }
+    planned_outputs(out_dir, &first.name, &first.output_settings, None, parts, Vec::new())?;
+    let placeholder = RenderOutput {
+        film: Film::new(1, 1).map_err(|e| RenderError::Options(e.to_string()))?,
+        stats: TraceStats::default(),
+        chunks: Vec::new(),
+        beams: 0,
+        seconds: 0.0,
+        moments: None,
+    };
+    let mut merged = std::mem::replace(&mut first.output, placeholder);
+    // Which part holds each chunk: coverage is checked by chunk identity, not by count.
+    let mut owner: std::collections::BTreeMap<u64, usize> =
+        merged.chunks.iter().map(|&c| (c, 0)).collect();
+    let mut seconds = vec![merged.seconds];
+    for (index, path) in parts.iter().enumerate().skip(1) {
+        let part = read(path)?;
+        let different = if part.scene_fingerprint != first.scene_fingerprint {
+            Some("scene")
+        } else if part.plan != first.plan {
+            Some("plan (beams, chunk size, seed or time budget)")
+        } else if part.effects != first.effects {
+            Some("effects decision")
+        } else if part.name != first.name || part.output_settings != first.output_settings {
+            Some("output settings")
+        } else if part.integrator != first.integrator {
+            Some("integrator")
+        } else if part.sampler != first.sampler {
+            Some("sampler")
+        } else if part.light_power.to_bits() != first.light_power.to_bits() {
+            Some("light power")
+        } else if (part.output.film.width(), part.output.film.height()) != (w, h) {
+            Some("image size")
+        } else {
+            None
+        };
+        if let Some(what) = different {
+            return Err(RenderError::Options(format!(
+                "{}: belongs to another render: its {what} differs from {}",
+                path.display(),
+                first_path.display()
+            )));
+        }
+        for &c in &part.output.chunks {
+            if let Some(&other) = owner.get(&c) {
+                return Err(RenderError::Options(format!(
+                    "{}: chunk {c} is also in {} (the same shard twice?)",
+                    path.display(),
+                    parts[other].display()
+                )));
+            }
+            owner.insert(c, index);
+        }
+        add_counts(&merged, &part.output).map_err(|what| {
+            RenderError::Options(format!(
+                "{}: adding its {what} to the other parts' overflows: not parts of one render",
+                path.display()
+            ))
+        })?;
+        merged
+            .merge(&part.output)
+            .map_err(|e| RenderError::Options(format!("{}: {e}", path.display())))?;
+        seconds.push(part.output.seconds);
+    }
+    // Time budgets and targets stop early: only they may leave chunks out.
+    if first.plan.time_budget.is_none() && first.plan.target_error.is_none() {
+        let expected = first.plan.chunks();
+        if owner.len() as u64 != expected {
+            let missing =
+                (0..expected).filter(|c| !owner.contains_key(c)).take(10).collect::<Vec<_>>();
+            return Err(RenderError::Options(format!(
+                "the parts cover {} of {expected} chunks; missing e.g. {missing:?}",
+                owner.len()
+            )));
+        }
+    }
+    let numerator = normalisation(first.integrator, first.light_power, u64::from(w) * u64::from(h));
+    let written = write_outputs(out_dir, &first.name, &first.output_settings, numerator, &merged)?;
+    let total_seconds: f64 = seconds.iter().sum();
+    let mut report = report(
+        first.scene_path.clone(),
+        (w, h),
+        first.plan,
+        first.effects,
+        first.integrator.name(),
+        &merged,
+        seconds.iter().copied().fold(0.0, f64::max),
+        first.light_power,
+        written,
+    );
+    report.beams_per_second =
+        if total_seconds > 0.0 { merged.beams as f64 / total_seconds } else { 0.0 };
+    report.sampler = first.sampler.name().to_owned();
+    write_sidecar(out_dir, &first.name, &report)?;
+    Ok(report)
+}
+
+/// Checks that adding `part`'s counters to `merged`'s cannot overflow (tampered parts could make
+/// them wrap); names the counter that would.
+fn add_counts(merged: &RenderOutput, part: &RenderOutput) -> Result<(), &'static str> {
+    let fits = |a: u64, b: u64, what: &'static str| a.checked_add(b).map(|_| ()).ok_or(what);
+    fits(merged.beams, part.beams, "beams")?;
+    fits(merged.stats.beams, part.stats.beams, "beam count")?;
+    fits(merged.stats.hits, part.stats.hits, "hit count")?;
+    fits(merged.stats.splats, part.stats.splats, "splat count")?;
+    fits(merged.stats.roulette_kills, part.stats.roulette_kills, "roulette count")?;
+    fits(merged.stats.depth_limited, part.stats.depth_limited, "depth-limit count")?;
+    fits(merged.stats.reemissions, part.stats.reemissions, "re-emission count")?;
+    fits(merged.film.accepted(), part.film.accepted(), "accepted-contribution count")?;
+    fits(merged.film.rejected(), part.film.rejected(), "rejected-contribution count")?;
+    Ok(())
+}

@@ -1,0 +1,58 @@
+//! Warnings about a result that is not an error: light the chosen estimator cannot reach, and
+//! contributions the film left out.
+
+use spectrace_tracer::IntegratorChoice;
+
+use crate::{Scene, tracer_scene};
+
+/// What a user should know about the chosen estimator: light a camera integrator cannot reach.
+pub(crate) fn integrator_warnings(scene: &Scene, choice: IntegratorChoice) -> Vec<String> {
+    let mut warnings = Vec::new();
+    let features = tracer_scene(scene).features(&scene.non_convex);
+    if choice == IntegratorChoice::Light && features.specular {
+        warnings.push(
+            "the light tracer cannot see into mirrors and glass: what they reflect or refract \
+             toward the camera is missing from this image (use --integrator bdpt or auto)"
+                .to_owned(),
+        );
+    }
+    if choice == IntegratorChoice::Bdpt && features.fluorescent && features.specular {
+        warnings.push(
+            "BDPT re-emits fluorescent light on light paths only: a fluorescent surface seen \
+             only through mirrors or glass is missing from this image (use --integrator path)"
+                .to_owned(),
+        );
+    }
+    if choice != IntegratorChoice::Path {
+        return warnings;
+    }
+    if features.beam_only_lights + features.delta_direction_lights > 0 {
+        warnings.push(
+            "the path tracer cannot reach lasers, skies or lights that only generate beams: \
+             their light is missing from this image (use --integrator light or auto)"
+                .to_owned(),
+        );
+    }
+    if features.line_spectra {
+        warnings.push(
+            "the path tracer draws wavelengths from a density and misses spectral lines: \
+             their light is missing from this image (use --integrator light or auto)"
+                .to_owned(),
+        );
+    }
+    if features.delta_position_lights > 0 && features.specular {
+        warnings.push(
+            "the path tracer cannot see caustics of point or spot lights (their light through \
+             mirrors and glass onto other surfaces is missing; use --integrator light or auto)"
+                .to_owned(),
+        );
+    }
+    warnings
+}
+
+pub(crate) fn rejected_warning(n: u64) -> String {
+    format!(
+        "{n} contributions were not finite or beyond the film's range and were left out: \
+         the image is darker than it should be where they fell"
+    )
+}
