@@ -3,7 +3,7 @@
 
 use spectrace_tracer::{Effects, EffectsMode, IntegratorChoice, RenderPlan, image_scale};
 
-use crate::{RenderError, RenderOptions, Scene, tracer_scene};
+use crate::{RenderError, RenderOptions, Scene};
 
 /// Most worker threads a render accepts.
 pub const MAX_THREADS: usize = 256;
@@ -13,8 +13,7 @@ pub fn choose_integrator(
     scene: &Scene,
     choice: Option<IntegratorChoice>,
 ) -> (IntegratorChoice, String) {
-    let features = tracer_scene(scene).features(&scene.non_convex);
-    choice.unwrap_or(scene.settings.integrator).decide(&features)
+    choice.unwrap_or(scene.settings.integrator).decide(&scene.features())
 }
 
 /// What turns a film's exact sums into the image: `light_power * factor / items`, where the
@@ -48,8 +47,7 @@ pub fn normalisation(integrator: IntegratorChoice, light_power: f64, pixels: u64
 
 /// The effects decision for a scene (with an optional override).
 pub fn decide_effects(scene: &Scene, mode: Option<EffectsMode>) -> Effects {
-    let features = tracer_scene(scene).features(&scene.non_convex);
-    Effects::decide(features, mode.unwrap_or(scene.effects.mode))
+    Effects::decide(scene.features(), mode.unwrap_or(scene.effects.mode))
 }
 
 /// The plan after command-line overrides.

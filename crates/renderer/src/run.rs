@@ -19,8 +19,8 @@ use crate::{
     RenderOptions, RenderReport, Scene, SensorIntegrator, SensorSource, Written,
     check_sensor_names, choose_integrator, decide_effects, image, normalisation, plan_with,
     planned_sensor_outputs, probe_with, sensor_integrator, sensor_pass, sensor_pass_path,
-    sensor_plan, sensor_summary, tracer_scene, with_integrator, with_integrator_filling,
-    write_atomically, write_outputs, write_sensors,
+    sensor_plan, sensor_summary, with_integrator, with_integrator_filling, write_atomically,
+    write_outputs, write_sensors,
 };
 
 /// Renders a scene file with overrides and writes its outputs (or, with a shard, its partial film).
@@ -157,11 +157,9 @@ fn render_with(
     let Setup { choice, reason, effects, plan, name } = *setup;
     let name = name.to_owned();
     warnings.extend(integrator_warnings(scene, choice));
-    let unreachable =
-        |f: spectrace_tracer::SceneFeatures| f.delta_direction_lights + f.beam_only_lights > 0;
     if !scene.sensors.is_empty()
         && scene.settings.sensor_integrator == SensorIntegrator::Path
-        && unreachable(tracer_scene(scene).features(&scene.non_convex))
+        && !scene.lights_sampled_from_points()
     {
         warnings.push(
             "settings.sensor_integrator \"path\": lasers, skies and beam-only lights cannot be \

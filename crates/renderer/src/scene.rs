@@ -2,7 +2,7 @@
 //! and assembly into what the tracer needs.
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use serde::{Deserialize, Serialize};
 use spectrace_geometry::{Disk, Rectangle};
@@ -15,7 +15,7 @@ use spectrace_spectrum::Reflectance;
 use spectrace_tracer::{
     BdptSettings, CameraWavelengths, DEFAULT_CHUNK_BEAMS, EffectsMode, Emitter, IntegratorChoice,
     LightTracerSettings, MAX_DEPTH, ObjectEmission, ObjectLight, PathTracerSettings, PinholeCamera,
-    RenderPlan, SamplerKind,
+    RenderPlan, SamplerKind, SceneFeatures,
 };
 use spectrace_tracer::{IrradianceSensor, SensorSet};
 
@@ -273,6 +273,9 @@ pub struct Scene {
     pub inputs: Vec<PathBuf>,
     /// The illuminance sensors.
     pub sensors: SensorSet,
+    /// What the scene contains, for the effects analysis: found once, on first use (see
+    /// [`Scene::features`]).
+    features: OnceLock<SceneFeatures>,
 }
 
 /// How a scene file may refer to other files.
@@ -521,7 +524,22 @@ impl Scene {
             output: file.output,
             inputs,
             sensors,
+            features: OnceLock::new(),
         })
+    }
+
+    /// What the scene contains (its lights, materials and shapes), for the effects analysis, the
+    /// choice of estimator and the warnings: found on first use and kept, since none of them
+    /// changes once the scene is loaded.
+    pub fn features(&self) -> SceneFeatures {
+        *self.features.get_or_init(|| crate::tracer_scene(self).features(&self.non_convex))
+    }
+
+    /// Whether a point can sample every light (no laser, sky or beam-only light): what the path
+    /// tracer needs, from the camera or from a sensor.
+    pub(crate) fn lights_sampled_from_points(&self) -> bool {
+        let f = self.features();
+        f.beam_only_lights == 0 && f.delta_direction_lights == 0
     }
 
     /// The tracer settings.

@@ -276,14 +276,8 @@ pub fn sensor_summary(r: &SensorReport) -> String {
 /// path tracer when every light can be sampled from a point, else light paths).
 pub fn sensor_integrator(scene: &Scene) -> SensorIntegrator {
     match scene.settings.sensor_integrator {
-        SensorIntegrator::Auto => {
-            let f = tracer_scene(scene).features(&scene.non_convex);
-            if f.beam_only_lights == 0 && f.delta_direction_lights == 0 {
-                SensorIntegrator::Path
-            } else {
-                SensorIntegrator::Light
-            }
-        }
+        SensorIntegrator::Auto if scene.lights_sampled_from_points() => SensorIntegrator::Path,
+        SensorIntegrator::Auto => SensorIntegrator::Light,
         other => other,
     }
 }

@@ -3,12 +3,12 @@
 
 use spectrace_tracer::IntegratorChoice;
 
-use crate::{Scene, tracer_scene};
+use crate::Scene;
 
 /// What a user should know about the chosen estimator: light a camera integrator cannot reach.
 pub(crate) fn integrator_warnings(scene: &Scene, choice: IntegratorChoice) -> Vec<String> {
     let mut warnings = Vec::new();
-    let features = tracer_scene(scene).features(&scene.non_convex);
+    let features = scene.features();
     if choice == IntegratorChoice::Light && features.specular {
         warnings.push(
             "the light tracer cannot see into mirrors and glass: what they reflect or refract \
@@ -26,7 +26,7 @@ pub(crate) fn integrator_warnings(scene: &Scene, choice: IntegratorChoice) -> Ve
     if choice != IntegratorChoice::Path {
         return warnings;
     }
-    if features.beam_only_lights + features.delta_direction_lights > 0 {
+    if !scene.lights_sampled_from_points() {
         warnings.push(
             "the path tracer cannot reach lasers, skies or lights that only generate beams: \
              their light is missing from this image (use --integrator light or auto)"
