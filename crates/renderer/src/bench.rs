@@ -5,10 +5,11 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 use spectrace_lights::LightSource;
-use spectrace_tracer::{Effects, EffectsMode, IntegratorChoice, LightTracer, render};
+use spectrace_tracer::{Effects, EffectsMode, IntegratorChoice, render};
 
+use crate::integrators::{ESTIMATORS, is_camera_integrator};
 use crate::{
-    RenderError, RenderOptions, Scene, choose_integrator, decide_effects, plan_with, tracer_scene,
+    RenderError, RenderOptions, Scene, choose_integrator, decide_effects, plan_with,
     with_integrator,
 };
 
@@ -53,10 +54,10 @@ pub fn effects_benchmark(
     let measure = |mode: EffectsMode| -> Result<(f64, f64, Effects), RenderError> {
         let effects = decide_effects(scene, Some(mode));
         let started = Instant::now();
-        let tracer_scene = tracer_scene(scene);
-        let tracer = LightTracer::new(&tracer_scene, scene.tracer_settings(), effects);
-        let out =
-            render(&tracer, &plan, &|_| {}).map_err(|e| RenderError::Options(e.to_string()))?;
+        let out = with_integrator(scene, IntegratorChoice::Light, effects, |tracer| {
+            render(tracer, &plan, &|_| {})
+        })
+        .map_err(|e| RenderError::Options(e.to_string()))?;
         let seconds = started.elapsed().as_secs_f64();
         scene.lights.reset_count();
         // Every splat carries `wavelengths_per_path` spectral samples.
@@ -103,7 +104,7 @@ pub fn render_xyz(
     };
     let (choice, _) = choose_integrator(scene, Some(integrator));
     let mut plan = plan_with(scene, &options, choice).map_err(|e| e.to_string())?;
-    if choice == IntegratorChoice::Light {
+    if !is_camera_integrator(choice) {
         // At least ~16 chunks per render, so small sweep points use every thread too; the chunk
         // size depends on the beams alone, so a cached reference stays valid whatever the thread
         // count. (A camera integrator's chunk is a pass of one sample per pixel.)
@@ -175,12 +176,7 @@ pub fn integrator_benchmark(
 ) -> Result<IntegratorBenchmarkRow, String> {
     let (auto_picks, auto_reason) = choose_integrator(scene, Some(IntegratorChoice::Auto));
     let mut timings = Vec::new();
-    for integrator in [
-        IntegratorChoice::Light,
-        IntegratorChoice::Path,
-        IntegratorChoice::Bdpt,
-        IntegratorChoice::Auto,
-    ] {
+    for integrator in ESTIMATORS.into_iter().chain([IntegratorChoice::Auto]) {
         let (_, seconds, traced) =
             render_xyz(scene, integrator, EffectsMode::Auto, paths, 1, threads)
                 .map_err(|e| format!("{}: {}: {e}", scene.path.display(), integrator.name()))?;

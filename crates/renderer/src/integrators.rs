@@ -1,11 +1,38 @@
-//! The one place the renderer knows its estimators: the tracer's view of a scene and each
-//! estimator built on it.
+//! The one place the renderer knows its estimators: which there are, how each counts its work,
+//! and each built on the tracer's view of a scene. Everything else goes through these (names
+//! come from [`IntegratorChoice::name`] and [`Integrator::name`]), so an estimator added to the
+//! tracer is added to the renderer here.
 
 use spectrace_tracer::{
     Bdpt, Effects, Integrator, IntegratorChoice, LightTracer, LightTracerScene, PathTracer,
 };
 
 use crate::Scene;
+
+/// Every estimator a render can use, in the order reports list them (`auto` picks one of them).
+pub(crate) const ESTIMATORS: [IntegratorChoice; 3] =
+    [IntegratorChoice::Light, IntegratorChoice::Path, IntegratorChoice::Bdpt];
+
+/// Whether `choice`'s work items are camera samples, in passes of one sample per pixel (path
+/// tracer, BDPT), rather than beams from the lights (the light tracer, and `auto` before it is
+/// decided, which [`with_integrator`] also builds as the light tracer).
+pub(crate) fn is_camera_integrator(choice: IntegratorChoice) -> bool {
+    match choice {
+        IntegratorChoice::Path | IntegratorChoice::Bdpt => true,
+        IntegratorChoice::Light | IntegratorChoice::Auto => false,
+    }
+}
+
+/// The names `--integrator` and `settings.integrator` accept, in words: `auto, light, path or
+/// bdpt`.
+pub(crate) fn choice_names() -> String {
+    let mut names: Vec<&str> = std::iter::once(IntegratorChoice::Auto)
+        .chain(ESTIMATORS)
+        .map(IntegratorChoice::name)
+        .collect();
+    let last = names.pop().unwrap_or_default();
+    format!("{} or {last}", names.join(", "))
+}
 
 /// The tracer's view of a scene.
 pub fn tracer_scene(scene: &Scene) -> LightTracerScene<'_> {
@@ -44,6 +71,19 @@ pub fn with_integrator_filling<R>(
         IntegratorChoice::Bdpt => f(&Bdpt::new(&tracer_scene, scene.bdpt_settings(), effects)),
         IntegratorChoice::Light | IntegratorChoice::Auto => {
             f(&LightTracer::new(&tracer_scene, scene.tracer_settings(), effects))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_names_in_words_are_every_choice_the_command_line_accepts() {
+        assert_eq!(choice_names(), "auto, light, path or bdpt");
+        for choice in ESTIMATORS {
+            assert_eq!(IntegratorChoice::from_name(choice.name()), Some(choice));
         }
     }
 }

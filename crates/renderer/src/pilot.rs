@@ -21,6 +21,7 @@ use serde::{Deserialize, Serialize};
 use spectrace_lights::LightSource;
 use spectrace_tracer::{IntegratorChoice, MIN_BATCHES, Progress, RenderPlan, render_observed};
 
+use crate::integrators::ESTIMATORS;
 use crate::warnings::integrator_warnings;
 use crate::{
     RenderError, RenderOptions, Scene, choose_integrator, decide_effects, duration, plan_with,
@@ -58,11 +59,7 @@ impl Default for EstimateOptions {
             pilot_seconds: DEFAULT_PILOT_SECONDS,
             threads: 0,
             seed: 0x5EED_0001,
-            integrators: vec![
-                IntegratorChoice::Light,
-                IntegratorChoice::Path,
-                IntegratorChoice::Bdpt,
-            ],
+            integrators: ESTIMATORS.to_vec(),
             fixed_rounds: None,
         }
     }

@@ -3,6 +3,7 @@
 
 use spectrace_tracer::{Effects, EffectsMode, IntegratorChoice, RenderPlan, image_scale};
 
+use crate::integrators::is_camera_integrator;
 use crate::{RenderError, RenderOptions, Scene};
 
 /// Most worker threads a render accepts.
@@ -38,10 +39,7 @@ impl Normalisation {
 
 /// The normalisation of a render by `integrator` of an image of `pixels` pixels.
 pub fn normalisation(integrator: IntegratorChoice, light_power: f64, pixels: u64) -> Normalisation {
-    let factor = match integrator {
-        IntegratorChoice::Path | IntegratorChoice::Bdpt => pixels as f64,
-        IntegratorChoice::Light | IntegratorChoice::Auto => 1.0,
-    };
+    let factor = if is_camera_integrator(integrator) { pixels as f64 } else { 1.0 };
     Normalisation { light_power, factor }
 }
 
@@ -73,7 +71,7 @@ pub fn plan_with(
     integrator: IntegratorChoice,
 ) -> Result<RenderPlan, RenderError> {
     let mut plan = plan_light(scene, options)?;
-    if matches!(integrator, IntegratorChoice::Path | IntegratorChoice::Bdpt) {
+    if is_camera_integrator(integrator) {
         let pixels = u64::from(scene.camera.width()) * u64::from(scene.camera.height());
         let pixels = pixels.max(1);
         let spp = match (options.spp, options.beams) {

@@ -5,10 +5,10 @@ use std::time::Instant;
 use spectrace_lights::LightSource;
 
 use spectrace_tracer::{
-    Effects, FilmError, Integrator, LightTracer, MemoryLimit, RenderPlan, TraceStats,
+    Effects, FilmError, Integrator, IntegratorChoice, MemoryLimit, RenderPlan, TraceStats,
 };
 
-use crate::{OUTPUT_BYTES_PER_PIXEL, Scene, SceneError, tracer_scene};
+use crate::{OUTPUT_BYTES_PER_PIXEL, Scene, SceneError, with_integrator};
 
 /// Beams traced to check that light can reach the camera before rendering.
 pub const PROBE_BEAMS: u64 = 20_000;
@@ -70,9 +70,9 @@ pub fn probe(
     effects: &Effects,
     plan: &RenderPlan,
 ) -> Result<ProbeOutcome, SceneError> {
-    let tracer_scene = tracer_scene(scene);
-    let tracer = LightTracer::new(&tracer_scene, scene.tracer_settings(), *effects);
-    probe_with(scene, plan, &tracer)
+    with_integrator(scene, IntegratorChoice::Light, *effects, |tracer| {
+        probe_with(scene, plan, tracer)
+    })
 }
 
 /// [`probe`] with any estimator: its work items (beams, or camera samples spread over the
