@@ -1,6 +1,7 @@
 //! How a scene is rendered: the estimator, the effects decision, the plan after overrides, and
 //! the normalisation that turns the film into the image.
 
+use spectrace_lights::LightSource;
 use spectrace_tracer::{Effects, EffectsMode, IntegratorChoice, RenderPlan, image_scale};
 
 use crate::integrators::is_camera_integrator;
@@ -41,6 +42,12 @@ impl Normalisation {
 pub fn normalisation(integrator: IntegratorChoice, light_power: f64, pixels: u64) -> Normalisation {
     let factor = if is_camera_integrator(integrator) { pixels as f64 } else { 1.0 };
     Normalisation { light_power, factor }
+}
+
+/// The normalisation of a render of `scene` by `choice`.
+pub(crate) fn scene_normalisation(scene: &Scene, choice: IntegratorChoice) -> Normalisation {
+    let pixels = u64::from(scene.camera.width()) * u64::from(scene.camera.height());
+    normalisation(choice, scene.lights.power(), pixels)
 }
 
 /// The effects decision for a scene (with an optional override).

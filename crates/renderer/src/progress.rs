@@ -1,10 +1,39 @@
-//! The progress bar on stderr and its live error message.
+//! A render watched by a progress bar on stderr, with its live error message.
 
-use spectrace_tracer::RenderPlan;
+use std::time::Instant;
 
-use crate::duration;
+use spectrace_tracer::{Integrator, RenderOutput, RenderPlan, render_observed};
 
-pub(crate) fn progress_bar(plan: &RenderPlan, visible: bool) -> indicatif::ProgressBar {
+use crate::{RenderError, duration};
+
+/// Renders `plan` with `tracer`, showing a progress bar when `visible`; returns the output and
+/// the wall time (s).
+///
+/// # Errors
+/// [`RenderError::Options`] if the film cannot be made.
+pub(crate) fn render_with_progress(
+    tracer: &dyn Integrator,
+    plan: &RenderPlan,
+    visible: bool,
+) -> Result<(RenderOutput, f64), RenderError> {
+    let bar = progress_bar(plan, visible);
+    let started = Instant::now();
+    let target = plan.shard_target_error();
+    let update = |p: &spectrace_tracer::Progress| {
+        bar.set_position(p.items.min(bar.length().unwrap_or(u64::MAX)));
+        if let Some(e) = &p.estimate {
+            bar.set_message(progress_message(e, target, p.seconds));
+        }
+    };
+    let output =
+        render_observed(tracer, plan, &update).map_err(|e| RenderError::Options(e.to_string()))?;
+    bar.finish_and_clear();
+    Ok((output, started.elapsed().as_secs_f64()))
+}
+
+/// The progress bar: hidden unless `visible`; a spinner for open-ended renders (a time budget
+/// or a target), else a bar with an ETA.
+fn progress_bar(plan: &RenderPlan, visible: bool) -> indicatif::ProgressBar {
     if !visible {
         return indicatif::ProgressBar::hidden();
     }
@@ -23,7 +52,7 @@ pub(crate) fn progress_bar(plan: &RenderPlan, visible: bool) -> indicatif::Progr
 
 /// The progress bar's message for a live estimate: the error and, with a target, the time
 /// still needed (error falling as `1 / sqrt(time)`).
-pub(crate) fn progress_message(
+fn progress_message(
     e: &spectrace_tracer::ErrorEstimate,
     target: Option<f64>,
     seconds: f64,

@@ -2,25 +2,24 @@
 //! (or a shard's part file); and renders kept in memory.
 
 use std::path::Path;
-use std::time::Instant;
 
 use spectrace_lights::LightSource;
 use spectrace_tracer::{
     Effects, Integrator, IntegratorChoice, MemoryLimit, RenderOutput, RenderPlan, render,
-    render_observed,
 };
 
-use crate::progress::{progress_bar, progress_message};
+use crate::plan::scene_normalisation;
+use crate::progress::render_with_progress;
 use crate::report::report;
-use crate::warnings::integrator_warnings;
-use crate::write::{planned_outputs, write_sidecar};
+use crate::sensors::render_sensors;
+use crate::shard::write_part;
+use crate::warnings::{black_image_warning, render_warnings};
+use crate::write::{part_path, planned_outputs, write_sidecar};
 use crate::{
-    DEFAULT_SENSOR_SPP, LoadOptions, MAX_PART_BYTES, PARTIAL_VERSION, PartialFilm, RenderError,
-    RenderOptions, RenderReport, Scene, SensorIntegrator, SensorSource, Written,
-    check_sensor_names, choose_integrator, decide_effects, image, normalisation, plan_with,
-    planned_sensor_outputs, probe_with, sensor_integrator, sensor_pass, sensor_pass_path,
-    sensor_plan, sensor_summary, with_integrator, with_integrator_filling, write_atomically,
-    write_outputs, write_sensors,
+    LoadOptions, MAX_PART_BYTES, PARTIAL_VERSION, PartialFilm, ProbeOutcome, RenderError,
+    RenderOptions, RenderReport, Scene, Written, check_sensor_names, choose_integrator,
+    decide_effects, image, plan_with, planned_sensor_outputs, probe_with, sensor_summary,
+    with_integrator, with_integrator_filling, write_outputs,
 };
 
 /// Renders a scene file with overrides and writes its outputs (or, with a shard, its partial film).
@@ -131,8 +130,7 @@ pub fn render_in_memory(
     let output = with_integrator(scene, choice, effects, |tracer| render(tracer, &plan, &|_| {}))
         .map_err(|e| RenderError::Options(e.to_string()))?;
     scene.lights.reset_count();
-    let pixels = u64::from(scene.camera.width()) * u64::from(scene.camera.height());
-    let image = image(&output, normalisation(choice, scene.lights.power(), pixels));
+    let image = image(&output, scene_normalisation(scene, choice));
     Ok(InMemoryRender { output, image, integrator: choice })
 }
 
@@ -154,138 +152,121 @@ fn render_with(
     mut warnings: Vec<String>,
     tracer: &dyn Integrator,
 ) -> Result<RenderReport, RenderError> {
-    let Setup { choice, reason, effects, plan, name } = *setup;
-    let name = name.to_owned();
-    warnings.extend(integrator_warnings(scene, choice));
-    if !scene.sensors.is_empty()
-        && scene.settings.sensor_integrator == SensorIntegrator::Path
-        && !scene.lights_sampled_from_points()
-    {
-        warnings.push(
-            "settings.sensor_integrator \"path\": lasers, skies and beam-only lights cannot be \
-             sampled from a point, so the sensors miss their light; use \"light\" or \"auto\""
-                .to_owned(),
-        );
+    warnings.extend(render_warnings(scene, setup.choice, &setup.plan));
+    let probed = probe_noting(scene, &setup.plan, tracer, options.verbose)?;
+    let (output, wall) = render_with_progress(tracer, &setup.plan, options.verbose)?;
+    let finished = Finished { scene, setup, integrator: tracer.name(), wall, warnings };
+    match setup.plan.shard {
+        Some(shard) => write_shard(&finished, &options.out_dir, shard, output),
+        None => write_render(&finished, options, tracer, probed, &output),
     }
-    if !scene.sensors.is_empty() && plan.shard.is_some() {
-        warnings.push(
-            "sensors are written by unsharded renders only (merge-parts writes the image): \
-             render without --shard for the sensors' files"
-                .to_owned(),
-        );
-    }
-    // The light tracer's probe checks that light can reach the camera (for camera integrators a
-    // black image is reported after the render).
-    let probed = probe_with(scene, &plan, tracer)?;
-    if options.verbose && !probed.lit {
+}
+
+/// The pre-render probe with the render's estimator (see [`probe_with`]); a probe that ran out
+/// of time is noted on stderr when `verbose` (and an image that then comes out black is
+/// reported after the render).
+fn probe_noting(
+    scene: &Scene,
+    plan: &RenderPlan,
+    tracer: &dyn Integrator,
+    verbose: bool,
+) -> Result<ProbeOutcome, RenderError> {
+    let probed = probe_with(scene, plan, tracer)?;
+    if verbose && !probed.lit {
         eprintln!(
             "note: the pre-render probe ran out of time after {} paths without seeing light reach \
              the camera; rendering anyway",
             probed.beams
         );
     }
-    let bar = progress_bar(&plan, options.verbose);
-    let started = Instant::now();
-    let target = plan.shard_target_error();
-    let update = |p: &spectrace_tracer::Progress| {
-        bar.set_position(p.items.min(bar.length().unwrap_or(u64::MAX)));
-        if let Some(e) = &p.estimate {
-            bar.set_message(progress_message(e, target, p.seconds));
-        }
-    };
-    let output =
-        render_observed(tracer, &plan, &update).map_err(|e| RenderError::Options(e.to_string()))?;
-    let pixels = u64::from(scene.camera.width()) * u64::from(scene.camera.height());
-    let numerator = normalisation(choice, scene.lights.power(), pixels);
-    bar.finish_and_clear();
-    let wall = started.elapsed().as_secs_f64();
-    let make_report = |output: &RenderOutput, mut written: Written| {
-        written.warnings.append(&mut warnings.clone());
+    Ok(probed)
+}
+
+/// A render that is done: what its reports share.
+struct Finished<'a> {
+    scene: &'a Scene,
+    setup: &'a Setup<'a>,
+    /// The estimator's [`Integrator::name`].
+    integrator: &'static str,
+    /// Wall time of the render (s).
+    wall: f64,
+    /// The warnings found before and while rendering.
+    warnings: Vec<String>,
+}
+
+impl Finished<'_> {
+    /// The sidecar's contents for `output` and what was written (whose warnings come first).
+    fn report(&self, output: &RenderOutput, mut written: Written) -> RenderReport {
+        let (scene, setup) = (self.scene, self.setup);
+        written.warnings.extend(self.warnings.iter().cloned());
         let mut r = report(
             scene.path.display().to_string(),
             (scene.camera.width(), scene.camera.height()),
-            plan,
-            effects,
-            tracer.name(),
+            setup.plan,
+            setup.effects,
+            self.integrator,
             output,
-            wall,
+            self.wall,
             scene.lights.power(),
             written,
         );
-        r.integrator_reason = reason.to_owned();
+        r.integrator_reason = setup.reason.to_owned();
         r.sampler = scene.settings.sampler.name().to_owned();
         r
-    };
-    if let Some((k, n)) = plan.shard {
-        let path = options.out_dir.join(format!("{name}.part-{k}-of-{n}.bin"));
-        let shard_report = make_report(
-            &output,
-            Written { files: vec![path.display().to_string()], ..Written::default() },
-        );
-        // The film moves into the part (no copy of what may be 1.5 GiB).
-        let part = PartialFilm {
-            version: PARTIAL_VERSION,
-            scene_fingerprint: scene.fingerprint(),
-            scene_path: scene.path.display().to_string(),
-            plan: RenderPlan { shard: None, threads: 0, ..plan },
-            light_power: scene.lights.power(),
-            integrator: choice,
-            sampler: scene.settings.sampler,
-            effects,
-            output_settings: scene.output.clone(),
-            name: name.clone(),
-            output,
-        };
-        let bytes =
-            part.encode().map_err(|message| RenderError::File { path: path.clone(), message })?;
-        drop(part);
-        write_atomically(&path, |p| std::fs::write(p, &bytes).map_err(|e| e.to_string()))
-            .map_err(|message| RenderError::File { path: path.clone(), message })?;
-        return Ok(shard_report);
     }
-    let mut written = write_outputs(&options.out_dir, &name, &scene.output, numerator, &output)?;
-    if !probed.lit && output.film.accepted() == 0 {
-        written.warnings.push(format!(
-            "no light reached the camera: the image is black (the pre-render probe ran out of \
-             time after {} paths, and none of the {} paths rendered lit a point the camera sees)",
-            probed.beams, output.beams
-        ));
-    }
-    let sensors = if scene.sensors.is_empty() {
-        Vec::new()
-    } else if tracer.sensor_cells() > 0 {
-        let source = SensorSource {
-            film: &output.film,
-            beams: output.beams,
-            seconds: output.seconds,
-            filled_by: "image beams (light tracer)",
-        };
-        write_sensors(scene, &options.out_dir, source)?
-    } else if sensor_integrator(scene) == SensorIntegrator::Light {
-        let (film, beams, seconds) =
-            sensor_pass(scene, &sensor_plan(scene, plan.threads), effects)?;
-        let source =
-            SensorSource { film: &film, beams, seconds, filled_by: "sensor pass (light tracer)" };
-        write_sensors(scene, &options.out_dir, source)?
-    } else {
-        let passes = scene.settings.sensor_spp.unwrap_or(DEFAULT_SENSOR_SPP);
-        let (film, beams, seconds) = sensor_pass_path(scene, passes, plan.threads, effects)?;
-        let source = SensorSource {
-            film: &film,
-            beams,
-            seconds,
-            filled_by: "points sampled on the sensor (path tracer)",
-        };
-        write_sensors(scene, &options.out_dir, source)?
+}
+
+/// A shard's end: its part file (the film moves into it) and its report, which has no sidecar.
+fn write_shard(
+    finished: &Finished<'_>,
+    out_dir: &Path,
+    shard: (u64, u64),
+    output: RenderOutput,
+) -> Result<RenderReport, RenderError> {
+    let (scene, setup) = (finished.scene, finished.setup);
+    let path = part_path(out_dir, setup.name, shard);
+    let report = finished
+        .report(&output, Written { files: vec![path.display().to_string()], ..Written::default() });
+    let part = PartialFilm {
+        version: PARTIAL_VERSION,
+        scene_fingerprint: scene.fingerprint(),
+        scene_path: scene.path.display().to_string(),
+        plan: RenderPlan { shard: None, threads: 0, ..setup.plan },
+        light_power: scene.lights.power(),
+        integrator: setup.choice,
+        sampler: scene.settings.sampler,
+        effects: setup.effects,
+        output_settings: scene.output.clone(),
+        name: setup.name.to_owned(),
+        output,
     };
+    write_part(&path, part)?;
+    Ok(report)
+}
+
+/// An unsharded render's end: the image files, the sensors' files and the sidecar.
+fn write_render(
+    finished: &Finished<'_>,
+    options: &RenderOptions,
+    tracer: &dyn Integrator,
+    probed: ProbeOutcome,
+    output: &RenderOutput,
+) -> Result<RenderReport, RenderError> {
+    let (scene, setup) = (finished.scene, finished.setup);
+    let numerator = scene_normalisation(scene, setup.choice);
+    let mut written =
+        write_outputs(&options.out_dir, setup.name, &scene.output, numerator, output)?;
+    written.warnings.extend(black_image_warning(&probed, output));
+    let sensors =
+        render_sensors(scene, &options.out_dir, tracer, output, &setup.plan, setup.effects)?;
     for r in &sensors {
         written.files.extend(r.files.iter().cloned());
         if options.verbose {
             eprintln!("{}", sensor_summary(r));
         }
     }
-    let mut report = make_report(&output, written);
+    let mut report = finished.report(output, written);
     report.sensors = sensors;
-    write_sidecar(&options.out_dir, &name, &report)?;
+    write_sidecar(&options.out_dir, setup.name, &report)?;
     Ok(report)
 }

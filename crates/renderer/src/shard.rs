@@ -1,4 +1,5 @@
-//! Merging the partial films of a sharded render into the outputs one machine would write.
+//! Sharded renders: a shard's part file, and merging the parts into the outputs one machine
+//! would write.
 
 use std::path::{Path, PathBuf};
 
@@ -6,7 +7,9 @@ use spectrace_tracer::{Film, MemoryLimit, RenderOutput, TraceStats};
 
 use crate::report::report;
 use crate::write::{planned_outputs, write_sidecar};
-use crate::{PartialFilm, RenderError, RenderReport, normalisation, write_outputs};
+use crate::{
+    PartialFilm, RenderError, RenderReport, normalisation, write_atomically, write_outputs,
+};
 
 /// Merges the partial films of a sharded render into the final outputs, bit-identical to a
 /// one-machine render with the same seed.
@@ -136,6 +139,19 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
     report.sampler = first.sampler.name().to_owned();
     write_sidecar(out_dir, &first.name, &report)?;
     Ok(report)
+}
+
+/// Writes a shard's part file (encoded, then written to a temporary name and renamed); the part
+/// is dropped once encoded, so its film is not held twice.
+///
+/// # Errors
+/// [`RenderError::File`] if it cannot be encoded or written.
+pub(crate) fn write_part(path: &Path, part: PartialFilm) -> Result<(), RenderError> {
+    let file_error = |message| RenderError::File { path: path.to_owned(), message };
+    let bytes = part.encode().map_err(file_error)?;
+    drop(part);
+    write_atomically(path, |p| std::fs::write(p, &bytes).map_err(|e| e.to_string()))
+        .map_err(file_error)
 }
 
 /// Checks that adding `part`'s counters to `merged`'s cannot overflow (tampered parts could make

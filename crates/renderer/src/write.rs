@@ -23,7 +23,7 @@ pub(crate) fn planned_outputs(
     check_output_name(name).map_err(|e| RenderError::Options(format!("output name: {e}")))?;
     prepare_out_dir(out_dir).map_err(RenderError::Options)?;
     let outputs = match shard {
-        Some((k, n)) => vec![out_dir.join(format!("{name}.part-{k}-of-{n}.bin"))],
+        Some(shard) => vec![part_path(out_dir, name, shard)],
         None => {
             let mut v = Vec::new();
             if settings.exr {
@@ -41,6 +41,11 @@ pub(crate) fn planned_outputs(
         }
     };
     check_no_input_replaced(&outputs, inputs).map_err(RenderError::Options)
+}
+
+/// The part file of shard `k` of `n`: `NAME.part-K-of-N.bin`.
+pub(crate) fn part_path(out_dir: &Path, name: &str, (k, n): (u64, u64)) -> PathBuf {
+    out_dir.join(format!("{name}.part-{k}-of-{n}.bin"))
 }
 
 /// What [`write_outputs`] wrote.
