@@ -1,9 +1,10 @@
 //! Sharded renders: a shard's part file, and merging the parts into the outputs one machine
 //! would write.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use spectrace_tracer::{Film, MemoryLimit, RenderOutput, TraceStats};
+use spectrace_tracer::{Film, MemoryLimit, RenderOutput, RenderPlan, TraceStats};
 
 use crate::report::report;
 use crate::write::{planned_outputs, write_sidecar};
@@ -24,16 +25,43 @@ use crate::{
 /// [`RenderError::Options`] when the parts do not belong together, overlap, miss chunks, or their
 /// counts overflow.
 pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, RenderError> {
-    let read = |path: &PathBuf| {
-        PartialFilm::read(path).map_err(|message| RenderError::File { path: path.clone(), message })
-    };
     let Some(first_path) = parts.first() else {
         return Err(RenderError::Options("merge needs at least one partial film".to_owned()));
     };
     // Parts are read one at a time: memory holds the merged film and one part, whatever their
     // number. The first part's film becomes the merged film.
-    let mut first = read(first_path)?;
-    let (w, h) = (first.output.film.width(), first.output.film.height());
+    let mut first = read_part(first_path)?;
+    let size = (first.output.film.width(), first.output.film.height());
+    check_merge_memory(size)?;
+    planned_outputs(out_dir, &first.name, &first.output_settings, None, parts, Vec::new())?;
+    let mut merged = take_output(&mut first)?;
+    // Which part holds each chunk: coverage is checked by chunk identity, not by count.
+    let mut owner: BTreeMap<u64, usize> = merged.chunks.iter().map(|&c| (c, 0)).collect();
+    let mut seconds = vec![merged.seconds];
+    for (index, path) in parts.iter().enumerate().skip(1) {
+        let part = read_part(path)?;
+        if let Some(what) = difference(&first, &part, size) {
+            return Err(RenderError::Options(format!(
+                "{}: belongs to another render: its {what} differs from {}",
+                path.display(),
+                first_path.display()
+            )));
+        }
+        claim_chunks(&mut owner, &part.output, index, parts)?;
+        add_part(&mut merged, &part.output, path)?;
+        seconds.push(part.output.seconds);
+    }
+    check_coverage(&first.plan, &owner)?;
+    write_merged(out_dir, &first, &merged, &seconds)
+}
+
+/// Reads and validates one part, naming the file in errors.
+fn read_part(path: &Path) -> Result<PartialFilm, RenderError> {
+    PartialFilm::read(path).map_err(|message| RenderError::File { path: path.to_owned(), message })
+}
+
+/// Checks that the merged film and one part of `width x height` fit in memory.
+fn check_merge_memory((w, h): (u32, u32)) -> Result<(), RenderError> {
     let limit = MemoryLimit::system();
     let needed = Film::bytes_for(w, h).saturating_mul(2);
     if needed > limit.bytes {
@@ -45,7 +73,11 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
             limit.source
         )));
     }
-    planned_outputs(out_dir, &first.name, &first.output_settings, None, parts, Vec::new())?;
+    Ok(())
+}
+
+/// Moves the part's output out (it becomes the merged film), leaving an empty one behind.
+fn take_output(part: &mut PartialFilm) -> Result<RenderOutput, RenderError> {
     let placeholder = RenderOutput {
         film: Film::new(1, 1).map_err(|e| RenderError::Options(e.to_string()))?,
         stats: TraceStats::default(),
@@ -54,74 +86,96 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
         seconds: 0.0,
         moments: None,
     };
-    let mut merged = std::mem::replace(&mut first.output, placeholder);
-    // Which part holds each chunk: coverage is checked by chunk identity, not by count.
-    let mut owner: std::collections::BTreeMap<u64, usize> =
-        merged.chunks.iter().map(|&c| (c, 0)).collect();
-    let mut seconds = vec![merged.seconds];
-    for (index, path) in parts.iter().enumerate().skip(1) {
-        let part = read(path)?;
-        let different = if part.scene_fingerprint != first.scene_fingerprint {
-            Some("scene")
-        } else if part.plan != first.plan {
-            Some("plan (beams, chunk size, seed or time budget)")
-        } else if part.effects != first.effects {
-            Some("effects decision")
-        } else if part.name != first.name || part.output_settings != first.output_settings {
-            Some("output settings")
-        } else if part.integrator != first.integrator {
-            Some("integrator")
-        } else if part.sampler != first.sampler {
-            Some("sampler")
-        } else if part.light_power.to_bits() != first.light_power.to_bits() {
-            Some("light power")
-        } else if (part.output.film.width(), part.output.film.height()) != (w, h) {
-            Some("image size")
-        } else {
-            None
-        };
-        if let Some(what) = different {
+    Ok(std::mem::replace(&mut part.output, placeholder))
+}
+
+/// What differs between `part` and the `first` part (whose image is `size`), if anything: the
+/// parts of one render share everything but their chunks.
+fn difference(first: &PartialFilm, part: &PartialFilm, size: (u32, u32)) -> Option<&'static str> {
+    if part.scene_fingerprint != first.scene_fingerprint {
+        Some("scene")
+    } else if part.plan != first.plan {
+        Some("plan (beams, chunk size, seed or time budget)")
+    } else if part.effects != first.effects {
+        Some("effects decision")
+    } else if part.name != first.name || part.output_settings != first.output_settings {
+        Some("output settings")
+    } else if part.integrator != first.integrator {
+        Some("integrator")
+    } else if part.sampler != first.sampler {
+        Some("sampler")
+    } else if part.light_power.to_bits() != first.light_power.to_bits() {
+        Some("light power")
+    } else if (part.output.film.width(), part.output.film.height()) != size {
+        Some("image size")
+    } else {
+        None
+    }
+}
+
+/// Records that part `index` holds its chunks; a chunk another part holds is an error.
+fn claim_chunks(
+    owner: &mut BTreeMap<u64, usize>,
+    part: &RenderOutput,
+    index: usize,
+    parts: &[PathBuf],
+) -> Result<(), RenderError> {
+    for &c in &part.chunks {
+        if let Some(&other) = owner.get(&c) {
             return Err(RenderError::Options(format!(
-                "{}: belongs to another render: its {what} differs from {}",
-                path.display(),
-                first_path.display()
+                "{}: chunk {c} is also in {} (the same shard twice?)",
+                parts[index].display(),
+                parts[other].display()
             )));
         }
-        for &c in &part.output.chunks {
-            if let Some(&other) = owner.get(&c) {
-                return Err(RenderError::Options(format!(
-                    "{}: chunk {c} is also in {} (the same shard twice?)",
-                    path.display(),
-                    parts[other].display()
-                )));
-            }
-            owner.insert(c, index);
-        }
-        add_counts(&merged, &part.output).map_err(|what| {
-            RenderError::Options(format!(
-                "{}: adding its {what} to the other parts' overflows: not parts of one render",
-                path.display()
-            ))
-        })?;
-        merged
-            .merge(&part.output)
-            .map_err(|e| RenderError::Options(format!("{}: {e}", path.display())))?;
-        seconds.push(part.output.seconds);
+        owner.insert(c, index);
     }
-    // Time budgets and targets stop early: only they may leave chunks out.
-    if first.plan.time_budget.is_none() && first.plan.target_error.is_none() {
-        let expected = first.plan.chunks();
-        if owner.len() as u64 != expected {
-            let missing =
-                (0..expected).filter(|c| !owner.contains_key(c)).take(10).collect::<Vec<_>>();
-            return Err(RenderError::Options(format!(
-                "the parts cover {} of {expected} chunks; missing e.g. {missing:?}",
-                owner.len()
-            )));
-        }
+    Ok(())
+}
+
+/// Adds a part's film and counters to the merged ones.
+fn add_part(
+    merged: &mut RenderOutput,
+    part: &RenderOutput,
+    path: &Path,
+) -> Result<(), RenderError> {
+    add_counts(merged, part).map_err(|what| {
+        RenderError::Options(format!(
+            "{}: adding its {what} to the other parts' overflows: not parts of one render",
+            path.display()
+        ))
+    })?;
+    merged.merge(part).map_err(|e| RenderError::Options(format!("{}: {e}", path.display())))
+}
+
+/// Checks that the parts cover every chunk of `plan`: time budgets and targets stop early, so
+/// only they may leave chunks out.
+fn check_coverage(plan: &RenderPlan, owner: &BTreeMap<u64, usize>) -> Result<(), RenderError> {
+    if plan.time_budget.is_some() || plan.target_error.is_some() {
+        return Ok(());
     }
+    let expected = plan.chunks();
+    if owner.len() as u64 != expected {
+        let missing = (0..expected).filter(|c| !owner.contains_key(c)).take(10).collect::<Vec<_>>();
+        return Err(RenderError::Options(format!(
+            "the parts cover {} of {expected} chunks; missing e.g. {missing:?}",
+            owner.len()
+        )));
+    }
+    Ok(())
+}
+
+/// Writes the merged render's outputs and sidecar: its wall time is the slowest shard's, its
+/// speed the beams over all shards' time.
+fn write_merged(
+    out_dir: &Path,
+    first: &PartialFilm,
+    merged: &RenderOutput,
+    seconds: &[f64],
+) -> Result<RenderReport, RenderError> {
+    let (w, h) = (merged.film.width(), merged.film.height());
     let numerator = normalisation(first.integrator, first.light_power, u64::from(w) * u64::from(h));
-    let written = write_outputs(out_dir, &first.name, &first.output_settings, numerator, &merged)?;
+    let written = write_outputs(out_dir, &first.name, &first.output_settings, numerator, merged)?;
     let total_seconds: f64 = seconds.iter().sum();
     let mut report = report(
         first.scene_path.clone(),
@@ -129,7 +183,7 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
         first.plan,
         first.effects,
         first.integrator.name(),
-        &merged,
+        merged,
         seconds.iter().copied().fold(0.0, f64::max),
         first.light_power,
         written,
