@@ -13,12 +13,21 @@
 //! target error (`--target-error`), and [`pilot::estimate`] predicts the time to a target per
 //! estimator before rendering. The key design decision: one render path for every estimator
 //! ([`with_integrator`]), so sharding, time budgets, targets, probes and outputs work the same for
-//! all. The `spectrace` binary exposes it; the xtask's `render` subcommand calls it.
+//! all, and the estimators are named and built in one place only (the `integrators` module). The
+//! `spectrace` binary exposes it; the xtask's `render` subcommand calls it.
 //! The accuracy report is not here: it is an experiment harness with its own crate,
 //! `spectrace-lab`, so programs that render do not link its plotting library; this crate keeps
 //! the timed measurement both it and `spectrace bench` use ([`render_xyz`],
 //! [`integrator_benchmark`]). Nothing but `spectrace-lab`, `xtask` and the tests depend on this
 //! crate.
+//!
+//! The modules follow the jobs, in the order a render meets them: `scene` (the file and its
+//! assembly, [`Scene::features`] found once), `options` (overrides, errors), `plan` (estimator,
+//! effects, plan, normalisation), `integrators` (the estimators), `probe`, `warnings`, `run`
+//! ([`render_scene`] in named steps), `progress`, `write` and `output` (the files and their
+//! encoding), `report` (the sidecar), `sensors` and `sensor_output`, `part` and `shard` (part
+//! files and [`merge_parts`]), `bench`, [`pilot`], [`cli`], and `files` (bounded reads, atomic
+//! writes). Everything public is re-exported here, at the crate's root.
 
 mod bench;
 pub mod cli;
