@@ -1,7 +1,8 @@
 //! The one place the renderer knows its estimators: which there are, how each counts its work,
-//! and each built on the tracer's view of a scene. Everything else goes through these (names
-//! come from [`IntegratorChoice::name`] and [`Integrator::name`]), so an estimator added to the
-//! tracer is added to the renderer here.
+//! and each built on the tracer's view of a scene. The rest of the renderer lists and builds
+//! estimators only through these, and names them by [`IntegratorChoice::name`] and
+//! [`Integrator::name`]; only what each cannot render (`warnings`) and the sensor passes'
+//! sensor-only tracers (`sensors`) are said elsewhere.
 
 use spectrace_tracer::{
     Bdpt, Effects, Integrator, IntegratorChoice, LightTracer, LightTracerScene, PathTracer,

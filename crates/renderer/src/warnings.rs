@@ -1,5 +1,5 @@
-//! Warnings about a result that is not an error: light the chosen estimator cannot reach, and
-//! contributions the film left out.
+//! Warnings about a result that is not an error: light the chosen estimator cannot reach,
+//! sensors that miss light or are not written, a black image, contributions the film left out.
 
 use spectrace_tracer::{IntegratorChoice, RenderOutput, RenderPlan};
 
