@@ -133,7 +133,7 @@ enum Command {
 /// An integrator name.
 fn parse_integrator(s: &str) -> Result<IntegratorChoice, String> {
     IntegratorChoice::from_name(s.trim())
-        .ok_or_else(|| format!("`{s}`: must be auto, light, path or bdpt"))
+        .ok_or_else(|| format!("`{s}`: must be {}", crate::integrators::choice_names()))
 }
 
 /// A whole number of at least 1 (beams).

@@ -104,7 +104,30 @@ impl PartialFilm {
     /// # Errors
     /// The first field that no render could have written, named as `part.field`.
     pub fn validate(&self) -> Result<(), String> {
-        let bad = |field: &str, why: String| Err(format!("{field}: {why}"));
+        self.validate_settings()?;
+        validate_plan(&self.plan)?;
+        let decided = Effects::decide(self.effects.features, self.effects.mode);
+        if decided != self.effects {
+            return bad(
+                "effects",
+                "the decision does not follow from the scene features it names".to_owned(),
+            );
+        }
+        let out = &self.output;
+        validate_film(out)?;
+        validate_chunks(&self.plan, out)?;
+        validate_moments(&self.plan, out)?;
+        if !(out.seconds >= 0.0 && out.seconds.is_finite()) {
+            return bad(
+                "output.seconds",
+                format!("{}: must be finite and non-negative", out.seconds),
+            );
+        }
+        Ok(())
+    }
+
+    /// The light power, the output name and the output settings.
+    fn validate_settings(&self) -> Result<(), String> {
         if !(self.light_power > 0.0 && self.light_power.is_finite()) {
             return bad(
                 "light_power",
@@ -121,133 +144,144 @@ impl PartialFilm {
                 format!("{}: must be finite", self.output_settings.exposure),
             );
         }
-        let plan = &self.plan;
-        if plan.beams == 0 || plan.chunk_beams == 0 {
-            return bad(
-                "plan",
-                format!(
-                    "beams {} and chunk_beams {} must be at least 1",
-                    plan.beams, plan.chunk_beams
-                ),
-            );
-        }
-        if plan.shard.is_some() {
-            return bad("plan.shard", "a part stores the whole plan, without its shard".to_owned());
-        }
-        if let Some(t) = plan.time_budget
-            && !(t > 0.0 && t.is_finite())
-        {
-            return bad("plan.time_budget", format!("{t}: must be a positive number of seconds"));
-        }
-        if let Some(e) = plan.target_error {
-            crate::check_target_error(e).or_else(|m| bad("plan.target_error", m))?;
-        }
-        let decided = Effects::decide(self.effects.features, self.effects.mode);
-        if decided != self.effects {
-            return bad(
-                "effects",
-                "the decision does not follow from the scene features it names".to_owned(),
-            );
-        }
-        let out = &self.output;
-        let (w, h) = (out.film.width(), out.film.height());
-        if w == 0 || h == 0 || u64::from(w) * u64::from(h) > 1 << 25 {
-            return bad("output.film", format!("size {w}x{h} is not a valid image size"));
-        }
-        let pixels = out.film.to_xyz(1.0);
-        // Shards fill no sensors, so a part's film is its pixels and nothing more.
-        let extra = out.film.sensor_cells();
-        if pixels.len() as u64 != u64::from(w) * u64::from(h) || extra != 0 {
-            return bad(
-                "output.film",
-                format!(
-                    "holds {} pixels, but a {w}x{h} image has {}",
-                    pixels.len() + extra as usize,
-                    w * h
-                ),
-            );
-        }
-        if let Some(i) = pixels.iter().position(|p| !(p.x >= 0.0 && p.y >= 0.0 && p.z >= 0.0)) {
-            return bad(
-                "output.film",
-                format!(
-                    "pixel {i} has a negative sum ({:?}): light adds, it never subtracts",
-                    pixels[i]
-                ),
-            );
-        }
-        let total_chunks = plan.chunks();
-        if let Some(pair) = out.chunks.windows(2).find(|p| p[0] >= p[1]) {
-            return bad(
-                "output.chunks",
-                format!("not strictly increasing ({} then {})", pair[0], pair[1]),
-            );
-        }
-        if let Some(&c) = out.chunks.iter().find(|&&c| c >= total_chunks) {
-            return bad(
-                "output.chunks",
-                format!("chunk {c} does not exist: the plan has {total_chunks} chunks"),
-            );
-        }
-        let capacity = out
-            .chunks
-            .iter()
-            .try_fold(0u64, |acc, &c| acc.checked_add(plan.beams_in_chunk(c)))
-            .unwrap_or(u64::MAX);
-        let consistent =
-            if plan.time_budget.is_some() { out.beams <= capacity } else { out.beams == capacity };
-        if !consistent || out.stats.beams != out.beams {
-            return bad(
-                "output.beams",
-                format!(
-                    "{} beams (counted {}) do not match the {} beams of its {} chunks",
-                    out.beams,
-                    out.stats.beams,
-                    capacity,
-                    out.chunks.len()
-                ),
-            );
-        }
-        if let Some(m) = &out.moments {
-            if (m.width(), m.height()) != (w, h) {
-                return bad(
-                    "output.moments",
-                    format!("size {}x{} differs from the film's {w}x{h}", m.width(), m.height()),
-                );
-            }
-            // Chunks cut short by a time budget are rendered but not in the moments.
-            let cut_short_allowed = plan.time_budget.is_some();
-            let (chunks, items) = (out.chunks.len() as u64, out.beams);
-            let matches = if cut_short_allowed {
-                m.chunks() <= chunks && m.items() <= items
-            } else {
-                m.chunks() == chunks && m.items() == items
-            };
-            if !matches {
-                return bad(
-                    "output.moments",
-                    format!(
-                        "{} chunks of {} items, but the part rendered {} chunks of {} items",
-                        m.chunks(),
-                        m.items(),
-                        out.chunks.len(),
-                        out.beams
-                    ),
-                );
-            }
-            m.validate().or_else(|e| bad("output.moments", e))?;
-        } else if plan.target_error.is_some() {
+        Ok(())
+    }
+}
+
+/// The error for `field` of a part: `field: why`.
+fn bad<T>(field: &str, why: String) -> Result<T, String> {
+    Err(format!("{field}: {why}"))
+}
+
+/// The plan: work to do, no shard (a part stores the whole plan), a valid budget and target.
+fn validate_plan(plan: &RenderPlan) -> Result<(), String> {
+    if plan.beams == 0 || plan.chunk_beams == 0 {
+        return bad(
+            "plan",
+            format!("beams {} and chunk_beams {} must be at least 1", plan.beams, plan.chunk_beams),
+        );
+    }
+    if plan.shard.is_some() {
+        return bad("plan.shard", "a part stores the whole plan, without its shard".to_owned());
+    }
+    if let Some(t) = plan.time_budget
+        && !(t > 0.0 && t.is_finite())
+    {
+        return bad("plan.time_budget", format!("{t}: must be a positive number of seconds"));
+    }
+    if let Some(e) = plan.target_error {
+        crate::check_target_error(e).or_else(|m| bad("plan.target_error", m))?;
+    }
+    Ok(())
+}
+
+/// The film: a valid image size, exactly its pixels (shards fill no sensors), no negative sum.
+fn validate_film(out: &RenderOutput) -> Result<(), String> {
+    let (w, h) = (out.film.width(), out.film.height());
+    if w == 0 || h == 0 || u64::from(w) * u64::from(h) > 1 << 25 {
+        return bad("output.film", format!("size {w}x{h} is not a valid image size"));
+    }
+    let pixels = out.film.to_xyz(1.0);
+    // Shards fill no sensors, so a part's film is its pixels and nothing more.
+    let extra = out.film.sensor_cells();
+    if pixels.len() as u64 != u64::from(w) * u64::from(h) || extra != 0 {
+        return bad(
+            "output.film",
+            format!(
+                "holds {} pixels, but a {w}x{h} image has {}",
+                pixels.len() + extra as usize,
+                w * h
+            ),
+        );
+    }
+    if let Some(i) = pixels.iter().position(|p| !(p.x >= 0.0 && p.y >= 0.0 && p.z >= 0.0)) {
+        return bad(
+            "output.film",
+            format!(
+                "pixel {i} has a negative sum ({:?}): light adds, it never subtracts",
+                pixels[i]
+            ),
+        );
+    }
+    Ok(())
+}
+
+/// The chunks: strictly increasing, in the plan, and holding exactly the beams counted (at most
+/// them with a time budget, which cuts the last chunks short).
+fn validate_chunks(plan: &RenderPlan, out: &RenderOutput) -> Result<(), String> {
+    let total_chunks = plan.chunks();
+    if let Some(pair) = out.chunks.windows(2).find(|p| p[0] >= p[1]) {
+        return bad(
+            "output.chunks",
+            format!("not strictly increasing ({} then {})", pair[0], pair[1]),
+        );
+    }
+    if let Some(&c) = out.chunks.iter().find(|&&c| c >= total_chunks) {
+        return bad(
+            "output.chunks",
+            format!("chunk {c} does not exist: the plan has {total_chunks} chunks"),
+        );
+    }
+    let capacity = out
+        .chunks
+        .iter()
+        .try_fold(0u64, |acc, &c| acc.checked_add(plan.beams_in_chunk(c)))
+        .unwrap_or(u64::MAX);
+    let consistent =
+        if plan.time_budget.is_some() { out.beams <= capacity } else { out.beams == capacity };
+    if !consistent || out.stats.beams != out.beams {
+        return bad(
+            "output.beams",
+            format!(
+                "{} beams (counted {}) do not match the {} beams of its {} chunks",
+                out.beams,
+                out.stats.beams,
+                capacity,
+                out.chunks.len()
+            ),
+        );
+    }
+    Ok(())
+}
+
+/// The error estimate's moments: the film's size, the chunks and items rendered (fewer with a
+/// time budget), valid sums; present whenever the plan has a target.
+fn validate_moments(plan: &RenderPlan, out: &RenderOutput) -> Result<(), String> {
+    let (w, h) = (out.film.width(), out.film.height());
+    let Some(m) = &out.moments else {
+        if plan.target_error.is_some() {
             return bad(
                 "output.moments",
                 "missing: a render to a target error keeps its estimate".to_owned(),
             );
         }
-        if !(out.seconds >= 0.0 && out.seconds.is_finite()) {
-            return bad(
-                "output.seconds",
-                format!("{}: must be finite and non-negative", out.seconds),
-            );
-        }
-        Ok(())
+        return Ok(());
+    };
+    if (m.width(), m.height()) != (w, h) {
+        return bad(
+            "output.moments",
+            format!("size {}x{} differs from the film's {w}x{h}", m.width(), m.height()),
+        );
     }
+    // Chunks cut short by a time budget are rendered but not in the moments.
+    let cut_short_allowed = plan.time_budget.is_some();
+    let (chunks, items) = (out.chunks.len() as u64, out.beams);
+    let matches = if cut_short_allowed {
+        m.chunks() <= chunks && m.items() <= items
+    } else {
+        m.chunks() == chunks && m.items() == items
+    };
+    if !matches {
+        return bad(
+            "output.moments",
+            format!(
+                "{} chunks of {} items, but the part rendered {} chunks of {} items",
+                m.chunks(),
+                m.items(),
+                out.chunks.len(),
+                out.beams
+            ),
+        );
+    }
+    m.validate().or_else(|e| bad("output.moments", e))
 }

@@ -21,9 +21,11 @@ use serde::{Deserialize, Serialize};
 use spectrace_lights::LightSource;
 use spectrace_tracer::{IntegratorChoice, MIN_BATCHES, Progress, RenderPlan, render_observed};
 
+use crate::integrators::ESTIMATORS;
+use crate::warnings::integrator_warnings;
 use crate::{
-    RenderError, RenderOptions, Scene, choose_integrator, decide_effects, duration,
-    integrator_warnings, plan_with, with_integrator,
+    RenderError, RenderOptions, Scene, choose_integrator, decide_effects, duration, plan_with,
+    with_integrator,
 };
 
 /// Fewest chunks a live estimate of the pilot needs to enter the slope fit.
@@ -57,11 +59,7 @@ impl Default for EstimateOptions {
             pilot_seconds: DEFAULT_PILOT_SECONDS,
             threads: 0,
             seed: 0x5EED_0001,
-            integrators: vec![
-                IntegratorChoice::Light,
-                IntegratorChoice::Path,
-                IntegratorChoice::Bdpt,
-            ],
+            integrators: ESTIMATORS.to_vec(),
             fixed_rounds: None,
         }
     }

@@ -2,7 +2,7 @@
 //! and assembly into what the tracer needs.
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use serde::{Deserialize, Serialize};
 use spectrace_geometry::{Disk, Rectangle};
@@ -15,7 +15,7 @@ use spectrace_spectrum::Reflectance;
 use spectrace_tracer::{
     BdptSettings, CameraWavelengths, DEFAULT_CHUNK_BEAMS, EffectsMode, Emitter, IntegratorChoice,
     LightTracerSettings, MAX_DEPTH, ObjectEmission, ObjectLight, PathTracerSettings, PinholeCamera,
-    RenderPlan, SamplerKind,
+    RenderPlan, SamplerKind, SceneFeatures,
 };
 use spectrace_tracer::{IrradianceSensor, SensorSet};
 
@@ -273,6 +273,9 @@ pub struct Scene {
     pub inputs: Vec<PathBuf>,
     /// The illuminance sensors.
     pub sensors: SensorSet,
+    /// What the scene contains, for the effects analysis: found once, on first use (see
+    /// [`Scene::features`]).
+    features: OnceLock<SceneFeatures>,
 }
 
 /// How a scene file may refer to other files.
@@ -336,192 +339,54 @@ impl Scene {
         // Editors on some systems start UTF-8 files with a byte-order mark; JSON does not allow
         // one, but it carries no meaning, so it is skipped.
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        // Syntax first, so syntax errors are reported as such with their position.
-        let value: serde_json::Value =
-            serde_json::from_str(text).map_err(|e| SceneError::Syntax {
-                path: path.to_owned(),
-                line: e.line(),
-                column: e.column(),
-                message: strip_position(&e.to_string()),
-            })?;
-        // Files named inside the scene (measured luminaires) resolve against its folder while it
-        // is deserialised, under the same path policy as OBJ meshes.
+        let value = parse_syntax(text, path)?;
         let base = path.parent().unwrap_or_else(|| Path::new("."));
-        let (file, light_inputs) = with_scene_folder(base, options.restrict_paths, || {
-            let mut de = serde_json::Deserializer::from_str(text);
-            serde_path_to_error::deserialize::<_, SceneFile>(&mut de)
-        });
-        let file: SceneFile = file.map_err(|e| {
-            let field = e.path().to_string();
-            let inner = e.into_inner();
-            SceneError::Invalid {
-                path: path.to_owned(),
-                line: inner.line(),
-                column: inner.column(),
-                field: if field.is_empty() || field == "." { "(scene)".to_owned() } else { field },
-                message: strip_position(&inner.to_string()),
-            }
-        })?;
-        let scene_error = |field: &str, message: String| SceneError::Scene {
-            path: path.to_owned(),
-            field: field.to_owned(),
-            message,
-        };
-        if file.objects.is_empty() {
-            return Err(scene_error(
-                "objects",
-                "the scene has no objects: nothing can reflect light to the camera".to_owned(),
-            ));
-        }
-        let s = &file.settings;
-        if s.beams == 0 {
-            return Err(scene_error("settings.beams", "must be at least 1".to_owned()));
-        }
-        if s.max_depth > MAX_DEPTH {
-            return Err(scene_error(
-                "settings.max_depth",
-                format!(
-                    "{}: at most {MAX_DEPTH} bounces (longer paths carry no measurable light, \
-                     and one beam could outlast a time budget)",
-                    s.max_depth
-                ),
-            ));
-        }
-        if s.spp == 0 {
-            return Err(scene_error("settings.spp", "must be at least 1".to_owned()));
-        }
-        if s.sensor_spp == Some(0) {
-            return Err(scene_error("settings.sensor_spp", "must be at least 1".to_owned()));
-        }
-        if s.sensor_beams == Some(0) {
-            return Err(scene_error("settings.sensor_beams", "must be at least 1".to_owned()));
-        }
-        if s.chunk_beams == 0 {
-            return Err(scene_error("settings.chunk_beams", "must be at least 1".to_owned()));
-        }
-        if let Some(t) = s.time_seconds
-            && !(t > 0.0 && t.is_finite())
-        {
-            return Err(scene_error(
-                "settings.time_seconds",
-                format!("{t}: must be a positive number of seconds"),
-            ));
-        }
-        if let Some(e) = s.target_error {
-            check_target_error(e).map_err(|m| scene_error("settings.target_error", m))?;
-        }
-        if let Some(name) = &file.output.name {
-            check_output_name(name).map_err(|e| scene_error("output.name", e))?;
-        }
-        if !file.output.exposure.is_finite() {
-            return Err(scene_error("output.exposure", "must be finite".to_owned()));
-        }
-        let mut shapes = Vec::with_capacity(file.objects.len());
-        let mut materials = Vec::with_capacity(file.objects.len());
-        let mut non_convex = Vec::with_capacity(file.objects.len());
-        let mut inputs = light_inputs;
-        let mut object_lights: Vec<(usize, ObjectLight)> = Vec::new();
-        for (index, mut object) in file.objects.into_iter().enumerate() {
-            if let Shape::Mesh(mesh) = &object.shape
-                && let Some(obj) = mesh.obj_path()
-            {
-                let resolved = base.join(obj);
-                if options.restrict_paths {
-                    check_inside(base, &resolved).map_err(|message| {
-                        scene_error(&format!("objects[{index}].shape.obj"), message)
-                    })?;
-                }
-                inputs.push(resolved);
-            }
-            if let Some(t) = object.transform.take() {
-                object.shape = apply_transform(object.shape, &t).map_err(|message| {
-                    scene_error(&format!("objects[{index}].transform"), message)
-                })?;
-            }
-            // Only flat shapes can never send light to themselves; a sphere sees its own inside.
-            non_convex.push(!matches!(object.shape, Shape::Rectangle(_) | Shape::Disk(_)));
-            object
-                .shape
-                .load(base)
-                .map_err(|e| scene_error(&format!("objects[{index}].shape"), e.to_string()))?;
-            if let Some(emission) = &object.emission {
-                let light = ObjectLight::new(object.shape.clone(), emission).map_err(|e| {
-                    scene_error(&format!("objects[{index}].emission"), e.to_string())
-                })?;
+        let (file, light_inputs) = deserialize(text, path, base, options)?;
+        check_settings(&file, path)?;
+        let mut parts = Assembly::new(path, base, options, light_inputs);
+        let mut object_lights = Vec::new();
+        for (index, object) in file.objects.into_iter().enumerate() {
+            if let Some(light) = parts.add_object(index, object)? {
                 object_lights.push((index, light));
             }
-            shapes.push(object.shape);
-            materials.push(Arc::from(object.material));
         }
-        let object_shapes = shapes.len();
-        let mut emitters: Vec<Option<Emitter>> = vec![None; object_shapes];
-        let mut all_lights = file.lights;
-        let glowing: Vec<(usize, f64, bool, f64)> = object_lights
-            .iter()
-            .map(|(i, l)| (*i, l.radiance(), l.two_sided(), l.area()))
-            .collect();
-        all_lights
-            .extend(object_lights.into_iter().map(|(_, l)| Box::new(l) as Box<dyn LightSource>));
-        if all_lights.is_empty() {
-            return Err(scene_error(
-                "lights",
-                "the scene has no lights and no object with an `emission`".to_owned(),
-            ));
-        }
-        let lights = LightSet::new(all_lights).map_err(|e| scene_error("lights", e.to_string()))?;
-        // Glowing objects' lights are the set's last ones.
-        let first_glowing = lights.lights().len() - glowing.len();
-        for (k, &(index, radiance, two_sided, area)) in glowing.iter().enumerate() {
-            emitters[index] = Some(Emitter::Object {
-                light: LightId((first_glowing + k) as u32),
-                radiance,
-                two_sided,
-                area,
-            });
-        }
-        // Area lights are part of the scene: their surfaces block light and camera paths, and
-        // camera paths that hit them see their radiance. They reflect nothing.
-        for (index, light) in lights.lights().iter().enumerate().take(first_glowing) {
-            let Some(surface) = light.surface() else { continue };
-            let shape = match surface {
-                LightSurface::Rectangle { corner, edge_u, edge_v } => {
-                    Rectangle::new(corner, edge_u, edge_v).map(Shape::from)
-                }
-                LightSurface::Disk { center, normal, radius } => {
-                    Disk::new(center, normal, radius).map(Shape::from)
-                }
-                _ => continue,
-            }
-            .map_err(|e| scene_error(&format!("lights[{index}]"), e.to_string()))?;
-            shapes.push(shape);
-            materials.push(black().map_err(|e| scene_error(&format!("lights[{index}]"), e))?);
-            non_convex.push(false);
-            emitters.push(Some(Emitter::Light(LightId(index as u32))));
-        }
-        for (i, sensor) in file.sensors.iter().enumerate() {
-            check_output_name(sensor.name())
-                .map_err(|e| scene_error(&format!("sensors[{i}].name"), e))?;
-        }
-        let sensors = SensorSet::new(file.sensors).map_err(|e| scene_error("sensors", e))?;
-        let world = World::with_base_dir(shapes, base)
-            .map_err(|e| scene_error("objects", e.to_string()))?;
+        let object_shapes = parts.shapes.len();
+        let lights = parts.add_lights(file.lights, object_lights)?;
+        let sensors = sensor_set(file.sensors, path)?;
+        let world = World::with_base_dir(parts.shapes, base)
+            .map_err(|e| scene_error(path, "objects", e.to_string()))?;
         let canonical_json = serde_json::to_string(&value).unwrap_or_default();
         Ok(Self {
             path: path.to_owned(),
             canonical_json,
             camera: file.camera,
             world,
-            materials,
-            non_convex,
-            emitters,
+            materials: parts.materials,
+            non_convex: parts.non_convex,
+            emitters: parts.emitters,
             object_shapes,
             lights,
             settings: file.settings,
             effects: file.effects,
             output: file.output,
-            inputs,
+            inputs: parts.inputs,
             sensors,
+            features: OnceLock::new(),
         })
+    }
+
+    /// What the scene contains (its lights, materials and shapes), for the effects analysis, the
+    /// choice of estimator and the warnings: found on first use and kept, since none of them
+    /// changes once the scene is loaded.
+    pub fn features(&self) -> SceneFeatures {
+        *self.features.get_or_init(|| crate::tracer_scene(self).features(&self.non_convex))
+    }
+
+    /// Whether a point can sample every light (no laser, sky or beam-only light): what the path
+    /// tracer needs, from the camera or from a sensor.
+    pub(crate) fn lights_sampled_from_points(&self) -> bool {
+        let f = self.features();
+        f.beam_only_lights == 0 && f.delta_direction_lights == 0
     }
 
     /// The tracer settings.
@@ -579,6 +444,250 @@ impl Scene {
             .bytes()
             .fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
     }
+}
+
+/// An error in a scene that is well-formed but cannot be rendered as it is.
+fn scene_error(path: &Path, field: &str, message: String) -> SceneError {
+    SceneError::Scene { path: path.to_owned(), field: field.to_owned(), message }
+}
+
+/// The scene's JSON, checked for syntax first so that syntax errors are reported as such, with
+/// their position.
+fn parse_syntax(text: &str, path: &Path) -> Result<serde_json::Value, SceneError> {
+    serde_json::from_str(text).map_err(|e| SceneError::Syntax {
+        path: path.to_owned(),
+        line: e.line(),
+        column: e.column(),
+        message: strip_position(&e.to_string()),
+    })
+}
+
+/// The scene file's fields, with errors naming the field path, and the files its lights read.
+/// Files named inside the scene (measured luminaires) resolve against its folder `base` while
+/// it is deserialised, under the same path policy as OBJ meshes.
+fn deserialize(
+    text: &str,
+    path: &Path,
+    base: &Path,
+    options: LoadOptions,
+) -> Result<(SceneFile, Vec<PathBuf>), SceneError> {
+    let (file, light_inputs) = with_scene_folder(base, options.restrict_paths, || {
+        let mut de = serde_json::Deserializer::from_str(text);
+        serde_path_to_error::deserialize::<_, SceneFile>(&mut de)
+    });
+    let file = file.map_err(|e| {
+        let field = e.path().to_string();
+        let inner = e.into_inner();
+        SceneError::Invalid {
+            path: path.to_owned(),
+            line: inner.line(),
+            column: inner.column(),
+            field: if field.is_empty() || field == "." { "(scene)".to_owned() } else { field },
+            message: strip_position(&inner.to_string()),
+        }
+    })?;
+    Ok((file, light_inputs))
+}
+
+/// Checks what the types alone do not: some objects, and settings and output settings in range.
+fn check_settings(file: &SceneFile, path: &Path) -> Result<(), SceneError> {
+    let error = |field: &str, message: String| scene_error(path, field, message);
+    if file.objects.is_empty() {
+        return Err(error(
+            "objects",
+            "the scene has no objects: nothing can reflect light to the camera".to_owned(),
+        ));
+    }
+    let s = &file.settings;
+    if s.beams == 0 {
+        return Err(error("settings.beams", "must be at least 1".to_owned()));
+    }
+    if s.max_depth > MAX_DEPTH {
+        return Err(error(
+            "settings.max_depth",
+            format!(
+                "{}: at most {MAX_DEPTH} bounces (longer paths carry no measurable light, \
+                 and one beam could outlast a time budget)",
+                s.max_depth
+            ),
+        ));
+    }
+    if s.spp == 0 {
+        return Err(error("settings.spp", "must be at least 1".to_owned()));
+    }
+    if s.sensor_spp == Some(0) {
+        return Err(error("settings.sensor_spp", "must be at least 1".to_owned()));
+    }
+    if s.sensor_beams == Some(0) {
+        return Err(error("settings.sensor_beams", "must be at least 1".to_owned()));
+    }
+    if s.chunk_beams == 0 {
+        return Err(error("settings.chunk_beams", "must be at least 1".to_owned()));
+    }
+    if let Some(t) = s.time_seconds
+        && !(t > 0.0 && t.is_finite())
+    {
+        return Err(error(
+            "settings.time_seconds",
+            format!("{t}: must be a positive number of seconds"),
+        ));
+    }
+    if let Some(e) = s.target_error {
+        check_target_error(e).map_err(|m| error("settings.target_error", m))?;
+    }
+    if let Some(name) = &file.output.name {
+        check_output_name(name).map_err(|e| error("output.name", e))?;
+    }
+    if !file.output.exposure.is_finite() {
+        return Err(error("output.exposure", "must be finite".to_owned()));
+    }
+    Ok(())
+}
+
+/// A scene being assembled: its shapes (the objects' first, then the area lights' surfaces)
+/// with one material, convexity and emitter each, and every file read.
+struct Assembly<'a> {
+    /// The scene file, for errors.
+    path: &'a Path,
+    /// Its folder, against which meshes resolve.
+    base: &'a Path,
+    options: LoadOptions,
+    shapes: Vec<Shape>,
+    materials: Vec<Arc<dyn Material>>,
+    non_convex: Vec<bool>,
+    emitters: Vec<Option<Emitter>>,
+    inputs: Vec<PathBuf>,
+}
+
+impl<'a> Assembly<'a> {
+    /// An empty scene from `path`, whose lights read `inputs`.
+    fn new(path: &'a Path, base: &'a Path, options: LoadOptions, inputs: Vec<PathBuf>) -> Self {
+        Self {
+            path,
+            base,
+            options,
+            shapes: Vec::new(),
+            materials: Vec::new(),
+            non_convex: Vec::new(),
+            emitters: Vec::new(),
+            inputs,
+        }
+    }
+
+    /// An error about `field` of this scene.
+    fn error(&self, field: &str, message: String) -> SceneError {
+        scene_error(self.path, field, message)
+    }
+
+    /// Adds object `index`: its mesh file (checked against the path policy), its transform
+    /// applied, its shape loaded; returns its light when it glows.
+    fn add_object(
+        &mut self,
+        index: usize,
+        mut object: Object,
+    ) -> Result<Option<ObjectLight>, SceneError> {
+        if let Shape::Mesh(mesh) = &object.shape
+            && let Some(obj) = mesh.obj_path()
+        {
+            let resolved = self.base.join(obj);
+            if self.options.restrict_paths {
+                check_inside(self.base, &resolved).map_err(|message| {
+                    self.error(&format!("objects[{index}].shape.obj"), message)
+                })?;
+            }
+            self.inputs.push(resolved);
+        }
+        if let Some(t) = object.transform.take() {
+            object.shape = apply_transform(object.shape, &t)
+                .map_err(|message| self.error(&format!("objects[{index}].transform"), message))?;
+        }
+        // Only flat shapes can never send light to themselves; a sphere sees its own inside.
+        self.non_convex.push(!matches!(object.shape, Shape::Rectangle(_) | Shape::Disk(_)));
+        object
+            .shape
+            .load(self.base)
+            .map_err(|e| self.error(&format!("objects[{index}].shape"), e.to_string()))?;
+        let light = match &object.emission {
+            Some(emission) => {
+                Some(ObjectLight::new(object.shape.clone(), emission).map_err(|e| {
+                    self.error(&format!("objects[{index}].emission"), e.to_string())
+                })?)
+            }
+            None => None,
+        };
+        self.shapes.push(object.shape);
+        self.materials.push(Arc::from(object.material));
+        Ok(light)
+    }
+
+    /// The light set: the file's lights, then the glowing objects' (`(object index, light)`),
+    /// which become those objects' emitters; then the area lights' surfaces as shapes.
+    fn add_lights(
+        &mut self,
+        lights: Vec<Box<dyn LightSource>>,
+        object_lights: Vec<(usize, ObjectLight)>,
+    ) -> Result<LightSet, SceneError> {
+        self.emitters = vec![None; self.shapes.len()];
+        let mut all_lights = lights;
+        let glowing: Vec<(usize, f64, bool, f64)> = object_lights
+            .iter()
+            .map(|(i, l)| (*i, l.radiance(), l.two_sided(), l.area()))
+            .collect();
+        all_lights
+            .extend(object_lights.into_iter().map(|(_, l)| Box::new(l) as Box<dyn LightSource>));
+        if all_lights.is_empty() {
+            return Err(self.error(
+                "lights",
+                "the scene has no lights and no object with an `emission`".to_owned(),
+            ));
+        }
+        let lights = LightSet::new(all_lights).map_err(|e| self.error("lights", e.to_string()))?;
+        // Glowing objects' lights are the set's last ones.
+        let first_glowing = lights.lights().len() - glowing.len();
+        for (k, &(index, radiance, two_sided, area)) in glowing.iter().enumerate() {
+            self.emitters[index] = Some(Emitter::Object {
+                light: LightId((first_glowing + k) as u32),
+                radiance,
+                two_sided,
+                area,
+            });
+        }
+        self.add_light_surfaces(&lights, first_glowing)?;
+        Ok(lights)
+    }
+
+    /// Adds the surfaces of the first `count` lights that have one. Area lights are part of the
+    /// scene: their surfaces block light and camera paths, and camera paths that hit them see
+    /// their radiance. They reflect nothing.
+    fn add_light_surfaces(&mut self, lights: &LightSet, count: usize) -> Result<(), SceneError> {
+        for (index, light) in lights.lights().iter().enumerate().take(count) {
+            let Some(surface) = light.surface() else { continue };
+            let shape = match surface {
+                LightSurface::Rectangle { corner, edge_u, edge_v } => {
+                    Rectangle::new(corner, edge_u, edge_v).map(Shape::from)
+                }
+                LightSurface::Disk { center, normal, radius } => {
+                    Disk::new(center, normal, radius).map(Shape::from)
+                }
+                _ => continue,
+            }
+            .map_err(|e| self.error(&format!("lights[{index}]"), e.to_string()))?;
+            self.shapes.push(shape);
+            self.materials.push(black().map_err(|e| self.error(&format!("lights[{index}]"), e))?);
+            self.non_convex.push(false);
+            self.emitters.push(Some(Emitter::Light(LightId(index as u32))));
+        }
+        Ok(())
+    }
+}
+
+/// The sensors, whose names must be plain file names.
+fn sensor_set(sensors: Vec<IrradianceSensor>, path: &Path) -> Result<SensorSet, SceneError> {
+    for (i, sensor) in sensors.iter().enumerate() {
+        check_output_name(sensor.name())
+            .map_err(|e| scene_error(path, &format!("sensors[{i}].name"), e))?;
+    }
+    SensorSet::new(sensors).map_err(|e| scene_error(path, "sensors", e))
 }
 
 /// The shape with `t` applied after its own transform (re-validated, since a curved shape only

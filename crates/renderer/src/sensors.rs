@@ -16,12 +16,12 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 use spectrace_lights::LightSource;
 use spectrace_tracer::{
-    Effects, Film, LightTracer, PathTracer, RenderPlan, SensorPathTracer, SensorSet, SensorSums,
-    render as render_plan,
+    Effects, Film, Integrator, LightTracer, PathTracer, RenderOutput, RenderPlan, SensorPathTracer,
+    SensorSet, SensorSums, render as render_plan,
 };
 
 use crate::sensor_output::{SensorGrid, write_sensor_files};
-use crate::{RenderError, Scene, tracer_scene};
+use crate::{DEFAULT_SENSOR_SPP, RenderError, Scene, SensorIntegrator, tracer_scene};
 
 /// One sensor's figures in the sidecar.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -270,4 +270,58 @@ pub fn sensor_summary(r: &SensorReport) -> String {
         "sensor {}: average {:.1} lx, min {:.1} lx, max {:.1} lx, U0 {:.2} ({error}, {} by {} beams)",
         r.name, r.average_lux, r.minimum_lux, r.maximum_lux, r.uniformity, r.filled_by, r.beams
     )
+}
+
+/// How a camera integrator's render fills the sensors: the setting, with `auto` resolved (the
+/// path tracer when every light can be sampled from a point, else light paths).
+pub fn sensor_integrator(scene: &Scene) -> SensorIntegrator {
+    match scene.settings.sensor_integrator {
+        SensorIntegrator::Auto if scene.lights_sampled_from_points() => SensorIntegrator::Path,
+        SensorIntegrator::Auto => SensorIntegrator::Light,
+        other => other,
+    }
+}
+
+/// Fills and writes the sensors after an unsharded render by `tracer`: with the image's own
+/// beams when the estimator filled them (the light tracer), else with a sensor pass (see
+/// [`sensor_integrator`]) on `plan`'s threads. Empty for a scene without sensors.
+///
+/// # Errors
+/// [`RenderError`] if a sensor pass's film cannot be made or a file cannot be written.
+pub(crate) fn render_sensors(
+    scene: &Scene,
+    dir: &Path,
+    tracer: &dyn Integrator,
+    output: &RenderOutput,
+    plan: &RenderPlan,
+    effects: Effects,
+) -> Result<Vec<SensorReport>, RenderError> {
+    if scene.sensors.is_empty() {
+        return Ok(Vec::new());
+    }
+    if tracer.sensor_cells() > 0 {
+        let source = SensorSource {
+            film: &output.film,
+            beams: output.beams,
+            seconds: output.seconds,
+            filled_by: "image beams (light tracer)",
+        };
+        return write_sensors(scene, dir, source);
+    }
+    if sensor_integrator(scene) == SensorIntegrator::Light {
+        let (film, beams, seconds) =
+            sensor_pass(scene, &sensor_plan(scene, plan.threads), effects)?;
+        let source =
+            SensorSource { film: &film, beams, seconds, filled_by: "sensor pass (light tracer)" };
+        return write_sensors(scene, dir, source);
+    }
+    let passes = scene.settings.sensor_spp.unwrap_or(DEFAULT_SENSOR_SPP);
+    let (film, beams, seconds) = sensor_pass_path(scene, passes, plan.threads, effects)?;
+    let source = SensorSource {
+        film: &film,
+        beams,
+        seconds,
+        filled_by: "points sampled on the sensor (path tracer)",
+    };
+    write_sensors(scene, dir, source)
 }

@@ -1,0 +1,105 @@
+//! The one place the renderer knows its estimators: which there are, how each counts its work,
+//! and each built on the tracer's view of a scene, all read from the tracer's registry
+//! ([`spectrace_tracer::INTEGRATORS`]). The rest of the renderer lists and builds estimators only
+//! through these, and names them by [`IntegratorChoice::name`] and [`Integrator::name`]; only
+//! what each cannot render (`warnings`) and the sensor passes' sensor-only tracers (`sensors`)
+//! are said elsewhere.
+
+use spectrace_tracer::{
+    Effects, INTEGRATORS, Integrator, IntegratorChoice, IntegratorSettings, LightTracerScene,
+    build_integrator, registered,
+};
+
+use crate::Scene;
+
+/// Every estimator a render can use, in the order reports list them (`auto` picks one of them):
+/// the tracer's registry.
+pub(crate) const ESTIMATORS: [IntegratorChoice; INTEGRATORS.len()] = {
+    let mut choices = [IntegratorChoice::Auto; INTEGRATORS.len()];
+    let mut i = 0;
+    while i < INTEGRATORS.len() {
+        choices[i] = INTEGRATORS[i].choice;
+        i += 1;
+    }
+    choices
+};
+
+/// Whether `choice`'s work items are camera samples, in passes of one sample per pixel (path
+/// tracer, BDPT), rather than beams from the lights (the light tracer, and `auto` before it is
+/// decided, which [`with_integrator`] also builds as the light tracer).
+pub(crate) fn is_camera_integrator(choice: IntegratorChoice) -> bool {
+    registered(choice).camera_passes
+}
+
+/// The scene's settings of every estimator.
+pub(crate) fn integrator_settings(scene: &Scene) -> IntegratorSettings {
+    IntegratorSettings {
+        light: scene.tracer_settings(),
+        path: scene.path_settings(),
+        bdpt: scene.bdpt_settings(),
+    }
+}
+
+/// The names `--integrator` and `settings.integrator` accept, in words: `auto, light, path or
+/// bdpt`.
+pub(crate) fn choice_names() -> String {
+    let mut names: Vec<&str> = std::iter::once(IntegratorChoice::Auto)
+        .chain(ESTIMATORS)
+        .map(IntegratorChoice::name)
+        .collect();
+    let last = names.pop().unwrap_or_default();
+    format!("{} or {last}", names.join(", "))
+}
+
+/// The tracer's view of a scene.
+pub fn tracer_scene(scene: &Scene) -> LightTracerScene<'_> {
+    LightTracerScene::new(&scene.world, &scene.materials, &scene.lights, &scene.camera)
+        .with_emitters(scene.emitters.clone(), scene.object_shapes)
+        .with_sampler(scene.settings.sampler)
+        .with_sensors(&scene.sensors)
+}
+
+/// Runs `f` with the estimator `choice` for `scene`, following `effects`.
+pub fn with_integrator<R>(
+    scene: &Scene,
+    choice: IntegratorChoice,
+    effects: Effects,
+    f: impl FnOnce(&dyn Integrator) -> R,
+) -> R {
+    with_integrator_filling(scene, choice, effects, true, f)
+}
+
+/// As [`with_integrator`]; with `sensors` false the light tracer leaves the scene's sensors
+/// alone (a shard's part holds the image only).
+pub fn with_integrator_filling<R>(
+    scene: &Scene,
+    choice: IntegratorChoice,
+    effects: Effects,
+    sensors: bool,
+    f: impl FnOnce(&dyn Integrator) -> R,
+) -> R {
+    let none = spectrace_tracer::SensorSet::default();
+    let tracer_scene =
+        if sensors { tracer_scene(scene) } else { tracer_scene(scene).with_sensors(&none) };
+    let integrator = build_integrator(choice, &tracer_scene, &integrator_settings(scene), effects);
+    f(integrator.as_ref())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_names_in_words_are_every_choice_the_command_line_accepts() {
+        assert_eq!(choice_names(), "auto, light, path or bdpt");
+        for choice in ESTIMATORS {
+            assert_eq!(IntegratorChoice::from_name(choice.name()), Some(choice));
+        }
+        // Auto is built as the light tracer until it is decided; each estimator's own name is
+        // its choice's.
+        assert!(!is_camera_integrator(IntegratorChoice::Auto));
+        assert!(is_camera_integrator(IntegratorChoice::Path));
+        assert!(is_camera_integrator(IntegratorChoice::Bdpt));
+        assert!(!is_camera_integrator(IntegratorChoice::Light));
+    }
+}

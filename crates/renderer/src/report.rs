@@ -1,0 +1,230 @@
+//! What a render did: the JSON sidecar's contents ([`RenderReport`]) and its accuracy estimate.
+
+use serde::{Deserialize, Serialize};
+use spectrace_tracer::{Effects, LightTracer, RenderOutput, RenderPlan, SamplerKind, TraceStats};
+
+use crate::warnings::rejected_warning;
+use crate::{SensorReport, Written};
+
+/// What a render did: the JSON sidecar's contents.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RenderReport {
+    /// The scene file.
+    pub scene: String,
+    /// Image size.
+    pub width: u32,
+    /// Image size.
+    pub height: u32,
+    /// The plan after overrides (beams, chunk size, seed, threads, shard, time budget).
+    pub plan: RenderPlan,
+    /// The effects analysis' decision.
+    pub effects: Effects,
+    /// The decision in words.
+    pub effects_summary: String,
+    /// The estimator that rendered the image
+    /// ([`Integrator::name`](spectrace_tracer::Integrator::name)): `"light"`, `"path"` or
+    /// `"bdpt"`.
+    #[serde(default = "light_integrator")]
+    pub integrator: String,
+    /// Why that estimator: asked for, or the effects analysis' reason.
+    #[serde(default)]
+    pub integrator_reason: String,
+    /// Where the random numbers came from (`settings.sampler`): `"independent"` or `"sobol"`.
+    #[serde(default = "independent_sampler")]
+    pub sampler: String,
+    /// Beams traced.
+    pub beams: u64,
+    /// Wall time (s).
+    pub wall_seconds: f64,
+    /// Beams per second.
+    pub beams_per_second: f64,
+    /// Contributions rejected by the film as non-finite or out of range (0 on every shipped
+    /// scene).
+    pub rejected_contributions: u64,
+    /// The EXR holds the image multiplied by `2^exr_scale_log2`: 0 unless the image lies beyond
+    /// the range of 32-bit floats (see [`encode_image`](crate::encode_image)).
+    pub exr_scale_log2: i32,
+    /// Channel values that would have overflowed to infinity (or underflowed to zero) in the
+    /// EXR without that scale.
+    pub out_of_range_values: u64,
+    /// Anything the user should know about the result (also printed).
+    pub warnings: Vec<String>,
+    /// How accurate the image is, estimated from the spread between its chunks (absent when
+    /// the image was too large to keep the estimate's moments).
+    #[serde(default)]
+    pub error_estimate: Option<AccuracyEstimate>,
+    /// Tracer counters.
+    pub stats: TraceStats,
+    /// Total power of the lights (W).
+    pub light_power: f64,
+    /// Files written.
+    pub outputs: Vec<String>,
+    /// The illuminance sensors' figures (empty for a scene without sensors).
+    #[serde(default)]
+    pub sensors: Vec<SensorReport>,
+    /// Spectrace version.
+    pub version: String,
+}
+
+/// The relative errors the sidecar predicts render times for (10%, 5%, 2%, 1%).
+pub const PREDICTED_ERRORS: [f64; 4] = [0.10, 0.05, 0.02, 0.01];
+
+/// How accurate a rendered image is and what more accuracy costs: the sidecar's
+/// `error_estimate`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AccuracyEstimate {
+    /// Estimated relative RMSE against the converged image (over all pixels and X, Y, Z: the
+    /// accuracy report's measure); `null` with fewer than two batches or a black image.
+    pub relative_rmse: Option<f64>,
+    /// One-sigma relative uncertainty of that estimate itself.
+    pub relative_uncertainty: f64,
+    /// Independent batches (work chunks) it comes from.
+    pub batches: u64,
+    /// `true` with at least [`spectrace_tracer::MIN_BATCHES`] batches.
+    pub trusted: bool,
+    /// The target asked for (`--target-error`, `settings.target_error`), if any.
+    pub target_error: Option<f64>,
+    /// Whether the estimate reached the target (`null` without one).
+    pub target_reached: Option<bool>,
+    /// Predicted total render time (s, at this render's speed) to reach each relative error in
+    /// [`PREDICTED_ERRORS`], with error falling as `1 / sqrt(work)`; `[error, seconds]` pairs,
+    /// only for errors below the current one.
+    pub predicted_seconds: Vec<[f64; 2]>,
+    /// More render time (s) that would halve the error (three times this render's: four
+    /// times the work).
+    pub seconds_to_halve: f64,
+    /// With a target the render did not reach (a time cap): the predicted total render time
+    /// (s) to reach it; `null` otherwise.
+    #[serde(default)]
+    pub seconds_to_target: Option<f64>,
+}
+
+impl AccuracyEstimate {
+    /// The sidecar's estimate of a render of `seconds` that ended with `estimate`.
+    pub fn new(
+        estimate: &spectrace_tracer::ErrorEstimate,
+        target: Option<f64>,
+        seconds: f64,
+    ) -> Self {
+        let e = estimate.relative_rmse;
+        let predicted_seconds = match e {
+            Some(e) if e > 0.0 => PREDICTED_ERRORS
+                .iter()
+                .filter(|&&t| t < e)
+                .map(|&t| [t, seconds * (e / t).powi(2)])
+                .collect(),
+            _ => Vec::new(),
+        };
+        Self {
+            relative_rmse: e,
+            relative_uncertainty: estimate.relative_uncertainty(),
+            batches: estimate.batches,
+            trusted: estimate.is_trusted(),
+            target_error: target,
+            target_reached: target.map(|t| e.is_some_and(|e| e <= t) && estimate.is_trusted()),
+            predicted_seconds,
+            seconds_to_halve: 3.0 * seconds,
+            seconds_to_target: match (e, target) {
+                (Some(e), Some(t)) if e > t && t > 0.0 => Some(seconds * (e / t).powi(2)),
+                _ => None,
+            },
+        }
+    }
+
+    /// One line for the terminal: `error 3.2% ±0.1% (64 batches); 2%: ~41 s`.
+    pub fn summary(&self) -> String {
+        let Some(e) = self.relative_rmse else {
+            return format!(
+                "error: no estimate ({} batches, need 2 and a lit image)",
+                self.batches
+            );
+        };
+        let mut line = format!(
+            "estimated error {:.2}% ±{:.2}% ({} batches{})",
+            e * 100.0,
+            e * self.relative_uncertainty * 100.0,
+            self.batches,
+            if self.trusted { "" } else { ", too few to trust" }
+        );
+        if let (Some(t), Some(reached)) = (self.target_error, self.target_reached) {
+            line.push_str(&format!(
+                "; target {:.2}% {}",
+                t * 100.0,
+                if reached { "reached" } else { "not reached" }
+            ));
+        }
+        if let Some([t, s]) = self.predicted_seconds.first() {
+            line.push_str(&format!("; {:.0}% would take ~{} in all", t * 100.0, duration(*s)));
+        }
+        line
+    }
+}
+
+/// Seconds in words: `850 ms`, `12.3 s`, `4.1 min`, `2.5 h`.
+pub fn duration(seconds: f64) -> String {
+    if !seconds.is_finite() {
+        "forever".to_owned()
+    } else if seconds < 1.0 {
+        format!("{:.0} ms", seconds * 1e3)
+    } else if seconds < 120.0 {
+        format!("{seconds:.1} s")
+    } else if seconds < 7200.0 {
+        format!("{:.1} min", seconds / 60.0)
+    } else {
+        format!("{:.1} h", seconds / 3600.0)
+    }
+}
+
+/// The integrator of sidecars written before the field existed: the light tracer.
+fn light_integrator() -> String {
+    LightTracer::NAME.to_owned()
+}
+
+/// The sampler of sidecars written before the field existed.
+fn independent_sampler() -> String {
+    SamplerKind::Independent.name().to_owned()
+}
+
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn report(
+    scene: String,
+    (width, height): (u32, u32),
+    plan: RenderPlan,
+    effects: Effects,
+    integrator: &str,
+    output: &RenderOutput,
+    wall: f64,
+    light_power: f64,
+    written: Written,
+) -> RenderReport {
+    let mut warnings = written.warnings;
+    if output.film.rejected() > 0 {
+        warnings.push(rejected_warning(output.film.rejected()));
+    }
+    RenderReport {
+        scene,
+        width,
+        height,
+        plan,
+        effects,
+        effects_summary: effects.summary(),
+        integrator: integrator.to_owned(),
+        integrator_reason: String::new(),
+        sampler: independent_sampler(),
+        beams: output.beams,
+        wall_seconds: wall,
+        beams_per_second: if wall > 0.0 { output.beams as f64 / wall } else { 0.0 },
+        rejected_contributions: output.film.rejected(),
+        error_estimate: output
+            .estimate()
+            .map(|e| AccuracyEstimate::new(&e, plan.target_error, output.seconds)),
+        stats: output.stats,
+        light_power,
+        outputs: written.files,
+        exr_scale_log2: written.exr_scale_log2,
+        out_of_range_values: written.out_of_range_values,
+        warnings,
+        sensors: Vec::new(),
+        version: env!("CARGO_PKG_VERSION").to_owned(),
+    }
+}

@@ -1,0 +1,272 @@
+//! Rendering a scene with its overrides: the plan, the probe, the render and the written outputs
+//! (or a shard's part file); and renders kept in memory.
+
+use std::path::Path;
+
+use spectrace_lights::LightSource;
+use spectrace_tracer::{
+    Effects, Integrator, IntegratorChoice, MemoryLimit, RenderOutput, RenderPlan, render,
+};
+
+use crate::plan::scene_normalisation;
+use crate::progress::render_with_progress;
+use crate::report::report;
+use crate::sensors::render_sensors;
+use crate::shard::write_part;
+use crate::warnings::{black_image_warning, render_warnings};
+use crate::write::{part_path, planned_outputs, write_sidecar};
+use crate::{
+    LoadOptions, MAX_PART_BYTES, PARTIAL_VERSION, PartialFilm, ProbeOutcome, RenderError,
+    RenderOptions, RenderReport, Scene, Written, check_sensor_names, choose_integrator,
+    decide_effects, image, plan_with, planned_sensor_outputs, probe_with, sensor_summary,
+    with_integrator, with_integrator_filling, write_outputs,
+};
+
+/// Renders a scene file with overrides and writes its outputs (or, with a shard, its partial film).
+///
+/// # Errors
+/// [`RenderError`] for an invalid scene or options, or a file that cannot be written.
+pub fn render_file(path: &Path, options: &RenderOptions) -> Result<RenderReport, RenderError> {
+    let scene = Scene::load_with(path, LoadOptions { restrict_paths: options.restrict_paths })?;
+    render_scene(&scene, options)
+}
+
+/// Renders a loaded scene with overrides and writes its outputs.
+///
+/// # Errors
+/// As [`render_file`].
+pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderReport, RenderError> {
+    let (choice, reason) = choose_integrator(scene, options.integrator);
+    let plan = plan_with(scene, options, choice)?;
+    let name = scene.output_name();
+    check_sensor_names(scene, &name)?;
+    planned_outputs(
+        &options.out_dir,
+        &name,
+        &scene.output,
+        plan.shard,
+        &scene.inputs,
+        planned_sensor_outputs(scene, &options.out_dir),
+    )?;
+    let (plan, estimate_warning) = fit_estimate(scene, plan)?;
+    let effects = decide_effects(scene, options.effects);
+    if options.verbose {
+        eprintln!("{}", effects.summary());
+        eprintln!("integrator: {reason}");
+    }
+    with_integrator_filling(scene, choice, effects, plan.shard.is_none(), |tracer| {
+        let setup = Setup { choice, reason: &reason, effects, plan, name: &name };
+        render_with(scene, options, &setup, estimate_warning.into_iter().collect(), tracer)
+    })
+}
+
+/// The plan without the error estimate when its moments would not fit in memory but the
+/// render would, or would make a shard's part file larger than a part may be (a very large
+/// image), with a warning saying so; the plan unchanged otherwise.
+///
+/// # Errors
+/// [`RenderError::Options`] when a target error needs the estimate that does not fit.
+fn fit_estimate(
+    scene: &Scene,
+    plan: RenderPlan,
+) -> Result<(RenderPlan, Option<String>), RenderError> {
+    if !plan.keeps_estimate() {
+        return Ok((plan, None));
+    }
+    let (w, h) = (scene.camera.width(), scene.camera.height());
+    let limit = MemoryLimit::system();
+    let without = RenderPlan { error_estimate: false, ..plan };
+    let estimate_bytes = plan.memory_bytes(w, h).saturating_sub(without.memory_bytes(w, h));
+    // A part file holds the film (up to 48 bytes per pixel) and the moments (72).
+    let part_bytes = (u64::from(w) * u64::from(h)).saturating_mul(48 + 72);
+    let why = if plan.shard.is_some() && part_bytes > MAX_PART_BYTES {
+        format!(
+            "a part file of a {w}x{h} image with its moments would exceed the {} part-file limit",
+            spectrace_geometry::human_bytes(MAX_PART_BYTES)
+        )
+    } else if plan.check_memory(w, h, &limit).is_err() && without.check_memory(w, h, &limit).is_ok()
+    {
+        format!(
+            "its moments for a {w}x{h} image ({} more) do not fit in the memory a render may \
+             use ({})",
+            spectrace_geometry::human_bytes(estimate_bytes),
+            limit.source
+        )
+    } else {
+        return Ok((plan, None));
+    };
+    // A target needs the estimate.
+    if plan.target_error.is_some() {
+        return Err(RenderError::Options(format!(
+            "--target-error / settings.target_error needs the error estimate, but {why}"
+        )));
+    }
+    Ok((without, Some(format!("no error estimate: {why}"))))
+}
+
+/// A render kept in memory: the film, the image and the estimator that made it.
+#[derive(Debug, Clone)]
+pub struct InMemoryRender {
+    /// The film and counters.
+    pub output: RenderOutput,
+    /// The image (XYZ per pixel, film units).
+    pub image: Vec<spectrace_spectrum::Xyz>,
+    /// The estimator.
+    pub integrator: IntegratorChoice,
+}
+
+/// Renders a scene with overrides without writing anything (no probe, no progress bar): for
+/// tests, benchmarks and the accuracy report.
+///
+/// # Errors
+/// [`RenderError::Options`] for invalid options or a film that cannot be made.
+pub fn render_in_memory(
+    scene: &Scene,
+    options: &RenderOptions,
+) -> Result<InMemoryRender, RenderError> {
+    let (choice, _) = choose_integrator(scene, options.integrator);
+    let plan = plan_with(scene, options, choice)?;
+    let effects = decide_effects(scene, options.effects);
+    let output = with_integrator(scene, choice, effects, |tracer| render(tracer, &plan, &|_| {}))
+        .map_err(|e| RenderError::Options(e.to_string()))?;
+    scene.lights.reset_count();
+    let image = image(&output, scene_normalisation(scene, choice));
+    Ok(InMemoryRender { output, image, integrator: choice })
+}
+
+/// What [`render_scene`] decided before building the estimator.
+struct Setup<'a> {
+    choice: IntegratorChoice,
+    reason: &'a str,
+    effects: Effects,
+    plan: RenderPlan,
+    name: &'a str,
+}
+
+/// The rest of [`render_scene`], once the estimator is built; `warnings` are the ones found so
+/// far.
+fn render_with(
+    scene: &Scene,
+    options: &RenderOptions,
+    setup: &Setup<'_>,
+    mut warnings: Vec<String>,
+    tracer: &dyn Integrator,
+) -> Result<RenderReport, RenderError> {
+    warnings.extend(render_warnings(scene, setup.choice, &setup.plan));
+    let probed = probe_noting(scene, &setup.plan, tracer, options.verbose)?;
+    let (output, wall) = render_with_progress(tracer, &setup.plan, options.verbose)?;
+    let finished = Finished { scene, setup, integrator: tracer.name(), wall, warnings };
+    match setup.plan.shard {
+        Some(shard) => write_shard(&finished, &options.out_dir, shard, output),
+        None => write_render(&finished, options, tracer, probed, &output),
+    }
+}
+
+/// The pre-render probe with the render's estimator (see [`probe_with`]); a probe that ran out
+/// of time is noted on stderr when `verbose` (and an image that then comes out black is
+/// reported after the render).
+fn probe_noting(
+    scene: &Scene,
+    plan: &RenderPlan,
+    tracer: &dyn Integrator,
+    verbose: bool,
+) -> Result<ProbeOutcome, RenderError> {
+    let probed = probe_with(scene, plan, tracer)?;
+    if verbose && !probed.lit {
+        eprintln!(
+            "note: the pre-render probe ran out of time after {} paths without seeing light reach \
+             the camera; rendering anyway",
+            probed.beams
+        );
+    }
+    Ok(probed)
+}
+
+/// A render that is done: what its reports share.
+struct Finished<'a> {
+    scene: &'a Scene,
+    setup: &'a Setup<'a>,
+    /// The estimator's [`Integrator::name`].
+    integrator: &'static str,
+    /// Wall time of the render (s).
+    wall: f64,
+    /// The warnings found before and while rendering.
+    warnings: Vec<String>,
+}
+
+impl Finished<'_> {
+    /// The sidecar's contents for `output` and what was written (whose warnings come first).
+    fn report(&self, output: &RenderOutput, mut written: Written) -> RenderReport {
+        let (scene, setup) = (self.scene, self.setup);
+        written.warnings.extend(self.warnings.iter().cloned());
+        let mut r = report(
+            scene.path.display().to_string(),
+            (scene.camera.width(), scene.camera.height()),
+            setup.plan,
+            setup.effects,
+            self.integrator,
+            output,
+            self.wall,
+            scene.lights.power(),
+            written,
+        );
+        r.integrator_reason = setup.reason.to_owned();
+        r.sampler = scene.settings.sampler.name().to_owned();
+        r
+    }
+}
+
+/// A shard's end: its part file (the film moves into it) and its report, which has no sidecar.
+fn write_shard(
+    finished: &Finished<'_>,
+    out_dir: &Path,
+    shard: (u64, u64),
+    output: RenderOutput,
+) -> Result<RenderReport, RenderError> {
+    let (scene, setup) = (finished.scene, finished.setup);
+    let path = part_path(out_dir, setup.name, shard);
+    let report = finished
+        .report(&output, Written { files: vec![path.display().to_string()], ..Written::default() });
+    let part = PartialFilm {
+        version: PARTIAL_VERSION,
+        scene_fingerprint: scene.fingerprint(),
+        scene_path: scene.path.display().to_string(),
+        plan: RenderPlan { shard: None, threads: 0, ..setup.plan },
+        light_power: scene.lights.power(),
+        integrator: setup.choice,
+        sampler: scene.settings.sampler,
+        effects: setup.effects,
+        output_settings: scene.output.clone(),
+        name: setup.name.to_owned(),
+        output,
+    };
+    write_part(&path, part)?;
+    Ok(report)
+}
+
+/// An unsharded render's end: the image files, the sensors' files and the sidecar.
+fn write_render(
+    finished: &Finished<'_>,
+    options: &RenderOptions,
+    tracer: &dyn Integrator,
+    probed: ProbeOutcome,
+    output: &RenderOutput,
+) -> Result<RenderReport, RenderError> {
+    let (scene, setup) = (finished.scene, finished.setup);
+    let numerator = scene_normalisation(scene, setup.choice);
+    let mut written =
+        write_outputs(&options.out_dir, setup.name, &scene.output, numerator, output)?;
+    written.warnings.extend(black_image_warning(&probed, output));
+    let sensors =
+        render_sensors(scene, &options.out_dir, tracer, output, &setup.plan, setup.effects)?;
+    for r in &sensors {
+        written.files.extend(r.files.iter().cloned());
+        if options.verbose {
+            eprintln!("{}", sensor_summary(r));
+        }
+    }
+    let mut report = finished.report(output, written);
+    report.sensors = sensors;
+    write_sidecar(&options.out_dir, setup.name, &report)?;
+    Ok(report)
+}

@@ -1,0 +1,98 @@
+//! Warnings about a result that is not an error: light the chosen estimator cannot reach,
+//! sensors that miss light or are not written, a black image, contributions the film left out.
+
+use spectrace_tracer::{IntegratorChoice, RenderOutput, RenderPlan};
+
+use crate::{ProbeOutcome, Scene, SensorIntegrator};
+
+/// What a user should know before a render by `choice` with `plan`: light the estimator cannot
+/// reach, and sensors that will miss light or not be written.
+pub(crate) fn render_warnings(
+    scene: &Scene,
+    choice: IntegratorChoice,
+    plan: &RenderPlan,
+) -> Vec<String> {
+    let mut warnings = integrator_warnings(scene, choice);
+    if !scene.sensors.is_empty()
+        && scene.settings.sensor_integrator == SensorIntegrator::Path
+        && !scene.lights_sampled_from_points()
+    {
+        warnings.push(
+            "settings.sensor_integrator \"path\": lasers, skies and beam-only lights cannot be \
+             sampled from a point, so the sensors miss their light; use \"light\" or \"auto\""
+                .to_owned(),
+        );
+    }
+    if !scene.sensors.is_empty() && plan.shard.is_some() {
+        warnings.push(
+            "sensors are written by unsharded renders only (merge-parts writes the image): \
+             render without --shard for the sensors' files"
+                .to_owned(),
+        );
+    }
+    warnings
+}
+
+/// What a user should know about the chosen estimator: light a camera integrator cannot reach.
+pub(crate) fn integrator_warnings(scene: &Scene, choice: IntegratorChoice) -> Vec<String> {
+    let mut warnings = Vec::new();
+    let features = scene.features();
+    if choice == IntegratorChoice::Light && features.specular {
+        warnings.push(
+            "the light tracer cannot see into mirrors and glass: what they reflect or refract \
+             toward the camera is missing from this image (use --integrator bdpt or auto)"
+                .to_owned(),
+        );
+    }
+    if choice == IntegratorChoice::Bdpt && features.fluorescent && features.specular {
+        warnings.push(
+            "BDPT re-emits fluorescent light on light paths only: a fluorescent surface seen \
+             only through mirrors or glass is missing from this image (use --integrator path)"
+                .to_owned(),
+        );
+    }
+    if choice != IntegratorChoice::Path {
+        return warnings;
+    }
+    if !scene.lights_sampled_from_points() {
+        warnings.push(
+            "the path tracer cannot reach lasers, skies or lights that only generate beams: \
+             their light is missing from this image (use --integrator light or auto)"
+                .to_owned(),
+        );
+    }
+    if features.line_spectra {
+        warnings.push(
+            "the path tracer draws wavelengths from a density and misses spectral lines: \
+             their light is missing from this image (use --integrator light or auto)"
+                .to_owned(),
+        );
+    }
+    if features.delta_position_lights > 0 && features.specular {
+        warnings.push(
+            "the path tracer cannot see caustics of point or spot lights (their light through \
+             mirrors and glass onto other surfaces is missing; use --integrator light or auto)"
+                .to_owned(),
+        );
+    }
+    warnings
+}
+
+/// The warning for an image that came out black after an inconclusive probe.
+pub(crate) fn black_image_warning(probed: &ProbeOutcome, output: &RenderOutput) -> Option<String> {
+    (!probed.lit && output.film.accepted() == 0).then(|| {
+        format!(
+            "no light reached the camera: the image is black (the pre-render probe ran out of \
+             time after {} paths, and none of the {} paths rendered lit a point the camera sees)",
+            probed.beams, output.beams
+        )
+    })
+}
+
+/// The warning for `n` contributions the film left out.
+pub(crate) fn rejected_warning(n: u64) -> String {
+    format!(
+        "{n} contributions were not finite or beyond the film's range and were left out: \
+         the image is darker than it should be where they fell"
+    )
+}

@@ -1,0 +1,148 @@
+//! The files of a render: which it will write (checked before any work), the image, the EXR,
+//! PNG and error image, and the JSON sidecar.
+
+use std::path::{Path, PathBuf};
+
+use spectrace_tracer::RenderOutput;
+
+use crate::{
+    Normalisation, OutputSettings, RenderError, RenderReport, check_no_input_replaced,
+    check_output_name, encode_image, prepare_out_dir, write_atomically, write_exr, write_png,
+};
+
+/// The files a render will write, checked before any work starts: a valid base name, an output
+/// folder that is a folder, and no output that would replace an input.
+pub(crate) fn planned_outputs(
+    out_dir: &Path,
+    name: &str,
+    settings: &OutputSettings,
+    shard: Option<(u64, u64)>,
+    inputs: &[PathBuf],
+    sensor_outputs: Vec<PathBuf>,
+) -> Result<(), RenderError> {
+    check_output_name(name).map_err(|e| RenderError::Options(format!("output name: {e}")))?;
+    prepare_out_dir(out_dir).map_err(RenderError::Options)?;
+    let outputs = match shard {
+        Some(shard) => vec![part_path(out_dir, name, shard)],
+        None => {
+            let mut v = Vec::new();
+            if settings.exr {
+                v.push(out_dir.join(format!("{name}.exr")));
+            }
+            if settings.png {
+                v.push(out_dir.join(format!("{name}.png")));
+            }
+            if settings.error_image {
+                v.push(out_dir.join(format!("{name}.error.exr")));
+            }
+            v.push(out_dir.join(format!("{name}.json")));
+            v.extend(sensor_outputs);
+            v
+        }
+    };
+    check_no_input_replaced(&outputs, inputs).map_err(RenderError::Options)
+}
+
+/// The part file of shard `k` of `n`: `NAME.part-K-of-N.bin`.
+pub(crate) fn part_path(out_dir: &Path, name: &str, (k, n): (u64, u64)) -> PathBuf {
+    out_dir.join(format!("{name}.part-{k}-of-{n}.bin"))
+}
+
+/// What [`write_outputs`] wrote.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Written {
+    /// The files.
+    pub files: Vec<String>,
+    /// The EXR's scale exponent (see [`encode_image`]).
+    pub exr_scale_log2: i32,
+    /// Values beyond the range of 32-bit floats without that scale.
+    pub out_of_range_values: u64,
+    /// Warnings for the user.
+    pub warnings: Vec<String>,
+}
+
+/// The final image of a render: XYZ per pixel in film units.
+pub fn image(output: &RenderOutput, norm: Normalisation) -> Vec<spectrace_spectrum::Xyz> {
+    output.film.to_xyz(norm.scale(output.beams))
+}
+
+/// Writes the EXR and PNG of a finished render (each to a temporary name, then renamed into
+/// place); returns what was written.
+///
+/// # Errors
+/// [`RenderError::File`] if a file cannot be written.
+pub fn write_outputs(
+    dir: &Path,
+    name: &str,
+    settings: &OutputSettings,
+    numerator: Normalisation,
+    output: &RenderOutput,
+) -> Result<Written, RenderError> {
+    let (w, h) = (output.film.width(), output.film.height());
+    let image = encode_image(output, numerator);
+    let mut written = Written {
+        exr_scale_log2: image.scale_log2,
+        out_of_range_values: image.out_of_range_values,
+        ..Written::default()
+    };
+    if image.scale_log2 != 0 {
+        written.warnings.push(format!(
+            "the image lies beyond the range of 32-bit floats ({} values would be infinite or \
+             zero): the EXR holds it multiplied by 2^{} (header attribute spectraceScaleLog2, \
+             sidecar exr_scale_log2)",
+            image.out_of_range_values, image.scale_log2
+        ));
+    }
+    let file_error = |path: &Path| {
+        let path = path.to_owned();
+        move |message| RenderError::File { path, message }
+    };
+    if settings.exr {
+        let path = dir.join(format!("{name}.exr"));
+        write_atomically(&path, |p| write_exr(p, w, h, &image.rgb, image.scale_log2))
+            .map_err(file_error(&path))?;
+        written.files.push(path.display().to_string());
+    }
+    if settings.png {
+        let path = dir.join(format!("{name}.png"));
+        write_atomically(&path, |p| {
+            write_png(p, w, h, &image.rgb, settings.exposure, image.scale_log2)
+        })
+        .map_err(file_error(&path))?;
+        written.files.push(path.display().to_string());
+    }
+    if settings.error_image {
+        match &output.moments {
+            Some(moments) => {
+                let path = dir.join(format!("{name}.error.exr"));
+                // In the image's units and with the image's EXR scale, so the two compare
+                // pixel by pixel.
+                let factor = numerator.scale(output.beams) * 2f64.powi(image.scale_log2);
+                let rgb: Vec<[f32; 3]> = moments
+                    .standard_error_rgb(factor)
+                    .into_iter()
+                    .map(|p| p.map(|v| v.min(f64::from(f32::MAX)) as f32))
+                    .collect();
+                write_atomically(&path, |p| write_exr(p, w, h, &rgb, image.scale_log2))
+                    .map_err(file_error(&path))?;
+                written.files.push(path.display().to_string());
+            }
+            None => written.warnings.push(
+                "output.error_image: no error image, the render kept no error estimate".to_owned(),
+            ),
+        }
+    }
+    Ok(written)
+}
+
+pub(crate) fn write_sidecar(
+    dir: &Path,
+    name: &str,
+    report: &RenderReport,
+) -> Result<(), RenderError> {
+    let path = dir.join(format!("{name}.json"));
+    let text = serde_json::to_string_pretty(report)
+        .map_err(|e| RenderError::File { path: path.clone(), message: e.to_string() })?;
+    write_atomically(&path, |p| std::fs::write(p, &text).map_err(|e| e.to_string()))
+        .map_err(|message| RenderError::File { path, message })
+}
