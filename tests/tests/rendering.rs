@@ -111,8 +111,8 @@ pub(crate) fn block_stats(
 /// of the image against `rho / pi * I * cos / r^2`, with `cos` given by `cos_at(unit vector to the
 /// light)`. Tolerance: 5 standard errors of each block mean from the 16 seeds (Student's t with 15
 /// degrees of freedom exceeds 5 with probability 1.6e-4 per block, so a correct renderer fails
-/// with probability 0.3%), plus 0.2% for evaluating the closed form at 4 points per pixel
-/// instead of integrating it.
+/// with probability 0.3%), plus [`LIT_PLANE_QUADRATURE`] for evaluating the closed form at 4
+/// points per pixel instead of integrating it.
 fn assert_lit_plane_matches(s: &Scene, first_seed: u64, cos_at: impl Fn(DVec3) -> f64) {
     assert_lit_plane_matches_with(s, IntegratorChoice::Light, 100_000, first_seed, cos_at);
 }
@@ -125,10 +125,32 @@ pub(crate) fn assert_lit_plane_matches_with(
     first_seed: u64,
     cos_at: impl Fn(DVec3) -> f64,
 ) {
-    let spd = Uniform::new(400.0, 700.0).unwrap();
     let images: Vec<_> =
         (0..16).map(|seed| render_with(s, integrator, effort, first_seed + seed).image).collect();
     let (w, h, b) = (32usize, 32usize, 8usize);
+    for (bx, by, mean, se) in block_stats(&images, w, h, b) {
+        let mut expected = 0.0;
+        for y in by * b..(by + 1) * b {
+            for x in bx * b..(bx + 1) * b {
+                expected += lit_plane_pixel(s, x, y, &cos_at);
+            }
+        }
+        expected /= (b * b) as f64;
+        assert!(
+            (mean - expected).abs() < 5.0 * se + LIT_PLANE_QUADRATURE * expected,
+            "block ({bx}, {by}): {mean} vs {expected} (standard error {se})"
+        );
+    }
+}
+
+/// What evaluating the lit plane's closed form at 4 points per pixel instead of integrating it
+/// over the pixel may be off by, relative.
+pub(crate) const LIT_PLANE_QUADRATURE: f64 = 0.002;
+
+/// The closed form of the lit plane of [`assert_lit_plane_matches`] in pixel `(x, y)` of `s`'s
+/// camera: Y of `rho / pi * I * cos / r^2`, the mean of 4 points of the pixel.
+pub(crate) fn lit_plane_pixel(s: &Scene, x: usize, y: usize, cos_at: impl Fn(DVec3) -> f64) -> f64 {
+    let spd = Uniform::new(400.0, 700.0).unwrap();
     let intensity = 100.0 / (4.0 * std::f64::consts::PI);
     let analytic_pixel = |px: f64, py: f64| {
         let d = s.camera.direction(px, py);
@@ -138,21 +160,11 @@ pub(crate) fn assert_lit_plane_matches_with(
         let r2 = to.length_squared();
         y_of_radiance(0.5 / std::f64::consts::PI * intensity * cos_at(to / r2.sqrt()) / r2, &spd)
     };
-    for (bx, by, mean, se) in block_stats(&images, w, h, b) {
-        let mut expected = 0.0;
-        for y in by * b..(by + 1) * b {
-            for x in bx * b..(bx + 1) * b {
-                for (sx, sy) in [(0.125, 0.125), (0.375, 0.625), (0.625, 0.375), (0.875, 0.875)] {
-                    expected += analytic_pixel(x as f64 + sx, y as f64 + sy);
-                }
-            }
-        }
-        expected /= (b * b * 4) as f64;
-        assert!(
-            (mean - expected).abs() < 5.0 * se + 0.002 * expected,
-            "block ({bx}, {by}): {mean} vs {expected} (standard error {se})"
-        );
-    }
+    [(0.125, 0.125), (0.375, 0.625), (0.625, 0.375), (0.875, 0.875)]
+        .iter()
+        .map(|(sx, sy)| analytic_pixel(x as f64 + sx, y as f64 + sy))
+        .sum::<f64>()
+        / 4.0
 }
 
 /// The point light of the lit-plane scenes: outside the view, so it is not in the image itself.
