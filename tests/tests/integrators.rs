@@ -44,9 +44,14 @@
 
 use crate::variance::pixel_noise;
 use spectrace_geometry::Ray;
-use spectrace_renderer::{InMemoryRender, Scene, choose_integrator, decide_effects};
+use spectrace_lights::LightSource;
+use spectrace_renderer::{
+    InMemoryRender, Scene, choose_integrator, decide_effects, normalisation, tracer_scene,
+};
 use spectrace_spectrum::{Uniform, Xyz};
-use spectrace_tracer::{EffectsMode, IntegratorChoice};
+use spectrace_tracer::{
+    Bdpt, BdptSettings, EffectsMode, Integrator, IntegratorChoice, LightTracer, PathTracer,
+};
 
 use crate::rendering::{
     LIT_PLANE_QUADRATURE, POINT_OVER_PLANE, block_stats, lit_plane_pixel, render_with, scene,
@@ -775,6 +780,53 @@ fn matrix_glass_caustic() {
     // That the caustic is there is the path tracer's blindness (asserted by the matrix): on the
     // pixels that do not see the glass, BDPT is brighter than the path tracer, which renders
     // everything in this view but the light the glass focuses from the spot.
+}
+
+#[test]
+fn every_estimator_writes_the_renderers_units() {
+    // The renderer turns every estimator's film into an image with `normalisation`: the lights'
+    // power over the beams for the light tracer, times the pixels for the camera estimators
+    // (their image is the mean per pixel). Each estimator's own image scale must be the same
+    // (BDPT's was once in absolute units, 30x too bright in the furnace: its lights' power).
+    for (s, nominal) in [(scene(FADING_SPOT), 10.0), (furnace_scene(0.6), 30.0)] {
+        let power = s.lights.power();
+        assert!((power - nominal).abs() <= 1e-12 * nominal, "{power} W");
+        let ts = tracer_scene(&s);
+        let effects = decide_effects(&s, None);
+        let light = LightTracer::new(&ts, s.tracer_settings(), effects);
+        let path = PathTracer::new(&ts, s.path_settings(), effects);
+        let bdpt = Bdpt::new(&ts, s.bdpt_settings(), effects);
+        // A pass is one sample of each of the 16 x 16 pixels.
+        assert_eq!((path.pass_samples(), bdpt.pass_samples()), (256, 256));
+        let estimators: [(&dyn Integrator, IntegratorChoice); 3] = [
+            (&light, IntegratorChoice::Light),
+            (&path, IntegratorChoice::Path),
+            (&bdpt, IntegratorChoice::Bdpt),
+        ];
+        for (integrator, choice) in estimators {
+            assert_eq!(integrator.name(), choice.name());
+            assert_eq!(integrator.image_scale(0), 0.0, "{}", choice.name());
+            let renderer = normalisation(choice, power, 256);
+            for samples in [256, 512, 4096, 12_345] {
+                let want = renderer.scale(samples);
+                let got = integrator.image_scale(samples);
+                assert!((got - want).abs() <= 1e-12 * want, "{}: {got} vs {want}", choice.name());
+            }
+        }
+        for samples in [256, 512, 4096, 12_345] {
+            assert_eq!(bdpt.image_scale(samples), path.image_scale(samples));
+        }
+        // The film is relative to the lights' power: 512 samples of 256 pixels are 2 per pixel.
+        assert!((bdpt.image_scale(512) - nominal * 0.5).abs() <= 1e-12 * nominal);
+        if nominal == 10.0 {
+            // The spot's power is given, not computed: exactly.
+            assert_eq!(bdpt.image_scale(512), 10.0 * 0.5);
+        }
+    }
+    // BDPT's settings as scene files write them; unknown fields are refused.
+    let s: BdptSettings = serde_json::from_str(r#"{"max_depth": 3, "rr_depth": 1}"#).unwrap();
+    assert_eq!(s, BdptSettings { max_depth: 3, rr_depth: 1, only_strategy: None });
+    assert!(serde_json::from_str::<BdptSettings>(r#"{"max_depth": 3, "rr": 1}"#).is_err());
 }
 
 // ---------------------------------------------------------------------------------------------
