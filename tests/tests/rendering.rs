@@ -111,8 +111,8 @@ pub(crate) fn block_stats(
 /// of the image against `rho / pi * I * cos / r^2`, with `cos` given by `cos_at(unit vector to the
 /// light)`. Tolerance: 5 standard errors of each block mean from the 16 seeds (Student's t with 15
 /// degrees of freedom exceeds 5 with probability 1.6e-4 per block, so a correct renderer fails
-/// with probability 0.3%), plus 0.2% for evaluating the closed form at 4 points per pixel
-/// instead of integrating it.
+/// with probability 0.3%), plus [`LIT_PLANE_QUADRATURE`] for evaluating the closed form at 4
+/// points per pixel instead of integrating it.
 fn assert_lit_plane_matches(s: &Scene, first_seed: u64, cos_at: impl Fn(DVec3) -> f64) {
     assert_lit_plane_matches_with(s, IntegratorChoice::Light, 100_000, first_seed, cos_at);
 }
@@ -125,10 +125,32 @@ pub(crate) fn assert_lit_plane_matches_with(
     first_seed: u64,
     cos_at: impl Fn(DVec3) -> f64,
 ) {
-    let spd = Uniform::new(400.0, 700.0).unwrap();
     let images: Vec<_> =
         (0..16).map(|seed| render_with(s, integrator, effort, first_seed + seed).image).collect();
     let (w, h, b) = (32usize, 32usize, 8usize);
+    for (bx, by, mean, se) in block_stats(&images, w, h, b) {
+        let mut expected = 0.0;
+        for y in by * b..(by + 1) * b {
+            for x in bx * b..(bx + 1) * b {
+                expected += lit_plane_pixel(s, x, y, &cos_at);
+            }
+        }
+        expected /= (b * b) as f64;
+        assert!(
+            (mean - expected).abs() < 5.0 * se + LIT_PLANE_QUADRATURE * expected,
+            "block ({bx}, {by}): {mean} vs {expected} (standard error {se})"
+        );
+    }
+}
+
+/// What evaluating the lit plane's closed form at 4 points per pixel instead of integrating it
+/// over the pixel may be off by, relative.
+pub(crate) const LIT_PLANE_QUADRATURE: f64 = 0.002;
+
+/// The closed form of the lit plane of [`assert_lit_plane_matches`] in pixel `(x, y)` of `s`'s
+/// camera: Y of `rho / pi * I * cos / r^2`, the mean of 4 points of the pixel.
+pub(crate) fn lit_plane_pixel(s: &Scene, x: usize, y: usize, cos_at: impl Fn(DVec3) -> f64) -> f64 {
+    let spd = Uniform::new(400.0, 700.0).unwrap();
     let intensity = 100.0 / (4.0 * std::f64::consts::PI);
     let analytic_pixel = |px: f64, py: f64| {
         let d = s.camera.direction(px, py);
@@ -138,21 +160,11 @@ pub(crate) fn assert_lit_plane_matches_with(
         let r2 = to.length_squared();
         y_of_radiance(0.5 / std::f64::consts::PI * intensity * cos_at(to / r2.sqrt()) / r2, &spd)
     };
-    for (bx, by, mean, se) in block_stats(&images, w, h, b) {
-        let mut expected = 0.0;
-        for y in by * b..(by + 1) * b {
-            for x in bx * b..(bx + 1) * b {
-                for (sx, sy) in [(0.125, 0.125), (0.375, 0.625), (0.625, 0.375), (0.875, 0.875)] {
-                    expected += analytic_pixel(x as f64 + sx, y as f64 + sy);
-                }
-            }
-        }
-        expected /= (b * b * 4) as f64;
-        assert!(
-            (mean - expected).abs() < 5.0 * se + 0.002 * expected,
-            "block ({bx}, {by}): {mean} vs {expected} (standard error {se})"
-        );
-    }
+    [(0.125, 0.125), (0.375, 0.625), (0.625, 0.375), (0.875, 0.875)]
+        .iter()
+        .map(|(sx, sy)| analytic_pixel(x as f64 + sx, y as f64 + sy))
+        .sum::<f64>()
+        / 4.0
 }
 
 /// The point light of the lit-plane scenes: outside the view, so it is not in the image itself.
@@ -165,44 +177,6 @@ pub(crate) const POINT_OVER_PLANE: &str = r#"{
   "lights": [{"type": "PointLight", "position": [2.2, 1, 0.2], "power": 100,
               "spd": {"type": "Uniform", "min_nm": 400, "max_nm": 700}}]
 }"#;
-
-#[test]
-fn point_light_over_a_diffuse_plane_matches_the_closed_form() {
-    // Radiance of a Lambertian plane lit by a point light: L = rho / pi * I cos(theta) / r^2.
-    assert_lit_plane_matches(&scene(POINT_OVER_PLANE), 100, |to_light| to_light.y);
-}
-
-#[test]
-fn integrating_sphere_conserves_energy() {
-    // A point light at the centre of a diffuse sphere of reflectance rho: every wall point
-    // receives E = P / (A (1 - rho)) (direct plus all interreflections), so the camera at the
-    // centre sees L = rho P / (pi A (1 - rho)). This needs beams to continue after diffuse hits
-    // (the effects analysis must see that a sphere sends light to itself) and Russian roulette to
-    // be unbiased. Tolerance: 5 standard errors of the image mean over 6 seeds.
-    let json = r#"{
-      "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "fov": 90, "width": 16, "height": 16},
-      "objects": [{"shape": {"type": "Sphere", "center": [0, 0, 0], "radius": 2},
-                   "material": {"type": "Diffuse", "reflectance": 0.8}}],
-      "lights": [{"type": "PointLight", "position": [0, 0, 0], "power": 10,
-                  "spd": {"type": "Uniform", "min_nm": 400, "max_nm": 700}}],
-      "settings": {"max_depth": 400, "rr_depth": 3}
-    }"#;
-    let s = scene(json);
-    assert!(decide_effects(&s, None).continue_after_diffuse, "a sphere reflects light onto itself");
-    let spd = Uniform::new(400.0, 700.0).unwrap();
-    let (rho, p, area) = (0.8, 10.0, 4.0 * std::f64::consts::PI * 4.0);
-    let expected = y_of_radiance(rho * p / (std::f64::consts::PI * area * (1.0 - rho)), &spd);
-    let means: Vec<f64> = (0..6)
-        .map(|seed| {
-            let (_, image) = render_inline(&s, 100_000, 7 + seed, 2);
-            image.iter().map(|p| p.y).sum::<f64>() / image.len() as f64
-        })
-        .collect();
-    let mean = means.iter().sum::<f64>() / 6.0;
-    let se = (means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / 5.0 / 6.0).sqrt();
-    assert!((mean - expected).abs() < 5.0 * se, "{mean} vs {expected} (standard error {se})");
-    assert!(se < 0.02 * expected, "the test must be sharp: standard error {se} vs {expected}");
-}
 
 #[test]
 fn prism_disperses_by_snells_law_with_the_sellmeier_index() {
