@@ -8,7 +8,7 @@
 //! (4.6e18) per pixel sum, both in the film's unscaled units (before the factor `power / beams`);
 //! contributions outside the range, NaN and infinities are rejected and counted, never added.
 
-use std::sync::{Mutex, PoisonError};
+use std::sync::{LazyLock, Mutex, PoisonError};
 
 use serde::{Deserialize, Serialize};
 use spectrace_spectrum::{CIE_Y_INTEGRAL, Xyz, cmf};
@@ -126,14 +126,18 @@ pub trait Splat {
 /// matching functions' table contributes nothing).
 #[inline]
 pub fn spectral_xyz(lambdas: &[f64], values: &[f64]) -> Xyz {
+    let inv_y = *INV_Y_INTEGRAL;
     let mut xyz = Xyz::default();
     for (&lambda, &v) in lambdas.iter().zip(values) {
         if v != 0.0 {
-            xyz += cmf(lambda) * v;
+            xyz += cmf(lambda) * (v * inv_y);
         }
     }
-    xyz * (1.0 / *CIE_Y_INTEGRAL)
+    xyz
 }
+
+/// One over the integral of `ybar` (nm^-1), computed once.
+static INV_Y_INTEGRAL: LazyLock<f64> = LazyLock::new(|| 1.0 / *CIE_Y_INTEGRAL);
 
 /// A film of `width x height` pixels, each accumulating X, Y, Z exactly, followed by the cells
 /// of the scene's sensors (if any), each accumulating `[radiant, luminous, luminous^2]` the same

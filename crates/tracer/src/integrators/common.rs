@@ -3,13 +3,17 @@
 //! choice, Russian roulette and the power heuristic.
 //!
 //! # Random numbers: a fixed budget per vertex
-//! Every scattering vertex of every path draws the same [`VertexSamples`], all of them, whether
-//! it uses them or not (pbrt's wavefront `RaySamples`). Which ones a render draws is fixed before
-//! it starts ([`SampleLayout`]: the fluorescence choice only in scenes that fluoresce, a lens
-//! point only for a thin lens, a light choice only for estimators that sample lights), so the
-//! `k`-th uniform of a path means the same thing whatever happened at earlier vertices: a Sobol
-//! dimension always feeds the same decision, and a kernel that traces many paths at once can
-//! reproduce the scalar one draw for draw. A camera sample starts with [`CameraSamples`].
+//! Every scattering vertex of every path draws the same uniforms, whether it uses them or not
+//! (pbrt's wavefront `RaySamples`): on reaching the vertex its [`VertexSamples`] (the
+//! fluorescence choice, a light sample, a lens point), and when the path goes on from it its
+//! [`ScatterSamples`] (the BSDF sample, and Russian roulette at the depths where it is played). Which groups a render draws is fixed
+//! before it starts ([`SampleLayout`]: the fluorescence choice only in scenes that fluoresce, a
+//! lens point only for a thin lens, a light sample only for estimators that sample lights), so
+//! the `k`-th uniform of a path means the same thing whatever happened at earlier vertices: a
+//! Sobol dimension always feeds the same decision, and a kernel that traces many paths at once
+//! can reproduce the scalar one draw for draw. (A path that ends at a vertex draws nothing for
+//! going on: no later draw of it exists to shift.) A camera sample starts with
+//! [`CameraSamples`].
 //!
 //! # Shadow rays: one epsilon policy
 //! [`unoccluded`] joins two [`End`]s. A surface point is left and reached at its robust offset
@@ -64,7 +68,8 @@ impl SampleLayout {
     }
 }
 
-/// The uniforms of one scattering vertex, in the order they are drawn.
+/// The uniforms a vertex draws when a path reaches it, in the order they are drawn: those of
+/// its choice of lobe and its connections.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct VertexSamples {
     /// Elastic or re-emitted, and the re-emitted wavelength.
@@ -73,10 +78,6 @@ pub(crate) struct VertexSamples {
     pub light: [f64; 2],
     /// A point on the lens for the connection to the camera.
     pub lens: [f64; 2],
-    /// The BSDF sample.
-    pub scatter: [f64; 3],
-    /// Russian roulette.
-    pub roulette: f64,
 }
 
 impl VertexSamples {
@@ -86,9 +87,27 @@ impl VertexSamples {
         let fluorescence = SampleLayout::pair(layout.fluorescence, rng);
         let light = SampleLayout::pair(layout.light, rng);
         let lens = SampleLayout::pair(layout.lens, rng);
+        Self { fluorescence, light, lens }
+    }
+}
+
+/// The uniforms a vertex draws when the path goes on from it: three for the BSDF, and one for
+/// Russian roulette at the vertices where roulette is played (past `rr_depth`, which depends
+/// on the vertex's depth alone, never on what a path met).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ScatterSamples {
+    /// The BSDF sample.
+    pub scatter: [f64; 3],
+    /// Russian roulette (0.5, not drawn, where it is not played).
+    pub roulette: f64,
+}
+
+impl ScatterSamples {
+    /// Draws them: the roulette uniform only if `roulette` is played at this vertex.
+    #[inline]
+    pub(crate) fn draw(rng: &mut dyn rand::Rng, roulette: bool) -> Self {
         let scatter = [uniform(rng), uniform(rng), uniform(rng)];
-        let roulette = uniform(rng);
-        Self { fluorescence, light, lens, scatter, roulette }
+        Self { scatter, roulette: if roulette { uniform(rng) } else { 0.5 } }
     }
 }
 
@@ -145,7 +164,9 @@ impl End<'_> {
 }
 
 /// Whether nothing blocks the segment from `from` to `to` (the one shadow ray of every
-/// estimator; see the module docs for its epsilon policy).
+/// estimator; see the module docs for its epsilon policy; connections to the camera use the
+/// same policy with the lens sample's direction).
+#[inline]
 pub(crate) fn unoccluded(scene: &LightTracerScene<'_>, from: End<'_>, to: End<'_>) -> bool {
     let origin = from.offset_towards(to.point());
     let target = to.offset_towards(from.point());
@@ -181,21 +202,30 @@ pub(crate) struct CameraConnection {
     pub importance: f64,
 }
 
-/// The camera seen from `from` through the lens point `u_lens`: `None` when the point is
-/// outside the image, behind the camera or occluded.
-pub(crate) fn connect_camera(
+/// The connection of `from` to the lens point `seen` (sampled towards it), when nothing blocks
+/// it: the shadow ray of [`unoccluded`], with the direction and distance `seen` already has
+/// where `from` is not on a surface.
+#[inline]
+fn connect_camera(
     scene: &LightTracerScene<'_>,
     from: End<'_>,
-    u_lens: [f64; 2],
+    seen: &crate::CameraSample,
 ) -> Option<CameraConnection> {
-    let seen = scene.camera.sample_wi(from.point(), u_lens)?;
     if !(seen.pdf > 0.0 && seen.importance > 0.0) {
         return None;
     }
-    if !unoccluded(scene, from, End::Point(seen.position)) {
-        return None;
-    }
-    Some(CameraConnection {
+    let reach = seen.distance * (1.0 - SHADOW_EPSILON);
+    let visible = match from {
+        End::Surface(_) => unoccluded(scene, from, End::Point(seen.position)),
+        End::Light(id, point) => {
+            let ray = Ray { origin: point, direction: seen.to_camera };
+            scene.intersect_from_light(&ray, id, reach).is_none()
+        }
+        End::Point(point) => {
+            !scene.world.occluded(&Ray { origin: point, direction: seen.to_camera }, reach)
+        }
+    };
+    visible.then_some(CameraConnection {
         x: seen.x,
         y: seen.y,
         to_camera: seen.to_camera,
@@ -216,10 +246,10 @@ pub(crate) fn connect_light_to_camera(
     let light = scene.lights.light(id)?;
     let seen = scene.camera.sample_wi(point, u_lens)?;
     let density = light.emission_density(point, seen.to_camera);
-    if !(density > 0.0 && seen.importance > 0.0) {
+    if !(density > 0.0) {
         return None;
     }
-    let connection = connect_camera(scene, End::Light(id, point), u_lens)?;
+    let connection = connect_camera(scene, End::Light(id, point), &seen)?;
     Some((connection, density * connection.importance))
 }
 
@@ -253,6 +283,7 @@ pub(crate) fn shading_correction(hit: &Hit, wi: DVec3, wo: DVec3) -> f64 {
 /// A light-side surface vertex seen by the camera: `f * cos * importance` per wavelength of
 /// `lambdas` into `values` (light arriving from `wi`, scattered by `material`), and the
 /// connection; `None` when nothing reaches the film.
+#[inline]
 pub(crate) fn connect_surface_to_camera(
     scene: &LightTracerScene<'_>,
     hit: &Hit,
@@ -262,7 +293,8 @@ pub(crate) fn connect_surface_to_camera(
     u_lens: [f64; 2],
     values: &mut [f64],
 ) -> Option<CameraConnection> {
-    let seen = connect_camera(scene, End::Surface(hit), u_lens)?;
+    let seen = scene.camera.sample_wi(hit.point, u_lens)?;
+    let seen = connect_camera(scene, End::Surface(hit), &seen)?;
     // The camera measures area on the true surface; the reflected light uses the shading normal.
     let cos = importance_cosine(hit, wi, seen.to_camera)?;
     let values = &mut values[..lambdas.len()];
@@ -402,7 +434,8 @@ mod tests {
 
     #[test]
     fn a_vertex_draws_the_same_count_whatever_it_uses() {
-        // 4 always, 2 more per optional group: the k-th draw of a path keeps its meaning.
+        // 2 per optional group on reaching it, then 4 to go on past the roulette depth: the k-th
+        // draw of a path keeps its meaning.
         for (layout, count) in [
             (SampleLayout::default(), 4),
             (SampleLayout { lens: true, ..SampleLayout::default() }, 6),
@@ -411,7 +444,14 @@ mod tests {
             let mut a = Pcg64::seed_from_u64(3);
             let mut b = Pcg64::seed_from_u64(3);
             let _ = VertexSamples::draw(&layout, &mut a);
+            let _ = ScatterSamples::draw(&mut a, true);
             for _ in 0..count {
+                let _ = uniform(&mut b);
+            }
+            assert_eq!(uniform(&mut a), uniform(&mut b), "{layout:?}");
+            // Before the roulette depth, one fewer.
+            let _ = ScatterSamples::draw(&mut a, false);
+            for _ in 0..3 {
                 let _ = uniform(&mut b);
             }
             assert_eq!(uniform(&mut a), uniform(&mut b), "{layout:?}");

@@ -30,7 +30,7 @@ use spectrace_materials::Transport;
 use spectrace_spectrum::lumens_per_watt;
 
 use super::common::{
-    Direction, SampleLayout, VertexSamples, choose_lobe, connect_light_to_camera,
+    Direction, SampleLayout, ScatterSamples, VertexSamples, choose_lobe, connect_light_to_camera,
     connect_surface_to_camera, relative_throughput, roulette, shading_correction,
 };
 use crate::{
@@ -305,6 +305,7 @@ impl BeamTracer<'_, '_> {
                 stats.depth_limited += 1;
                 break;
             }
+            let go = ScatterSamples::draw(rng, depth >= self.settings.rr_depth);
             // One scatter for the whole bundle: without dispersion every wavelength takes the
             // same direction, each with its own weight; a wavelength the surface absorbs drops
             // out alone, and a dispersive surface keeps only the first live one.
@@ -313,7 +314,7 @@ impl BeamTracer<'_, '_> {
                 hit.shading_normal,
                 lambdas,
                 weights,
-                u.scatter,
+                go.scatter,
                 Transport::Importance,
             ) else {
                 break;
@@ -326,7 +327,7 @@ impl BeamTracer<'_, '_> {
             depth += 1;
             if depth > self.settings.rr_depth {
                 let relative = relative_throughput(weights, &b.start[..b.len]);
-                let Some(survive) = roulette(relative, u.roulette, stats) else { break };
+                let Some(survive) = roulette(relative, go.roulette, stats) else { break };
                 for w in weights.iter_mut() {
                     *w /= survive;
                 }

@@ -149,3 +149,68 @@ pub fn build_integrator<'a>(
 ) -> Box<dyn Integrator + 'a> {
     (registered(choice).build)(scene, settings, effects)
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+
+    use std::sync::Arc;
+
+    use glam::DVec3;
+    use spectrace_geometry::{Rectangle, Shape, World};
+    use spectrace_lights::{LightSet, LightSource};
+    use spectrace_materials::Material;
+
+    use super::*;
+    use crate::{CameraRepr, EffectsMode, FovAxis, PinholeCamera};
+
+    #[test]
+    fn every_registered_estimator_is_built_under_its_own_name_and_normalisation() {
+        let floor = Rectangle::new(DVec3::new(-1.0, 0.0, -1.0), DVec3::Z * 2.0, DVec3::X * 2.0);
+        let world = World::new(vec![Shape::Rectangle(floor.unwrap())]).unwrap();
+        let diffuse: Box<dyn Material> =
+            serde_json::from_str(r#"{"type": "Diffuse", "reflectance": 0.5}"#).unwrap();
+        let materials: Vec<Arc<dyn Material>> = vec![Arc::from(diffuse)];
+        let light: Box<dyn LightSource> = serde_json::from_str(
+            r#"{"type": "PointLight", "position": [0, 1, 0], "power": 7,
+                "spd": {"type": "Uniform", "min_nm": 400, "max_nm": 700}}"#,
+        )
+        .unwrap();
+        let lights = LightSet::new(vec![light]).unwrap();
+        let camera = PinholeCamera::new(CameraRepr {
+            position: DVec3::new(0.0, 1.0, 2.0),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+            fov: 50.0,
+            fov_axis: FovAxis::Horizontal,
+            width: 8,
+            height: 6,
+            aperture_radius: 0.0,
+            focus_distance: None,
+        })
+        .unwrap();
+        let scene = LightTracerScene::new(&world, &materials, &lights, &camera);
+        let effects = Effects::decide(scene.features(&[false]), EffectsMode::Off);
+        let settings = IntegratorSettings::default();
+        let mut names = Vec::new();
+        for r in &INTEGRATORS {
+            let built = build_integrator(r.choice, &scene, &settings, effects);
+            assert_eq!(built.name(), r.choice.name());
+            assert_eq!(IntegratorChoice::from_name(built.name()), Some(r.choice));
+            assert_eq!(built.resolution(), (8, 6));
+            // Beams: power over beams; passes: power times the pixels over the samples.
+            let expected = if r.camera_passes { 7.0 * 48.0 / 96.0 } else { 7.0 / 96.0 };
+            assert!(
+                (built.image_scale(96) - expected).abs() <= 1e-12 * expected,
+                "{}",
+                r.choice.name()
+            );
+            names.push(built.name());
+        }
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), INTEGRATORS.len(), "names are unique");
+        // `auto` is decided before building; undecided, it is the light tracer.
+        assert_eq!(registered(IntegratorChoice::Auto).choice, IntegratorChoice::Light);
+    }
+}

@@ -48,7 +48,7 @@ use spectrace_lights::{LightId, LightSource};
 use spectrace_materials::{ExcitationSampler, Material, ScatterKind, Transport};
 
 use super::common::{
-    CameraSamples, Direction, End, SampleLayout, VertexSamples, choose_lobe,
+    CameraSamples, Direction, End, SampleLayout, ScatterSamples, VertexSamples, choose_lobe,
     connect_light_to_camera, power_heuristic, relative_throughput, roulette, sample_light,
     unoccluded,
 };
@@ -242,32 +242,32 @@ impl<'a> PathTracer<'a> {
             if material.is_dispersive() && !p.collapsed {
                 p.collapse(lambda_weights);
             }
-            if !self.bounce(&mut p, &hit, wo, material, &u, stats) {
+            if !material.is_specular() {
+                self.next_event(&mut p, &hit, wo, material, u.light, stats);
+                if !self.effects.continue_after_diffuse {
+                    // No light can come back to a non-specular surface by interreflection:
+                    // only an emitter seen by the BSDF-sampled ray remains (for MIS).
+                    p.last_bounce = true;
+                }
+            }
+            let go = ScatterSamples::draw(rng, p.depth >= self.settings.rr_depth);
+            if !self.bounce(&mut p, &hit, material, &go, stats) {
                 break;
             }
         }
         p.radiance
     }
 
-    /// Next-event estimation at a non-specular vertex, then the BSDF sample and Russian
-    /// roulette; `false` when the path ends here.
+    /// The BSDF sample and Russian roulette at a vertex (after its next-event estimation);
+    /// `false` when the path ends here.
     fn bounce(
         &self,
         p: &mut PathState,
         hit: &Hit,
-        wo: DVec3,
         material: &dyn Material,
-        u: &VertexSamples,
+        u: &ScatterSamples,
         stats: &mut TraceStats,
     ) -> bool {
-        if !material.is_specular() {
-            self.next_event(p, hit, wo, material, u.light, stats);
-            if !self.effects.continue_after_diffuse {
-                // No light can come back to a non-specular surface by interreflection: only
-                // an emitter seen by the BSDF-sampled ray remains (for MIS).
-                p.last_bounce = true;
-            }
-        }
         if p.depth >= self.settings.max_depth && !p.last_bounce {
             // The deepest vertex: one more ray, only for the emission it may hit (the BSDF
             // half of this vertex's MIS pair), as the light tracer's deepest connection.

@@ -10,7 +10,8 @@ use super::Bdpt;
 use super::vertex::{LightEnd, Vertex, VertexKind, Wavelength, light_normal};
 use crate::TraceStats;
 use crate::integrators::common::{
-    CameraSamples, Direction, VertexSamples, choose_lobe, roulette, shading_correction,
+    CameraSamples, Direction, ScatterSamples, VertexSamples, choose_lobe, roulette,
+    shading_correction,
 };
 
 /// Reused storage of one chunk: no allocation per sample.
@@ -152,9 +153,10 @@ impl Bdpt<'_> {
                 stats.depth_limited += 1;
                 return;
             }
+            let go = ScatterSamples::draw(rng, path.len() > self.settings.rr_depth as usize + 1);
             let incoming =
                 Incoming { direction: ray.direction, normal: hit.shading_normal, lambda: v.lambda };
-            let Some(s) = material.scatter_with(&incoming, u.scatter, walk.transport) else {
+            let Some(s) = material.scatter_with(&incoming, go.scatter, walk.transport) else {
                 return;
             };
             let wp = -ray.direction;
@@ -175,7 +177,7 @@ impl Bdpt<'_> {
             path[n - 2].pdf_rev = Self::to_area(pdf_rev, hit.point, &prev);
             if (n - 1) as u32 > self.settings.rr_depth {
                 let relative = if start > 0.0 { beta / start } else { 0.0 };
-                let Some(survive) = roulette(relative, u.roulette, stats) else { return };
+                let Some(survive) = roulette(relative, go.roulette, stats) else { return };
                 beta /= survive;
             }
             if !(beta > 0.0 && beta.is_finite()) {

@@ -1,5 +1,6 @@
-//! BDPT against itself (MIS weights of every strategy of sampled paths sum to one) and against
-//! the other estimators and closed forms on scenes built in code.
+//! BDPT against itself: the MIS weights of every strategy of sampled paths sum to one, on scenes
+//! built in code (its images against the other estimators and closed forms are the estimator
+//! matrix, `tests/tests/integrators.rs`).
 #![allow(clippy::unwrap_used)]
 
 use rand::SeedableRng;
@@ -8,23 +9,17 @@ use spectrace_geometry::{Rectangle, Shape, Sphere, World};
 use spectrace_lights::LightSet;
 use spectrace_materials::Material;
 
-use std::f64::consts::PI;
 use std::sync::Arc;
 
 use glam::DVec3;
-use spectrace_geometry::Ray;
 use spectrace_lights::{LightId, LightSource};
-use spectrace_spectrum::CIE_Y_INTEGRAL;
 
 use super::mis::mis_weight;
 use super::subpath::Buffers;
 use super::vertex::Wavelength;
 use super::*;
-use crate::{
-    CameraRepr, EffectsMode, FovAxis, LightTracer, LightTracerSettings, PathTracer,
-    PathTracerSettings, PinholeCamera, RenderPlan, render,
-};
-use crate::{Effects, Emitter, Integrator, TraceStats};
+use crate::{CameraRepr, EffectsMode, FovAxis, PinholeCamera};
+use crate::{Effects, Emitter, TraceStats};
 
 /// A scene built in code: shapes (with their materials), lights, camera, emitters.
 struct Fixture {
@@ -172,85 +167,6 @@ fn effects(scene: &LightTracerScene<'_>) -> Effects {
     Effects::decide(scene.features(&[false; 8]), EffectsMode::Off)
 }
 
-/// Mean Y over the image (the pixels `mask` keeps) of `runs` independent renders (seeds
-/// 1..=runs) of `items` work items each (chunks of `chunk`), and its standard error.
-fn mean_y(
-    integrator: &dyn Integrator,
-    runs: u64,
-    items: u64,
-    chunk: u64,
-    mask: &[bool],
-) -> (f64, f64) {
-    let means: Vec<f64> = (1..=runs)
-        .map(|seed| {
-            let plan = RenderPlan {
-                beams: items,
-                chunk_beams: chunk,
-                seed,
-                threads: 2,
-                shard: None,
-                time_budget: None,
-                error_estimate: false,
-                target_error: None,
-            };
-            let out = render(integrator, &plan, &|_| {}).unwrap();
-            let image = out.film.to_xyz(integrator.image_scale(out.beams));
-            let kept = image.iter().zip(mask).filter(|(_, keep)| **keep);
-            let n = kept.clone().count();
-            kept.map(|(p, _)| p.y).sum::<f64>() / n as f64
-        })
-        .collect();
-    let k = means.len() as f64;
-    let mean = means.iter().sum::<f64>() / k;
-    let var = means.iter().map(|m| (m - mean) * (m - mean)).sum::<f64>() / (k - 1.0);
-    (mean, (var / k).sqrt())
-}
-
-fn assert_agree(name: &str, a: (f64, f64), b: (f64, f64)) {
-    let combined = (a.1 * a.1 + b.1 * b.1).sqrt();
-    assert!(a.0 > 0.0 && b.0 > 0.0, "{name}: {a:?} {b:?}");
-    // The test is only meaningful if the estimates are precise.
-    assert!(combined < 0.05 * a.0, "{name}: standard errors too large: {a:?} {b:?}");
-    assert!((a.0 - b.0).abs() < 3.0 * combined, "{name}: {a:?} vs {b:?}");
-}
-
-const ALL: [bool; 256] = [true; 256];
-
-fn bdpt_mean(scene: &LightTracerScene<'_>, runs: u64, passes: u64, mask: &[bool]) -> (f64, f64) {
-    let bdpt = Bdpt::new(scene, BdptSettings::default(), effects(scene));
-    let pixels = bdpt.pass_samples();
-    mean_y(&bdpt, runs, passes * pixels, pixels, mask)
-}
-
-fn light_mean(scene: &LightTracerScene<'_>, runs: u64, beams: u64, mask: &[bool]) -> (f64, f64) {
-    let lt = LightTracer::new(scene, LightTracerSettings::default(), effects(scene));
-    mean_y(&lt, runs, beams, 20_000, mask)
-}
-
-fn path_mean(scene: &LightTracerScene<'_>, runs: u64, passes: u64) -> (f64, f64) {
-    let pt = PathTracer::new(scene, PathTracerSettings::default(), effects(scene));
-    let pixels = pt.pass_samples();
-    mean_y(&pt, runs, passes * pixels, pixels, &ALL)
-}
-
-/// The pixels in which no camera ray (on an 8 x 8 grid) sees shape `shape` first.
-fn pixels_not_seeing(fixture: &Fixture, shape: u32) -> Vec<bool> {
-    let camera = &fixture.camera;
-    let mut mask = vec![true; 256];
-    for (p, keep) in mask.iter_mut().enumerate() {
-        let (px, py) = ((p % 16) as f64, (p / 16) as f64);
-        for k in 0..64 {
-            let (u, v) = ((k % 8) as f64 / 7.0, (k / 8) as f64 / 7.0);
-            let ray =
-                Ray { origin: camera.position(), direction: camera.direction(px + u, py + v) };
-            if fixture.world.intersect(&ray, f64::INFINITY).is_some_and(|h| h.primitive == shape) {
-                *keep = false;
-            }
-        }
-    }
-    mask
-}
-
 #[test]
 fn mis_weight_counts_only_possible_strategies() {
     let v = |from_light, from_camera, delta| MisVertex { from_light, from_camera, delta };
@@ -342,71 +258,11 @@ fn mis_weights_of_all_strategies_of_sampled_paths_sum_to_one() {
 }
 
 #[test]
-fn spot_over_a_plane_matches_the_light_and_path_tracers() {
-    let fixture = spot_scene();
-    let scene = fixture.scene();
-    let bdpt = bdpt_mean(&scene, 8, 16, &ALL);
-    assert_agree("bdpt vs light", bdpt, light_mean(&scene, 8, 200_000, &ALL));
-    assert_agree("bdpt vs path", bdpt, path_mean(&scene, 8, 32));
-}
-
-#[test]
-fn cornell_box_matches_the_light_and_path_tracers() {
-    let fixture = box_scene();
-    let scene = fixture.scene();
-    let bdpt = bdpt_mean(&scene, 8, 10, &ALL);
-    assert_agree("bdpt vs light", bdpt, light_mean(&scene, 8, 80_000, &ALL));
-    assert_agree("bdpt vs path", bdpt, path_mean(&scene, 8, 12));
-}
-
-#[test]
-fn glass_caustic_matches_the_light_tracer() {
-    let fixture = caustic_scene();
-    let scene = fixture.scene();
-    // The light tracer cannot see anything through the glass (its paths end at a diffuse
-    // vertex connected to the pinhole): compare the pixels where the sphere is not seen.
-    let mask = pixels_not_seeing(&fixture, 1);
-    let kept = mask.iter().filter(|k| **k).count();
-    assert!((100..240).contains(&kept), "{kept} pixels kept");
-    let bdpt = bdpt_mean(&scene, 8, 10, &mask);
-    assert_agree("bdpt vs light", bdpt, light_mean(&scene, 8, 80_000, &mask));
-    // The caustic is there: the floor under the sphere is brighter than without it.
-    let plain = spot_scene();
-    let plain_scene = plain.scene();
-    let without = light_mean(&plain_scene, 4, 40_000, &mask);
-    assert!(bdpt.0 > without.0 + 3.0 * (bdpt.1 + without.1), "{bdpt:?} vs {without:?}");
-}
-
-#[test]
-fn glowing_furnace_matches_the_closed_form_in_the_renderers_units() {
-    // A closed two-sided glowing diffuse sphere seen from inside: L / (1 - a) everywhere.
-    let a = 0.6;
-    let fixture = furnace_scene(a);
-    let scene = fixture.scene();
-    let bdpt = Bdpt::new(&scene, BdptSettings::default(), effects(&scene));
-    let pt = PathTracer::new(&scene, PathTracerSettings::default(), effects(&scene));
-    // The renderer turns every camera integrator's film into an image with the lights'
-    // power times the pixels over the samples: BDPT's film must be in the path tracer's
-    // units (it was in absolute units, 30x too bright here, the lights' power).
-    let (power, pixels) = (scene.lights.power(), bdpt.pass_samples());
-    for samples in [256, 4096, 12_345] {
-        let renderer = crate::image_scale(power, samples) * pixels as f64;
-        assert!((bdpt.image_scale(samples) - renderer).abs() <= 1e-12 * renderer);
-        assert_eq!(bdpt.image_scale(samples), pt.image_scale(samples));
-    }
-    let spd = spectrace_spectrum::Uniform::new(400.0, 700.0).unwrap();
-    let l = 30.0 / (2.0 * PI * 4.0 * PI * 1.5 * 1.5);
-    let expected = l / (1.0 - a) * spectrace_spectrum::xyz_of(&spd).y / *CIE_Y_INTEGRAL;
-    let (mean, se) = mean_y(&bdpt, 6, 8 * pixels, pixels, &ALL);
-    assert!((mean - expected).abs() < 4.0 * se, "{mean} vs {expected} (standard error {se})");
-    assert!(se < 0.02 * expected, "standard error {se} vs {expected}");
-}
-
-#[test]
-fn thin_lens_matches_the_path_tracer() {
+fn mis_weights_of_a_thin_lens_sum_to_one() {
     // The spot over the plane through a thin lens (aperture 0.05) focused on the plane: camera
-    // subpaths start on the lens, t = 1 connections sample the lens; the image mean is the
-    // path tracer's within 4 combined standard errors.
+    // subpaths start on the lens, t = 1 connections sample the lens (with the light vertex's own
+    // lens uniforms), and the weights of every strategy still sum to one. (Its image against the
+    // path tracer's is a cell of the estimator matrix, `tests/tests/integrators.rs`.)
     let mut fixture = spot_scene();
     let (position, look_at) = (DVec3::new(0.0, 1.2, 2.0), DVec3::ZERO);
     fixture.camera = PinholeCamera::new(CameraRepr {
@@ -417,12 +273,6 @@ fn thin_lens_matches_the_path_tracer() {
     .unwrap();
     assert!(!fixture.camera.is_pinhole());
     let scene = fixture.scene();
-    let bdpt = bdpt_mean(&scene, 8, 16, &ALL);
-    let path = path_mean(&scene, 8, 32);
-    let combined = (bdpt.1 * bdpt.1 + path.1 * path.1).sqrt();
-    assert!(combined < 0.03 * path.0, "standard errors too large: {bdpt:?} {path:?}");
-    assert!((bdpt.0 - path.0).abs() < 4.0 * combined, "bdpt {bdpt:?} vs path {path:?}");
-    // The MIS weights of the lens's strategies still sum to one.
     let mut rng = Pcg64::seed_from_u64(3);
     let bdpt = Bdpt::new(&scene, BdptSettings::default(), effects(&scene));
     let mut buffers = Buffers { light: Vec::new(), camera: Vec::new(), mis: Vec::new() };
@@ -471,19 +321,4 @@ fn thin_lens_matches_the_path_tracer() {
         }
     }
     assert!(lens_connections > 100, "only {lens_connections} connections to the lens");
-}
-
-#[test]
-fn passes_are_normalised_per_pixel() {
-    let fixture = spot_scene();
-    let scene = fixture.scene();
-    let bdpt = Bdpt::new(&scene, BdptSettings::default(), effects(&scene));
-    assert_eq!(bdpt.name(), "bdpt");
-    assert_eq!(bdpt.pass_samples(), 256);
-    assert_eq!(bdpt.image_scale(0), 0.0);
-    // The film is relative to the lights' power (10 W), as the path tracer's.
-    assert_eq!(bdpt.image_scale(512), 10.0 * 0.5);
-    let s: BdptSettings = serde_json::from_str(r#"{"max_depth": 3, "rr_depth": 1}"#).unwrap();
-    assert_eq!(s, BdptSettings { max_depth: 3, rr_depth: 1, only_strategy: None });
-    assert!(serde_json::from_str::<BdptSettings>(r#"{"max_depth": 3, "rr": 1}"#).is_err());
 }

@@ -82,13 +82,8 @@ impl Vertex {
 
 /// The uniforms of a vertex that draws none (the camera's, and vertices sampled by a
 /// connection).
-pub(super) const NO_SAMPLES: VertexSamples = VertexSamples {
-    fluorescence: [0.5; 2],
-    light: [0.5; 2],
-    lens: [0.5; 2],
-    scatter: [0.5; 3],
-    roulette: 0.5,
-};
+pub(super) const NO_SAMPLES: VertexSamples =
+    VertexSamples { fluorescence: [0.5; 2], light: [0.5; 2], lens: [0.5; 2] };
 
 /// A light as a path end: its id, its flags, and the probability of choosing it given the
 /// sample's wavelength.
