@@ -33,25 +33,45 @@ use crate::{LightTracerScene, TraceStats};
 /// stops, so that the light's own surface does not count as an occluder.
 pub(crate) const SHADOW_EPSILON: f64 = 1e-9;
 
-/// Which of the optional uniforms a render's vertices draw (fixed for the whole render).
+/// Which of the optional uniforms the vertices of a kind of path draw (fixed for the whole
+/// render): each group only where some strategy uses it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub(crate) struct SampleLayout {
-    /// Two uniforms for the fluorescence choice (scenes with a fluorescent material).
+    /// Two uniforms for the fluorescence choice (paths that may re-emit, in scenes with a
+    /// fluorescent material).
     pub fluorescence: bool,
-    /// Two uniforms for a light sample (estimators that sample lights, when some light can be
-    /// sampled by area).
+    /// Two uniforms for a light sample (camera paths that sample lights).
     pub light: bool,
-    /// Two uniforms for a point on the lens (thin-lens cameras).
+    /// Two uniforms for a point on the lens at each vertex (light paths connected to a thin
+    /// lens).
     pub lens: bool,
+    /// Two uniforms for the lens point a camera sample starts from (camera paths, thin lens).
+    pub camera_lens: bool,
 }
 
 impl SampleLayout {
-    /// The layout of `scene` for an estimator that samples lights (`samples_lights`) or not.
-    pub(crate) fn new(scene: &LightTracerScene<'_>, samples_lights: bool) -> Self {
+    /// The layout of light paths in `scene`: they may re-emit and connect to the lens.
+    pub(crate) fn light_paths(scene: &LightTracerScene<'_>) -> Self {
         Self {
-            fluorescence: scene.materials.iter().any(|m| m.fluorescence().is_some()),
-            light: samples_lights && !scene.area_lights().is_empty(),
+            fluorescence: fluoresces(scene),
+            light: false,
             lens: !scene.camera.is_pinhole(),
+            camera_lens: false,
+        }
+    }
+
+    /// The layout of camera paths in `scene`: they start on the lens, re-emit if `reemit` (and
+    /// the scene fluoresces), and sample lights if `sample_lights`.
+    pub(crate) fn camera_paths(
+        scene: &LightTracerScene<'_>,
+        reemit: bool,
+        sample_lights: bool,
+    ) -> Self {
+        Self {
+            fluorescence: reemit && fluoresces(scene),
+            light: sample_lights,
+            lens: false,
+            camera_lens: !scene.camera.is_pinhole(),
         }
     }
 
@@ -68,6 +88,11 @@ impl SampleLayout {
     }
 }
 
+/// Whether any surface of `scene` fluoresces.
+fn fluoresces(scene: &LightTracerScene<'_>) -> bool {
+    scene.materials.iter().any(|m| m.fluorescence().is_some())
+}
+
 /// The uniforms a vertex draws when a path reaches it, in the order they are drawn: those of
 /// its choice of lobe and its connections.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -81,7 +106,7 @@ pub(crate) struct VertexSamples {
 }
 
 impl VertexSamples {
-    /// Draws a vertex's uniforms under `layout`.
+    /// Draws the uniforms of a vertex of a path of `layout`.
     #[inline]
     pub(crate) fn draw(layout: &SampleLayout, rng: &mut dyn rand::Rng) -> Self {
         let fluorescence = SampleLayout::pair(layout.fluorescence, rng);
@@ -127,7 +152,7 @@ impl CameraSamples {
     #[inline]
     pub(crate) fn draw(layout: &SampleLayout, rng: &mut dyn rand::Rng) -> Self {
         let film = [uniform(rng), uniform(rng)];
-        let lens = layout.lens(rng);
+        let lens = SampleLayout::pair(layout.camera_lens, rng);
         Self { film, lens, wavelength: uniform(rng) }
     }
 }
@@ -313,17 +338,21 @@ pub(crate) fn connect_surface_to_camera(
 }
 
 /// A point on light `id` sampled towards `receiver` (next-event estimation), when it gives
-/// light: positive intensity at a positive distance. Visibility is the caller's
+/// light: positive intensity at a positive distance (a non-finite value is the film's to
+/// refuse). Visibility is the caller's
 /// ([`unoccluded`] with [`End::Light`]), after it has checked the sample is worth a ray.
+#[inline]
 pub(crate) fn sample_light(
     scene: &LightTracerScene<'_>,
     id: LightId,
     receiver: DVec3,
     u: [f64; 2],
 ) -> Option<LightSample> {
-    let sample = scene.lights.light(id)?.sample_towards(receiver, u)?;
-    (sample.intensity > 0.0 && sample.distance > 0.0 && sample.intensity.is_finite())
-        .then_some(sample)
+    scene
+        .lights
+        .light(id)?
+        .sample_towards(receiver, u)
+        .filter(|s| s.intensity > 0.0 && s.distance > 0.0)
 }
 
 /// The lobe a path scatters with at a fluorescent surface, chosen before any connection
@@ -439,7 +468,9 @@ mod tests {
         for (layout, count) in [
             (SampleLayout::default(), 4),
             (SampleLayout { lens: true, ..SampleLayout::default() }, 6),
-            (SampleLayout { fluorescence: true, light: true, lens: true }, 10),
+            (SampleLayout { fluorescence: true, lens: true, ..SampleLayout::default() }, 8),
+            // Camera paths draw their lens point once, at the camera, not at each vertex.
+            (SampleLayout { fluorescence: true, light: true, camera_lens: true, lens: false }, 8),
         ] {
             let mut a = Pcg64::seed_from_u64(3);
             let mut b = Pcg64::seed_from_u64(3);

@@ -168,7 +168,7 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
         scene,
         settings,
         effects,
-        layout: SampleLayout::new(scene, false),
+        layout: SampleLayout::light_paths(scene),
         bundle: effects.wavelengths_per_path.clamp(1, MAX_BUNDLE),
     };
     let mut next_check = DEADLINE_CHECK_WORK;

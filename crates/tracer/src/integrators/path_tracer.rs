@@ -167,7 +167,7 @@ impl<'a> PathTracer<'a> {
         } else {
             Vec::new()
         };
-        let layout = SampleLayout::new(scene, true);
+        let layout = SampleLayout::camera_paths(scene, true, !scene.area_lights().is_empty());
         Self { scene, settings, effects, layout, excitation }
     }
 
@@ -388,8 +388,10 @@ impl<'a> PathTracer<'a> {
     ) {
         let scene = self.scene;
         let inv_y = 1.0 / *spectrace_spectrum::CIE_Y_INTEGRAL;
+        // One lens point per light and pass, as a light path's vertex draws it.
+        let lens = SampleLayout { lens: self.layout.camera_lens, ..SampleLayout::default() };
         for &id in scene.delta_lights() {
-            let u_lens = self.layout.lens(rng);
+            let u_lens = lens.lens(rng);
             let (Some(light), Some(spd)) = (scene.lights.light(id), scene.light_spd(id)) else {
                 continue;
             };

@@ -141,7 +141,10 @@ pub struct Bdpt<'a> {
     effects: Effects,
     /// The light set's SPD (the marginal density of a beam's wavelength).
     set_spd: Arc<dyn SpectralPowerDistribution>,
-    layout: SampleLayout,
+    /// The uniforms of camera-subpath vertices (a light sample for `s = 1`, no re-emission).
+    camera_layout: SampleLayout,
+    /// The uniforms of light-subpath vertices (re-emission, a lens point for `t = 1`).
+    light_layout: SampleLayout,
 }
 
 /// A strategy: `s` vertices of the light subpath `light` joined to `t` of the camera
@@ -161,8 +164,11 @@ impl<'a> Bdpt<'a> {
     /// A bidirectional path tracer of `scene` with `settings` (the `effects` decision is kept
     /// for reports; paths always continue after diffuse hits).
     pub fn new(scene: &'a LightTracerScene<'a>, settings: BdptSettings, effects: Effects) -> Self {
-        let layout = SampleLayout::new(scene, !scene.all_lights().is_empty());
-        Self { scene, settings, effects, set_spd: LightSource::spd(scene.lights), layout }
+        let camera_layout =
+            SampleLayout::camera_paths(scene, false, !scene.all_lights().is_empty());
+        let light_layout = SampleLayout::light_paths(scene);
+        let set_spd = LightSource::spd(scene.lights);
+        Self { scene, settings, effects, set_spd, camera_layout, light_layout }
     }
 
     /// Its settings.

@@ -45,7 +45,7 @@ impl Bdpt<'_> {
         stats: &mut TraceStats,
     ) {
         let camera = self.scene.camera;
-        let u = CameraSamples::draw(&self.layout, rng);
+        let u = CameraSamples::draw(&self.camera_layout, rng);
         let camera_ray = camera.generate_ray(px, py, u.film, u.lens);
         let ray = Ray { origin: camera_ray.origin, direction: camera_ray.direction };
         buffers.camera.clear();
@@ -72,7 +72,7 @@ impl Bdpt<'_> {
     ) {
         let scene = self.scene;
         buffers.light.clear();
-        let u = VertexSamples::draw(&self.layout, rng);
+        let u = VertexSamples::draw(&self.light_layout, rng);
         let Some(source) = scene.lights.light(light.id) else { return };
         let (pdf_pos, pdf_dir) = self.light_pdfs(light.id, beam.origin, beam.direction);
         let beta = scene.lights.power() * beam.scale;
@@ -112,7 +112,8 @@ impl Bdpt<'_> {
         while let Some(hit) = next.take() {
             stats.hits += 1;
             let Some(prev) = path.last().copied() else { return };
-            let u = VertexSamples::draw(&self.layout, rng);
+            let layout = if walk.reemit { &self.light_layout } else { &self.camera_layout };
+            let u = VertexSamples::draw(layout, rng);
             let kind = VertexKind::Surface(hit);
             let mut v = Vertex::at(kind, hit.point, hit.geometric_normal, beta, prev.lambda, u);
             v.fluoresced = prev.fluoresced;
