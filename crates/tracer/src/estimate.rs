@@ -28,7 +28,7 @@ use std::sync::{Mutex, PoisonError};
 use serde::{Deserialize, Serialize};
 use spectrace_spectrum::Xyz;
 
-use crate::raster::{FilmError, film_pixels, raster_bytes};
+use crate::raster::{FilmError, film_pixels, raster_bytes, same_size};
 
 /// Chunks (batches) a render needs before its error estimate is trusted to stop it.
 pub const MIN_BATCHES: u64 = 16;
@@ -194,14 +194,7 @@ impl Moments {
     /// # Errors
     /// [`FilmError::SizeMismatch`] when the sizes differ.
     pub fn merge(&mut self, other: &Moments) -> Result<(), FilmError> {
-        if (self.width, self.height) != (other.width, other.height) {
-            return Err(FilmError::SizeMismatch(
-                self.width,
-                self.height,
-                other.width,
-                other.height,
-            ));
-        }
+        same_size(self.width, self.height, (other.width, other.height))?;
         for (a, b) in self.sums.iter_mut().zip(&other.sums) {
             for (x, y) in a.iter_mut().zip(b) {
                 *x += y;

@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 use spectrace_spectrum::{CIE_Y_INTEGRAL, Xyz, cmf};
 
 use crate::estimate::{ChunkTally, Moments};
-use crate::raster::{FilmError, film_pixels, pixel_index, raster_bytes};
+use crate::raster::{FilmError, film_pixels, pixel_index, raster_bytes, same_size};
 
 /// Fractional bits of the fixed-point sums.
 const FRAC_BITS: i32 = 64;
@@ -273,9 +273,9 @@ impl Film {
     /// # Errors
     /// [`FilmError::SizeMismatch`] if the sizes differ.
     pub fn merge(&mut self, other: &Film) -> Result<(), FilmError> {
-        if (self.width, self.height, self.sums.len())
-            != (other.width, other.height, other.sums.len())
-        {
+        same_size(self.width, self.height, (other.width, other.height))?;
+        if self.sums.len() != other.sums.len() {
+            // Same raster, different sensor cells.
             return Err(FilmError::SizeMismatch(
                 self.width,
                 self.height,

@@ -67,3 +67,13 @@ pub(crate) fn pixel_index(x: u32, y: u32, width: u32, height: u32) -> Option<usi
 pub(crate) fn raster_bytes(width: u32, height: u32, per_pixel: u64, fixed: usize) -> u64 {
     (u64::from(width) * u64::from(height)).saturating_mul(per_pixel).saturating_add(fixed as u64)
 }
+
+/// `Ok` when a `width x height` raster and an `other_width x other_height` one have the same
+/// size, else [`FilmError::SizeMismatch`] naming both.
+pub(crate) fn same_size(width: u32, height: u32, other: (u32, u32)) -> Result<(), FilmError> {
+    if (width, height) == other {
+        Ok(())
+    } else {
+        Err(FilmError::SizeMismatch(width, height, other.0, other.1))
+    }
+}

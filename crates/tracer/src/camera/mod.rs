@@ -338,15 +338,7 @@ impl PinholeCamera {
             return None;
         }
         let (sx, sy) = (d.dot(self.right) / cos, d.dot(self.up) / cos);
-        let px = (sx / self.half_width + 1.0) / 2.0 * f64::from(self.repr.width);
-        let py = (1.0 - sy / self.half_height) / 2.0 * f64::from(self.repr.height);
-        if !(px >= 0.0
-            && py >= 0.0
-            && px < f64::from(self.repr.width)
-            && py < f64::from(self.repr.height))
-        {
-            return None;
-        }
+        let (px, py) = self.to_raster(sx, sy)?;
         let importance = 1.0 / (distance * distance * cos * cos * cos * self.pixel_area());
         Some(Projection {
             x: px as u32,
@@ -360,6 +352,16 @@ impl PinholeCamera {
     /// True for a pinhole (delta position), false with an aperture.
     pub fn is_pinhole(&self) -> bool {
         self.lens_radius == 0.0
+    }
+
+    /// The raster position (continuous pixel coordinates) of a point `(sx, sy)` on the plane at
+    /// distance 1 in front of the pinhole, or `None` outside the image.
+    #[inline]
+    fn to_raster(&self, sx: f64, sy: f64) -> Option<(f64, f64)> {
+        let (width, height) = (f64::from(self.repr.width), f64::from(self.repr.height));
+        let px = (sx / self.half_width + 1.0) / 2.0 * width;
+        let py = (1.0 - sy / self.half_height) / 2.0 * height;
+        (px >= 0.0 && py >= 0.0 && px < width && py < height).then_some((px, py))
     }
 
     /// Area of the whole image on the plane at distance 1 (= width*height*pixel_area()).
@@ -390,15 +392,7 @@ impl PinholeCamera {
         }
         let sx = w.dot(self.right) / cos + self.lens_over_focus * l[0];
         let sy = w.dot(self.up) / cos + self.lens_over_focus * l[1];
-        let px = (sx / self.half_width + 1.0) / 2.0 * f64::from(self.repr.width);
-        let py = (1.0 - sy / self.half_height) / 2.0 * f64::from(self.repr.height);
-        if !(px >= 0.0
-            && py >= 0.0
-            && px < f64::from(self.repr.width)
-            && py < f64::from(self.repr.height))
-        {
-            return None;
-        }
+        let (px, py) = self.to_raster(sx, sy)?;
         Some((px, py, cos))
     }
 
