@@ -147,12 +147,14 @@ impl PowerLightSampler {
 }
 
 impl LightSampler for PowerLightSampler {
+    #[inline]
     fn sample(&self, u: f64) -> Option<SampledLight> {
         let choice = self.choice.as_ref()?;
         let (k, remapped) = choice.sample_remapped(u);
         Some(SampledLight { id: *self.ids.get(k)?, pmf: choice.pmf(k), u: remapped })
     }
 
+    #[inline]
     fn pmf(&self, id: LightId) -> f64 {
         match (&self.choice, self.index(id)) {
             (Some(choice), Some(k)) => choice.pmf(k),

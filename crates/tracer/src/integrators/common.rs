@@ -170,7 +170,7 @@ pub(crate) enum End<'h> {
 
 impl End<'_> {
     /// The point itself.
-    #[inline]
+    #[inline(always)]
     fn point(&self) -> DVec3 {
         match *self {
             End::Surface(h) => h.point,
@@ -179,7 +179,7 @@ impl End<'_> {
     }
 
     /// Where a segment towards `other` leaves or reaches this end.
-    #[inline]
+    #[inline(always)]
     fn offset_towards(&self, other: DVec3) -> DVec3 {
         match *self {
             End::Surface(h) => h.spawn_origin(other - h.point),
@@ -191,7 +191,7 @@ impl End<'_> {
 /// Whether nothing blocks the segment from `from` to `to` (the one shadow ray of every
 /// estimator; see the module docs for its epsilon policy; connections to the camera use the
 /// same policy with the lens sample's direction).
-#[inline]
+#[inline(always)]
 pub(crate) fn unoccluded(scene: &LightTracerScene<'_>, from: End<'_>, to: End<'_>) -> bool {
     let origin = from.offset_towards(to.point());
     let target = to.offset_towards(from.point());

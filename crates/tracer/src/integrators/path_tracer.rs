@@ -126,6 +126,7 @@ impl PathState {
     }
 
     /// Adds `le` (whole spectrum, times light `light`'s SPD) weighted by `weight`.
+    #[inline]
     fn add_emission(&mut self, scene: &LightTracerScene<'_>, light: LightId, le: f64, weight: f64) {
         let Some(spd) = scene.light_spd(light) else { return };
         if weight > 0.0 {
@@ -260,6 +261,7 @@ impl<'a> PathTracer<'a> {
 
     /// The BSDF sample and Russian roulette at a vertex (after its next-event estimation);
     /// `false` when the path ends here.
+    #[inline]
     fn bounce(
         &self,
         p: &mut PathState,

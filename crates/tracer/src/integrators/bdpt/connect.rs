@@ -117,7 +117,7 @@ impl Bdpt<'_> {
                 if beam_light.flags.delta_direction {
                     return None;
                 }
-                let (seen, density) = connect_light_to_camera(self.scene, id, qs.point, qs.u.lens)?;
+                let (seen, density) = connect_light_to_camera(self.scene, id, qs.point, qs.u)?;
                 ((seen.x, seen.y), seen.lens, qs.beta * density, wl.lambda)
             }
             VertexKind::Surface(hit) => {
@@ -130,7 +130,7 @@ impl Bdpt<'_> {
                     material,
                     wi,
                     &[qs.lambda],
-                    qs.u.lens,
+                    qs.u,
                     &mut f,
                 )?;
                 ((seen.x, seen.y), seen.lens, qs.beta * f[0], qs.lambda)
@@ -153,9 +153,9 @@ impl Bdpt<'_> {
         let scene = self.scene;
         let pt = &st.camera[st.t - 1];
         let VertexKind::Surface(hit) = pt.kind else { return None };
-        let chosen = scene.all_lights().sample_given(pt.u.light[0], wl.lambda)?;
+        let chosen = scene.all_lights().sample_given(pt.u[0], wl.lambda)?;
         let end = self.light_end(chosen.id, wl)?;
-        let sample = sample_light(scene, chosen.id, pt.point, [chosen.u, pt.u.light[1]])?;
+        let sample = sample_light(scene, chosen.id, pt.point, [chosen.u, pt.u[1]])?;
         let pmf = scene.all_lights().pmf(chosen.id);
         if !(pmf > 0.0 && end.pmf > 0.0) {
             return None;

@@ -78,7 +78,7 @@ impl Bdpt<'_> {
         let beta = scene.lights.power() * beam.scale;
         let ng = light_normal(source, beam.origin);
         let mut start =
-            Vertex::at(VertexKind::Light(light.id), beam.origin, ng, beta, wl.lambda, u);
+            Vertex::at(VertexKind::Light(light.id), beam.origin, ng, beta, wl.lambda, u.lens);
         start.delta = light.flags.delta_direction;
         start.pdf_fwd = if camera_strategies { light.pmf * pdf_pos } else { 1.0 };
         buffers.light.push(start);
@@ -115,7 +115,10 @@ impl Bdpt<'_> {
             let layout = if walk.reemit { &self.light_layout } else { &self.camera_layout };
             let u = VertexSamples::draw(layout, rng);
             let kind = VertexKind::Surface(hit);
-            let mut v = Vertex::at(kind, hit.point, hit.geometric_normal, beta, prev.lambda, u);
+            // A light vertex keeps its lens point, a camera vertex its light sample.
+            let connect = if walk.reemit { u.lens } else { u.light };
+            let mut v =
+                Vertex::at(kind, hit.point, hit.geometric_normal, beta, prev.lambda, connect);
             v.fluoresced = prev.fluoresced;
             v.pdf_fwd = Self::to_area(pdf_dir, prev.point, &v);
             let Some(material) = self.scene.materials.get(hit.primitive as usize) else {

@@ -9,7 +9,6 @@ use spectrace_lights::{LightFlags, LightId, LightSource, LightSurface};
 use spectrace_materials::{Material, Transport, reemission_lobe};
 
 use super::Bdpt;
-use crate::integrators::common::VertexSamples;
 
 /// What a vertex is.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -44,9 +43,9 @@ pub(super) struct Vertex {
     pub reemitted: bool,
     /// This vertex or one before it on its subpath re-emitted.
     pub fluoresced: bool,
-    /// The vertex's uniforms, drawn when it was made: its connections use them (a light vertex
-    /// its lens point for `t = 1`, a camera vertex its light sample for `s = 1`).
-    pub u: VertexSamples,
+    /// The uniforms of the vertex's one connection, drawn when it was made: a light vertex's
+    /// lens point for `t = 1`, a camera vertex's light sample for `s = 1`.
+    pub u: [f64; 2],
 }
 
 impl Vertex {
@@ -62,7 +61,7 @@ impl Vertex {
         ng: DVec3,
         beta: f64,
         lambda: f64,
-        u: VertexSamples,
+        u: [f64; 2],
     ) -> Self {
         Self {
             kind,
@@ -80,10 +79,9 @@ impl Vertex {
     }
 }
 
-/// The uniforms of a vertex that draws none (the camera's, and vertices sampled by a
-/// connection).
-pub(super) const NO_SAMPLES: VertexSamples =
-    VertexSamples { fluorescence: [0.5; 2], light: [0.5; 2], lens: [0.5; 2] };
+/// The connection uniforms of a vertex that draws none (the camera's, and vertices sampled by
+/// a connection).
+pub(super) const NO_SAMPLES: [f64; 2] = [0.5; 2];
 
 /// A light as a path end: its id, its flags, and the probability of choosing it given the
 /// sample's wavelength.
