@@ -87,6 +87,15 @@ pub struct PathTracer<'a> {
     excitation: Vec<Option<ExcitationSampler>>,
 }
 
+/// A vertex as next-event estimation sees it: the hit, the direction back along the path and
+/// what scatters there.
+#[derive(Clone, Copy)]
+struct Shading<'h> {
+    hit: &'h Hit,
+    wo: DVec3,
+    material: &'h dyn Material,
+}
+
 /// The state of one camera path between bounces.
 struct PathState {
     ray: Ray,
@@ -244,7 +253,8 @@ impl<'a> PathTracer<'a> {
                 p.collapse(lambda_weights);
             }
             if !material.is_specular() {
-                self.next_event(&mut p, &hit, wo, material, u.light, stats);
+                let at = Shading { hit: &hit, wo, material };
+                self.next_event(&mut p, &at, u.light, stats);
                 if !self.effects.continue_after_diffuse {
                     // No light can come back to a non-specular surface by interreflection:
                     // only an emitter seen by the BSDF-sampled ray remains (for MIS).
@@ -304,50 +314,30 @@ impl<'a> PathTracer<'a> {
         true
     }
 
-    /// Next-event estimation at a non-specular `hit` seen from `wo`: every delta-position light
+    /// Next-event estimation at a non-specular vertex `at`: every delta-position light
     /// (points, spots) once, and one area light chosen by the scene's light sampler, weighted by
     /// the power heuristic against BSDF sampling; added to the path's radiance.
-    fn next_event(
-        &self,
-        p: &mut PathState,
-        hit: &Hit,
-        wo: DVec3,
-        material: &dyn Material,
-        u: [f64; 2],
-        stats: &mut TraceStats,
-    ) {
+    fn next_event(&self, p: &mut PathState, at: &Shading<'_>, u: [f64; 2], stats: &mut TraceStats) {
         for &id in self.scene.delta_lights() {
-            self.connect_light(p, hit, wo, material, id, 1.0, [0.5, 0.5], stats);
+            self.connect_light(p, at, (id, 1.0), [0.5, 0.5], stats);
         }
         if let Some(chosen) = self.scene.area_lights().sample(u[0]) {
-            self.connect_light(
-                p,
-                hit,
-                wo,
-                material,
-                chosen.id,
-                chosen.pmf,
-                [chosen.u, u[1]],
-                stats,
-            );
+            self.connect_light(p, at, (chosen.id, chosen.pmf), [chosen.u, u[1]], stats);
         }
     }
 
-    /// One light sample of light `id` (chosen with probability `pmf`) seen from `hit`, weighted
-    /// by the power heuristic against BSDF sampling (fully for a delta light), added to the
-    /// path's radiance.
-    #[allow(clippy::too_many_arguments)]
+    /// One light sample of light `id` (chosen with probability `pmf`) seen from the vertex `at`,
+    /// weighted by the power heuristic against BSDF sampling (fully for a delta light), added
+    /// to the path's radiance.
     fn connect_light(
         &self,
         p: &mut PathState,
-        hit: &Hit,
-        wo: DVec3,
-        material: &dyn Material,
-        id: LightId,
-        pmf: f64,
+        at: &Shading<'_>,
+        (id, pmf): (LightId, f64),
         u: [f64; 2],
         stats: &mut TraceStats,
     ) {
+        let Shading { hit, wo, material } = *at;
         let scene = self.scene;
         let Some(sample) = sample_light(scene, id, hit.point, u) else { return };
         let wi = -sample.direction;

@@ -186,6 +186,12 @@ impl<'a> Bdpt<'a> {
         u64::from(self.scene.camera.width()) * u64::from(self.scene.camera.height())
     }
 
+    /// Whether a sample with `beam` at `wl` may use camera strategies: a beam of weight 1 at a
+    /// wavelength the lights' spectrum has a density for (see the module docs).
+    fn camera_strategies(beam: &spectrace_lights::Beam, wl: &Wavelength) -> bool {
+        beam.scale == 1.0 && wl.density > 0.0 && wl.density.is_finite()
+    }
+
     /// Most vertices of a camera subpath (pinhole included) and of a light subpath.
     fn max_vertices(&self) -> (usize, usize) {
         let d = self.settings.max_depth.min(crate::MAX_DEPTH) as usize;
@@ -207,9 +213,9 @@ impl<'a> Bdpt<'a> {
         let beam = LightSource::next_beam(scene.lights, rng);
         let density = self.set_spd.value(beam.lambda);
         let wl = Wavelength { lambda: beam.lambda, density };
-        let camera_strategies = beam.scale == 1.0 && density > 0.0 && density.is_finite();
+        let camera_strategies = Self::camera_strategies(&beam, &wl);
         let Some(light) = self.light_end(beam.parent, &wl) else { return };
-        self.light_subpath(&beam, &light, &wl, camera_strategies, rng, buffers, stats);
+        self.light_subpath(&beam, &light, &wl, rng, buffers, stats);
         if camera_strategies {
             self.camera_subpath(px, py, &wl, rng, buffers, stats);
         } else {

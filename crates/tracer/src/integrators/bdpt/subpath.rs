@@ -21,6 +21,16 @@ pub(crate) struct Buffers {
     pub(super) mis: Vec<super::MisVertex>,
 }
 
+/// Where a walk starts: the ray leaving the subpath's first vertex, its first hit, the
+/// throughput on leaving and the solid-angle density of the ray's direction (0 for a delta).
+#[derive(Debug, Clone, Copy)]
+struct WalkStart {
+    ray: Ray,
+    first: Option<Hit>,
+    beta: f64,
+    pdf_dir: f64,
+}
+
 /// How a walk continues: the transport it follows, whether it may re-emit, and its length.
 #[derive(Debug, Clone, Copy)]
 struct Walk {
@@ -54,22 +64,22 @@ impl Bdpt<'_> {
         let first = self.scene.world.intersect(&ray, f64::INFINITY);
         let walk =
             Walk { transport: Transport::Radiance, reemit: false, max: self.max_vertices().0 };
-        self.random_walk(ray, first, 1.0, pdf_dir, walk, &mut buffers.camera, rng, stats);
+        let start = WalkStart { ray, first, beta: 1.0, pdf_dir };
+        self.random_walk(start, walk, &mut buffers.camera, rng, stats);
     }
 
     /// The light subpath of `beam` into `buffers.light`: the beam's origin on its light, then a
     /// random walk along the beam.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn light_subpath(
         &self,
         beam: &Beam,
         light: &LightEnd,
         wl: &Wavelength,
-        camera_strategies: bool,
         rng: &mut dyn rand::Rng,
         buffers: &mut Buffers,
         stats: &mut TraceStats,
     ) {
+        let camera_strategies = Self::camera_strategies(beam, wl);
         let scene = self.scene;
         buffers.light.clear();
         let u = VertexSamples::draw(&self.light_layout, rng);
@@ -87,26 +97,22 @@ impl Bdpt<'_> {
         let pdf_dir = if light.flags.delta_direction { 0.0 } else { pdf_dir };
         let walk =
             Walk { transport: Transport::Importance, reemit: true, max: self.max_vertices().1 };
-        self.random_walk(ray, first, beta, pdf_dir, walk, &mut buffers.light, rng, stats);
+        let start = WalkStart { ray, first, beta, pdf_dir };
+        self.random_walk(start, walk, &mut buffers.light, rng, stats);
     }
 
-    /// Follows `ray` (whose first hit is `first`) through the scene, appending a vertex per
-    /// surface hit to `path` (which holds the subpath's start) until it has `walk.max`
-    /// vertices, the path is absorbed or Russian roulette ends it. `beta` is the throughput on
-    /// leaving the start, `pdf_dir` the solid-angle density of the ray's direction (0 for a
-    /// delta).
-    #[allow(clippy::too_many_arguments)]
+    /// Follows `start.ray` (whose first hit is `start.first`) through the scene, appending a
+    /// vertex per surface hit to `path` (which holds the subpath's start) until it has
+    /// `walk.max` vertices, the path is absorbed or Russian roulette ends it.
     fn random_walk(
         &self,
-        mut ray: Ray,
-        first: Option<Hit>,
-        mut beta: f64,
-        mut pdf_dir: f64,
+        start: WalkStart,
         walk: Walk,
         path: &mut Vec<Vertex>,
         rng: &mut dyn rand::Rng,
         stats: &mut TraceStats,
     ) {
+        let WalkStart { mut ray, first, mut beta, mut pdf_dir } = start;
         let start = beta;
         let mut next = first;
         while let Some(hit) = next.take() {

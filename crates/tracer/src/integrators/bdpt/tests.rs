@@ -202,7 +202,7 @@ fn mis_weights_of_all_strategies_of_sampled_paths_sum_to_one() {
             let density = bdpt.set_spd.value(beam.lambda);
             let wl = Wavelength { lambda: beam.lambda, density };
             let end = bdpt.light_end(beam.parent, &wl).unwrap();
-            bdpt.light_subpath(&beam, &end, &wl, true, &mut rng, &mut buffers, &mut stats);
+            bdpt.light_subpath(&beam, &end, &wl, &mut rng, &mut buffers, &mut stats);
             buffers.camera.clear();
             bdpt.camera_subpath(i % 16, (i / 16) % 16, &wl, &mut rng, &mut buffers, &mut stats);
             let (lv, cv) = (buffers.light.clone(), buffers.camera.clone());
@@ -282,7 +282,7 @@ fn mis_weights_of_a_thin_lens_sum_to_one() {
         let beam = LightSource::next_beam(scene.lights, &mut rng);
         let wl = Wavelength { lambda: beam.lambda, density: bdpt.set_spd.value(beam.lambda) };
         let end = bdpt.light_end(beam.parent, &wl).unwrap();
-        bdpt.light_subpath(&beam, &end, &wl, true, &mut rng, &mut buffers, &mut stats);
+        bdpt.light_subpath(&beam, &end, &wl, &mut rng, &mut buffers, &mut stats);
         buffers.camera.clear();
         let (px, py) = (i % 16, (i / 16) % 16);
         bdpt.camera_subpath(px, py, &wl, &mut rng, &mut buffers, &mut stats);
