@@ -261,13 +261,6 @@ impl Film {
         }
     }
 
-    /// Adds a spectral contribution: `weight` at wavelength `lambda` (nm), weighted by the CIE
-    /// 1931 matching functions.
-    #[inline]
-    pub fn add_spectral(&mut self, x: u32, y: u32, lambda: f64, weight: f64) -> bool {
-        self.add(x, y, cmf(lambda) * weight)
-    }
-
     /// Adds every pixel of `other` (same size) to this film, exactly.
     ///
     /// # Errors
@@ -518,12 +511,12 @@ mod tests {
             .collect();
         let mut one = Film::new(8, 5).unwrap();
         for &(x, y, l, w) in &contributions {
-            one.add_spectral(x, y, l, w);
+            one.splat_spectral(x, y, &[l], &[w]);
         }
         let mut parts =
             [Film::new(8, 5).unwrap(), Film::new(8, 5).unwrap(), Film::new(8, 5).unwrap()];
         for (k, &(x, y, l, w)) in contributions.iter().enumerate() {
-            parts[k % 3].add_spectral(x, y, l, w);
+            parts[k % 3].splat_spectral(x, y, &[l], &[w]);
         }
         let mut merged = Film::new(8, 5).unwrap();
         for p in parts.iter().rev() {
