@@ -187,6 +187,50 @@ fn mis_weight_counts_only_possible_strategies() {
     assert_eq!(mis_weight(&[], 0, false), 0.0);
 }
 
+/// One BDPT sample of pixel `pixel` with fresh subpaths (left in `buffers`); every strategy that
+/// gives light is checked: its full path has `s + t` vertices, it is one of the counted
+/// strategies, its weight is in (0, 1] and is the weight of its path, and the weights of every
+/// counted strategy of that path sum to 1. Returns the `(s, t)` of those strategies.
+fn check_sample(
+    bdpt: &Bdpt<'_>,
+    pixel: (u32, u32),
+    rng: &mut Pcg64,
+    buffers: &mut Buffers,
+) -> Vec<(usize, usize)> {
+    let mut stats = TraceStats::default();
+    let beam = LightSource::next_beam(bdpt.scene.lights, rng);
+    let wl = Wavelength { lambda: beam.lambda, density: bdpt.set_spd.value(beam.lambda) };
+    let end = bdpt.light_end(beam.parent, &wl).unwrap();
+    bdpt.light_subpath(&beam, &end, &wl, rng, buffers, &mut stats);
+    bdpt.camera_subpath(pixel.0, pixel.1, &wl, rng, buffers, &mut stats);
+    let (lv, cv) = (buffers.light.clone(), buffers.camera.clone());
+    let mut gave = Vec::new();
+    for t in 1..=cv.len() {
+        for s in (0..=lv.len()).filter(|s| s + t >= 2) {
+            let mis = &mut buffers.mis;
+            let strategy = Strategy { light: &lv, camera: &cv, s, t };
+            let Some(c) = bdpt.connect(strategy, &end, &wl, true, mis) else { continue };
+            let n = mis.len();
+            assert_eq!(n, s + t);
+            let valid = |k: usize| {
+                if k == 0 {
+                    !mis[0].delta && !c.light_is_delta
+                } else {
+                    !mis[k - 1].delta && !mis[k].delta
+                }
+            };
+            assert!(valid(s), "strategy ({s}, {t}) gave light but is not counted");
+            assert!(c.weight > 0.0 && c.weight <= 1.0);
+            assert_eq!(c.weight, mis_weight(mis, s, c.light_is_delta));
+            let sum: f64 =
+                (0..n).filter(|&k| valid(k)).map(|k| mis_weight(mis, k, c.light_is_delta)).sum();
+            assert!((sum - 1.0).abs() < 1e-9, "({s}, {t}): weights sum to {sum}");
+            gave.push((s, t));
+        }
+    }
+    gave
+}
+
 #[test]
 fn mis_weights_of_all_strategies_of_sampled_paths_sum_to_one() {
     for fixture in [box_scene(), caustic_scene(), spot_scene(), furnace_scene(0.6)] {
@@ -194,60 +238,18 @@ fn mis_weights_of_all_strategies_of_sampled_paths_sum_to_one() {
         let bdpt = Bdpt::new(&scene, BdptSettings::default(), effects(&scene));
         let mut rng = Pcg64::seed_from_u64(11);
         let mut buffers = Buffers { light: Vec::new(), camera: Vec::new(), mis: Vec::new() };
-        let mut stats = TraceStats::default();
-        let mut checked = 0;
         let mut strategies = [0usize; 4];
         for i in 0..4000u32 {
-            let beam = LightSource::next_beam(scene.lights, &mut rng);
-            let density = bdpt.set_spd.value(beam.lambda);
-            let wl = Wavelength { lambda: beam.lambda, density };
-            let end = bdpt.light_end(beam.parent, &wl).unwrap();
-            bdpt.light_subpath(&beam, &end, &wl, &mut rng, &mut buffers, &mut stats);
-            buffers.camera.clear();
-            bdpt.camera_subpath(i % 16, (i / 16) % 16, &wl, &mut rng, &mut buffers, &mut stats);
-            let (lv, cv) = (buffers.light.clone(), buffers.camera.clone());
-            for t in 1..=cv.len() {
-                for s in 0..=lv.len() {
-                    if s + t < 2 {
-                        continue;
-                    }
-                    let mis = &mut buffers.mis;
-                    let Some(c) = bdpt.connect(
-                        Strategy { light: &lv, camera: &cv, s, t },
-                        &end,
-                        &wl,
-                        true,
-                        mis,
-                    ) else {
-                        continue;
-                    };
-                    let n = mis.len();
-                    assert_eq!(n, s + t);
-                    let valid = |k: usize| {
-                        if k == 0 {
-                            !mis[0].delta && !c.light_is_delta
-                        } else {
-                            !mis[k - 1].delta && !mis[k].delta
-                        }
-                    };
-                    assert!(valid(s), "strategy ({s}, {t}) gave light but is not counted");
-                    assert!(c.weight > 0.0 && c.weight <= 1.0);
-                    assert_eq!(c.weight, mis_weight(mis, s, c.light_is_delta));
-                    let sum: f64 = (0..n)
-                        .filter(|&k| valid(k))
-                        .map(|k| mis_weight(mis, k, c.light_is_delta))
-                        .sum();
-                    assert!((sum - 1.0).abs() < 1e-9, "({s}, {t}): weights sum to {sum}");
-                    checked += 1;
-                    strategies[match (s, t) {
-                        (0, _) => 0,
-                        (1, _) => 1,
-                        (_, 1) => 2,
-                        _ => 3,
-                    }] += 1;
-                }
+            for (s, t) in check_sample(&bdpt, (i % 16, (i / 16) % 16), &mut rng, &mut buffers) {
+                strategies[match (s, t) {
+                    (0, _) => 0,
+                    (1, _) => 1,
+                    (_, 1) => 2,
+                    _ => 3,
+                }] += 1;
             }
         }
+        let checked: usize = strategies.iter().sum();
         assert!(checked > 1000, "only {checked} connections");
         assert!(strategies[1] > 0 && strategies[2] > 0, "{strategies:?}");
         // Only the box has two diffuse surfaces that see each other, and a visible emitter.
@@ -276,49 +278,13 @@ fn mis_weights_of_a_thin_lens_sum_to_one() {
     let mut rng = Pcg64::seed_from_u64(3);
     let bdpt = Bdpt::new(&scene, BdptSettings::default(), effects(&scene));
     let mut buffers = Buffers { light: Vec::new(), camera: Vec::new(), mis: Vec::new() };
-    let mut stats = TraceStats::default();
     let mut lens_connections = 0;
     for i in 0..2000u32 {
-        let beam = LightSource::next_beam(scene.lights, &mut rng);
-        let wl = Wavelength { lambda: beam.lambda, density: bdpt.set_spd.value(beam.lambda) };
-        let end = bdpt.light_end(beam.parent, &wl).unwrap();
-        bdpt.light_subpath(&beam, &end, &wl, &mut rng, &mut buffers, &mut stats);
-        buffers.camera.clear();
-        let (px, py) = (i % 16, (i / 16) % 16);
-        bdpt.camera_subpath(px, py, &wl, &mut rng, &mut buffers, &mut stats);
+        let gave = check_sample(&bdpt, (i % 16, (i / 16) % 16), &mut rng, &mut buffers);
         // The camera subpath starts on the lens.
         let start = buffers.camera[0].point;
         assert!((start - position).length() <= 0.05 + 1e-12);
-        let (lv, cv) = (buffers.light.clone(), buffers.camera.clone());
-        for t in 1..=cv.len() {
-            for s in 0..=lv.len() {
-                if s + t < 2 {
-                    continue;
-                }
-                let mis = &mut buffers.mis;
-                let Some(c) =
-                    bdpt.connect(Strategy { light: &lv, camera: &cv, s, t }, &end, &wl, true, mis)
-                else {
-                    continue;
-                };
-                let n = mis.len();
-                let valid = |k: usize| {
-                    if k == 0 {
-                        !mis[0].delta && !c.light_is_delta
-                    } else {
-                        !mis[k - 1].delta && !mis[k].delta
-                    }
-                };
-                let sum: f64 = (0..n)
-                    .filter(|&k| valid(k))
-                    .map(|k| mis_weight(mis, k, c.light_is_delta))
-                    .sum();
-                assert!((sum - 1.0).abs() < 1e-9, "({s}, {t}): weights sum to {sum}");
-                if t == 1 {
-                    lens_connections += 1;
-                }
-            }
-        }
+        lens_connections += gave.iter().filter(|&&(_, t)| t == 1).count();
     }
     assert!(lens_connections > 100, "only {lens_connections} connections to the lens");
 }
