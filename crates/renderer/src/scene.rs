@@ -2,7 +2,7 @@
 //! and assembly into what the tracer needs.
 
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 use spectrace_geometry::{Disk, Rectangle};
@@ -273,9 +273,6 @@ pub struct Scene {
     pub inputs: Vec<PathBuf>,
     /// The illuminance sensors.
     pub sensors: SensorSet,
-    /// What the scene contains, for the effects analysis: found once, on first use (see
-    /// [`Scene::features`]).
-    features: OnceLock<SceneFeatures>,
 }
 
 /// How a scene file may refer to other files.
@@ -371,15 +368,15 @@ impl Scene {
             output: file.output,
             inputs: parts.inputs,
             sensors,
-            features: OnceLock::new(),
         })
     }
 
     /// What the scene contains (its lights, materials and shapes), for the effects analysis, the
-    /// choice of estimator and the warnings: found on first use and kept, since none of them
-    /// changes once the scene is loaded.
+    /// choice of estimator and the warnings: the one place it is found. Not cached, since the
+    /// lights are a public field that experiments change after loading (the lab's knobs); a scan
+    /// of the lights and materials costs nothing next to a render.
     pub fn features(&self) -> SceneFeatures {
-        *self.features.get_or_init(|| crate::tracer_scene(self).features(&self.non_convex))
+        crate::tracer_scene(self).features(&self.non_convex)
     }
 
     /// Whether a point can sample every light (no laser, sky or beam-only light): what the path

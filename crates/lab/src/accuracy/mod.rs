@@ -65,7 +65,7 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 use spectrace_lights::WavelengthSampling;
-use spectrace_renderer::{Scene, choose_integrator, decide_effects, render_xyz, tracer_scene};
+use spectrace_renderer::{Scene, choose_integrator, decide_effects, render_xyz};
 use spectrace_spectrum::{SpectralPowerDistribution, Xyz};
 use spectrace_tracer::{
     CameraRepr, EffectsMode, IntegratorChoice, PinholeCamera, SamplerKind, SceneFeatures,
@@ -544,7 +544,7 @@ fn run_scene(
     let effects_summary = decide_effects(&baseline, Some(EffectsMode::Auto)).summary();
     let (auto_picks, auto_reason) = choose_integrator(&baseline, Some(IntegratorChoice::Auto));
     let reference_integrator = reference_integrator(&baseline);
-    let features = tracer_scene(&baseline).features(&baseline.non_convex);
+    let features = baseline.features();
     eprintln!(
         "accuracy: {name}: {width}x{height} pixels; {effects_summary}; auto picks {auto_reason}; \
          reference by {}",
@@ -836,7 +836,7 @@ mod tests {
         assert_eq!(apply(Configuration::Baseline, &mut baseline).unwrap(), "");
         // Biases known from the scene's features: none on a diffuse floor under a point light;
         // with a mirror, the light tracer's (black mirrors) and the path tracer's (caustics).
-        let features = tracer_scene(&baseline).features(&baseline.non_convex);
+        let features = baseline.features();
         let bias = |c, f: &SceneFeatures| known_bias(c, IntegratorChoice::Path, f);
         for c in Configuration::ALL {
             let expected = c == Configuration::PiecewiseConstantSpd;
