@@ -22,8 +22,9 @@
 //! crate.
 //!
 //! The modules follow the jobs, in the order a render meets them: `scene` (the file and its
-//! assembly, [`Scene::features`] found once), `options` (overrides, errors), `plan` (estimator,
-//! effects, plan, normalisation), `integrators` (the estimators), `probe`, `warnings`, `run`
+//! assembly; [`Scene::features`], the one place its features are found), `options` (overrides,
+//! errors), `plan` (estimator, effects, plan, normalisation), `integrators` (the estimators, from
+//! the tracer's registry), `probe`, `warnings`, `run`
 //! ([`render_scene`] in named steps), `progress`, `write` and `output` (the files and their
 //! encoding), `report` (the sidecar), `sensors` and `sensor_output`, `part` and `shard` (part
 //! files and [`merge_parts`]), `bench`, [`pilot`], [`cli`], and `files` (bounded reads, atomic
