@@ -22,10 +22,11 @@ use std::f64::consts::PI;
 
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
+use spectrace_sampling::Frame;
 
 use crate::disk::circle_extent;
 use crate::float::{
-    Frame, finite_point, gamma, positive, safe_length, stable_quadratic_roots, unit_direction,
+    finite_point, gamma, positive, safe_length, stable_quadratic_roots, unit_direction,
 };
 use crate::shape::{Primitives, SurfacePoint, similarity};
 use crate::{Bounds, GeometryError, Hit, Ray, Transform};
@@ -81,7 +82,7 @@ impl TryFrom<CylinderRepr> for Cylinder {
         let axis = unit_direction(S, "transform", t.vector(axis))?;
         Ok(Self {
             center: finite_point(S, "transform", t.point(center))?,
-            frame: Frame::new(axis),
+            frame: Frame::from_normal(axis),
             height: positive(S, "transform", height * s)?,
             radius: positive(S, "transform", radius * s)?,
             repr: Box::new(r),
@@ -119,8 +120,8 @@ impl Cylinder {
     pub(crate) fn sample_area(&self, u: [f64; 3]) -> SurfacePoint {
         let fr = &self.frame;
         let phi = 2.0 * PI * u[1];
-        let n = (fr.u * phi.cos() + fr.v * phi.sin()).normalize();
-        let point = self.center + fr.n * (u[0] * self.height) + n * self.radius;
+        let n = (fr.t() * phi.cos() + fr.b() * phi.sin()).normalize();
+        let point = self.center + fr.n() * (u[0] * self.height) + n * self.radius;
         SurfacePoint { point, normal: n }
     }
 }
@@ -131,8 +132,8 @@ impl Primitives for Cylinder {
     }
 
     fn bounds(&self, _index: u32) -> Bounds {
-        let e = circle_extent(self.frame.n, self.radius);
-        let top = self.center + self.frame.n * self.height;
+        let e = circle_extent(self.frame.n(), self.radius);
+        let top = self.center + self.frame.n() * self.height;
         Bounds { min: self.center.min(top) - e, max: self.center.max(top) + e }
     }
 
@@ -143,10 +144,10 @@ impl Primitives for Cylinder {
     fn intersect(&self, _index: u32, ray: &Ray, t_max: f64) -> Option<Hit> {
         let (t, z, n) = self.solve(ray, t_max)?;
         let (c, r, fr, h) = (self.center, self.radius, &self.frame, self.height);
-        let along = fr.n * z;
+        let along = fr.n() * z;
         let point = c + along + n * r;
         let error = (c.abs() + along.abs() + (n * r).abs()) * gamma(10);
-        let phi = n.dot(fr.v).atan2(n.dot(fr.u));
+        let phi = n.dot(fr.b()).atan2(n.dot(fr.t()));
         let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
         Some(Hit {
             t,
@@ -166,8 +167,8 @@ impl Cylinder {
     #[inline]
     fn solve(&self, ray: &Ray, t_max: f64) -> Option<(f64, f64, DVec3)> {
         let (c, r, fr) = (self.center, self.radius, &self.frame);
-        let o = fr.local(ray.origin - c);
-        let d = fr.local(ray.direction);
+        let o = fr.to_local(ray.origin - c);
+        let d = fr.to_local(ray.direction);
         let (o2, d2) = (DVec2::new(o.x, o.y), DVec2::new(d.x, d.y));
         let a = d2.length_squared();
         if !(a > 0.0) {
@@ -188,8 +189,8 @@ impl Cylinder {
             t > 0.0 && t < t_max && (0.0..=h).contains(&z)
         })?;
         let q = ray.at(t) - c;
-        let z = q.dot(fr.n);
-        let radial = q - fr.n * z;
+        let z = q.dot(fr.n());
+        let radial = q - fr.n() * z;
         let len = radial.length();
         if !(len > 0.0) {
             return None;

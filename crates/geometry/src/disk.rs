@@ -18,8 +18,9 @@ use std::f64::consts::PI;
 
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
+use spectrace_sampling::Frame;
 
-use crate::float::{Frame, finite_point, positive, unit_direction};
+use crate::float::{finite_point, positive, unit_direction};
 use crate::rectangle::plane_hit;
 use crate::shape::{Primitives, SurfacePoint, similarity};
 use crate::{Bounds, GeometryError, Hit, Ray, Transform};
@@ -57,7 +58,7 @@ impl TryFrom<DiskRepr> for Disk {
         let normal = unit_direction(S, "transform", t.normal(normal))?;
         let center = finite_point(S, "transform", t.point(center))?;
         let radius = positive(S, "transform", radius * s)?;
-        Ok(Self { center, radius, frame: Frame::new(normal), repr: Box::new(r) })
+        Ok(Self { center, radius, frame: Frame::from_normal(normal), repr: Box::new(r) })
     }
 }
 
@@ -78,7 +79,7 @@ impl Disk {
 
     /// Unit normal.
     pub fn normal(&self) -> DVec3 {
-        self.frame.n
+        self.frame.n()
     }
 
     /// Area `pi r^2` (m^2).
@@ -91,8 +92,8 @@ impl Disk {
     pub(crate) fn sample_area(&self, u: [f64; 3]) -> SurfacePoint {
         let rho = self.radius * u[0].sqrt();
         let phi = 2.0 * PI * u[1];
-        let offset = self.frame.world(DVec3::new(rho * phi.cos(), rho * phi.sin(), 0.0));
-        SurfacePoint { point: self.center + offset, normal: self.frame.n }
+        let offset = self.frame.to_world(DVec3::new(rho * phi.cos(), rho * phi.sin(), 0.0));
+        SurfacePoint { point: self.center + offset, normal: self.frame.n() }
     }
 }
 
@@ -100,8 +101,8 @@ impl Disk {
     /// The plane crossing inside the radius: `(t, point, error, local point, rho)`.
     #[inline]
     fn solve(&self, ray: &Ray, t_max: f64) -> Option<(f64, DVec3, DVec3, DVec3, f64)> {
-        let (t, point, error) = plane_hit(self.center, self.frame.n, ray, t_max)?;
-        let local = self.frame.local(point - self.center);
+        let (t, point, error) = plane_hit(self.center, self.frame.n(), ray, t_max)?;
+        let local = self.frame.to_local(point - self.center);
         let rho = local.x.hypot(local.y);
         if !(rho <= self.radius) {
             return None;
@@ -121,7 +122,7 @@ impl Primitives for Disk {
     }
 
     fn bounds(&self, _index: u32) -> Bounds {
-        let e = circle_extent(self.frame.n, self.radius);
+        let e = circle_extent(self.frame.n(), self.radius);
         Bounds { min: self.center - e, max: self.center + e }
     }
 
@@ -136,8 +137,8 @@ impl Primitives for Disk {
         Some(Hit {
             t,
             point,
-            geometric_normal: self.frame.n,
-            shading_normal: self.frame.n,
+            geometric_normal: self.frame.n(),
+            shading_normal: self.frame.n(),
             uv: DVec2::new(phi / (2.0 * PI), rho / self.radius),
             primitive: 0,
             triangle: 0,

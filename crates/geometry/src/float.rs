@@ -69,52 +69,6 @@ pub(crate) fn positive(
     }
 }
 
-/// An orthonormal, right-handed frame `(u, v, n)` with `u x v = n`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Frame {
-    /// First tangent.
-    pub(crate) u: DVec3,
-    /// Second tangent.
-    pub(crate) v: DVec3,
-    /// The frame's axis.
-    pub(crate) n: DVec3,
-}
-
-impl Frame {
-    /// A frame around the unit vector `n` (Duff et al. 2017, branchless ONB).
-    pub(crate) fn new(n: DVec3) -> Self {
-        let sign = 1.0_f64.copysign(n.z);
-        let a = -1.0 / (sign + n.z);
-        let b = n.x * n.y * a;
-        let u = DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
-        let v = DVec3::new(b, sign + n.y * n.y * a, -n.y);
-        Self { u, v, n }
-    }
-
-    /// A frame from a unit axis and a preferred first tangent (Gram-Schmidt; falls back to
-    /// [`Frame::new`] when the tangent is parallel to the axis).
-    pub(crate) fn with_tangent(n: DVec3, tangent: DVec3) -> Self {
-        let t = tangent - n * tangent.dot(n);
-        let len = t.length();
-        if len > 1e-9 && len.is_finite() {
-            let u = t / len;
-            Self { u, v: n.cross(u), n }
-        } else {
-            Self::new(n)
-        }
-    }
-
-    /// World vector to local coordinates.
-    pub(crate) fn local(self, w: DVec3) -> DVec3 {
-        DVec3::new(w.dot(self.u), w.dot(self.v), w.dot(self.n))
-    }
-
-    /// Local coordinates to a world vector.
-    pub(crate) fn world(self, l: DVec3) -> DVec3 {
-        self.u * l.x + self.v * l.y + self.n * l.z
-    }
-}
-
 /// The stable roots `t0 <= t1` of `a t^2 + 2 b t + c = 0` given the reduced discriminant
 /// `disc = b^2 - a c >= 0` computed by the caller (in a cancellation-free form).
 pub(crate) fn stable_quadratic_roots(a: f64, b: f64, c: f64, disc: f64) -> (f64, f64) {

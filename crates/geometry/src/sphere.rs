@@ -23,8 +23,9 @@ use std::f64::consts::PI;
 
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
+use spectrace_sampling::Frame;
 
-use crate::float::{Frame, finite_point, gamma, positive, stable_quadratic_roots};
+use crate::float::{finite_point, gamma, positive, stable_quadratic_roots};
 use crate::shape::{Primitives, SurfacePoint, similarity};
 use crate::{Bounds, GeometryError, Hit, Ray, Transform};
 
@@ -56,7 +57,8 @@ impl TryFrom<SphereRepr> for Sphere {
         let radius = positive(S, "radius", r.radius)?;
         let t = r.transform.unwrap_or_default();
         let s = similarity(S, &t)?;
-        let frame = Frame::with_tangent(t.vector(DVec3::Y).normalize(), t.vector(DVec3::X));
+        let frame =
+            Frame::from_normal_and_tangent(t.vector(DVec3::Y).normalize(), t.vector(DVec3::X));
         let center = finite_point(S, "transform", t.point(center))?;
         let radius = positive(S, "transform", radius * s)?;
         Ok(Self { center, radius, frame, repr: Box::new(r) })
@@ -108,7 +110,7 @@ impl Sphere {
         let z = 1.0 - 2.0 * u[0];
         let s = (1.0 - z * z).max(0.0).sqrt();
         let phi = 2.0 * PI * u[1];
-        let n = self.frame.world(DVec3::new(s * phi.cos(), s * phi.sin(), z)).normalize();
+        let n = self.frame.to_world(DVec3::new(s * phi.cos(), s * phi.sin(), z)).normalize();
         SurfacePoint { point: self.center + n * self.radius, normal: n }
     }
 }
@@ -132,7 +134,7 @@ impl Primitives for Sphere {
         let v = n * r;
         let point = c + v;
         let error = (c.abs() + v.abs()) * gamma(6);
-        let local = self.frame.local(n);
+        let local = self.frame.to_local(n);
         let phi = local.y.atan2(local.x);
         let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
         let uv = DVec2::new(phi / (2.0 * PI), local.z.clamp(-1.0, 1.0).acos() / PI);

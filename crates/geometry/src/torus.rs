@@ -34,8 +34,9 @@ use std::f64::consts::PI;
 
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
+use spectrace_sampling::Frame;
 
-use crate::float::{Frame, finite_point, gamma, positive, unit_direction};
+use crate::float::{finite_point, gamma, positive, unit_direction};
 use crate::shape::{Primitives, SurfacePoint, similarity};
 use crate::{Bounds, GeometryError, Hit, Ray, Transform};
 
@@ -83,7 +84,7 @@ impl TryFrom<TorusRepr> for Torus {
         let axis = unit_direction(S, "transform", t.vector(axis))?;
         Ok(Self {
             center: finite_point(S, "transform", t.point(center))?,
-            frame: Frame::new(axis),
+            frame: Frame::from_normal(axis),
             major: positive(S, "transform", major * s)?,
             minor: positive(S, "transform", minor * s)?,
             repr: Box::new(r),
@@ -208,8 +209,8 @@ impl Torus {
         let phi = minor_angle(u[1], self.minor / self.major);
         let ring = DVec3::new(theta.cos(), theta.sin(), 0.0);
         let nl = ring * phi.cos() + DVec3::Z * phi.sin();
-        let offset = self.frame.world(ring * self.major + nl * self.minor);
-        SurfacePoint { point: self.center + offset, normal: self.frame.world(nl).normalize() }
+        let offset = self.frame.to_world(ring * self.major + nl * self.minor);
+        SurfacePoint { point: self.center + offset, normal: self.frame.to_world(nl).normalize() }
     }
 
     /// Signed distance of the local point `q` to the tube (negative inside).
@@ -225,7 +226,7 @@ impl Primitives for Torus {
     }
 
     fn bounds(&self, _index: u32) -> Bounds {
-        let e = crate::disk::circle_extent(self.frame.n, self.major) + self.minor;
+        let e = crate::disk::circle_extent(self.frame.n(), self.major) + self.minor;
         Bounds { min: self.center - e, max: self.center + e }
     }
 
@@ -247,11 +248,11 @@ impl Primitives for Torus {
         let ml = m.length();
         let nl = if ml > 0.0 { m / ml } else { ring / big_r };
         let local = ring + nl * r;
-        let offset = fr.world(local);
+        let offset = fr.to_world(local);
         let point = self.center + offset;
         let error =
             (self.center.abs() + offset.abs()) * gamma(10) + DVec3::splat(gamma(10) * (big_r + r));
-        let n = fr.world(nl).normalize();
+        let n = fr.to_world(nl).normalize();
         let phi = ring.y.atan2(ring.x);
         let theta = nl.z.atan2(nl.dot(ring) / big_r);
         let wrap = |x: f64| (if x < 0.0 { x + 2.0 * PI } else { x }) / (2.0 * PI);
@@ -272,8 +273,8 @@ impl Torus {
     /// The first crossing in `(0, t_max)`: `(t, local point on the ray there)`.
     fn solve(&self, ray: &Ray, t_max: f64) -> Option<(f64, DVec3)> {
         let (big_r, r, fr) = (self.major, self.minor, &self.frame);
-        let o = fr.local(ray.origin - self.center);
-        let d = fr.local(ray.direction);
+        let o = fr.to_local(ray.origin - self.center);
+        let d = fr.to_local(ray.direction);
         // Bounding sphere of radius R + r, slightly enlarged.
         let rb = (big_r + r) * (1.0 + 1e-9);
         let a = d.length_squared();

@@ -29,6 +29,21 @@ impl Frame {
         Self { t, b: bt, n }
     }
 
+    /// The frame around the unit vector `n` whose first tangent is `tangent` made orthogonal to
+    /// `n` (Gram-Schmidt), so that a shape's local `+x` follows its transform; the frame of
+    /// [`from_normal`](Self::from_normal) when `tangent` is (nearly) parallel to `n` or not
+    /// finite.
+    pub fn from_normal_and_tangent(n: DVec3, tangent: DVec3) -> Self {
+        let t = tangent - n * tangent.dot(n);
+        let len = t.length();
+        if len > 1e-9 && len.is_finite() {
+            let t = t / len;
+            Self { t, b: n.cross(t), n }
+        } else {
+            Self::from_normal(n)
+        }
+    }
+
     /// The first tangent (local `+x`).
     #[inline]
     pub fn t(&self) -> DVec3 {

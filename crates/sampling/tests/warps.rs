@@ -268,6 +268,22 @@ fn frames_are_orthonormal_for_awkward_normals() {
     }
 }
 
+#[test]
+fn a_frame_with_a_tangent_follows_it_and_falls_back_when_it_is_parallel() {
+    let n = DVec3::new(1.0, -2.0, 0.5).normalize();
+    let tangent = DVec3::new(0.3, 0.9, -0.2);
+    let f = Frame::from_normal_and_tangent(n, tangent);
+    let projected = (tangent - n * tangent.dot(n)).normalize();
+    assert!((f.t() - projected).length() < 1e-15, "the first tangent follows the tangent");
+    assert!((f.t().cross(f.b()) - n).length() < 1e-15, "right-handed around n");
+    assert!(f.t().dot(f.b()).abs() < 1e-15 && (f.b().length() - 1.0).abs() < 1e-15);
+    assert_eq!(f.n(), n);
+    // A tangent along the normal (or not finite) gives the frame around the normal alone.
+    for bad in [n * 3.0, DVec3::ZERO, DVec3::new(f64::NAN, 0.0, 0.0)] {
+        assert_eq!(Frame::from_normal_and_tangent(n, bad), Frame::from_normal(n), "{bad}");
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(10_000))]
 
