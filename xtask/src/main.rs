@@ -7,6 +7,8 @@
 //! - `cargo xtask` / `cargo xtask status`: what Spectrace contains so far and how to use it.
 //! - `cargo xtask bench`: runs every crate's benchmarks (sampling, spectrum, lights, geometry) in
 //!   release mode.
+//! - `cargo xtask callgrind [BINARY [OUTFILE]]`: instructions per work item of every estimator,
+//!   counted by callgrind (`xtask/scripts/callgrind.sh`): the cost measure of refactors.
 //! - `cargo xtask ci`: runs `.ci/run` itself (rustfmt, clippy, the tests, the fuzz run, the
 //!   status page), so the two can never differ.
 //! - `cargo xtask render [SCENE] [options]`: builds the renderer in release mode and renders a
@@ -96,6 +98,7 @@ fn main() -> ExitCode {
             &["bench", "-p", "spectrace-geometry"],
         ]),
         "ci" => ci(),
+        "callgrind" => callgrind(&args[1..]),
         "help" | "-h" | "--help" => {
             print_help();
             ExitCode::SUCCESS
@@ -286,6 +289,7 @@ fn print_help() {
                   the materials cross-check against Mitsuba 3 (docs/materials-peer.md)\n  \
          bench    run every crate's benchmarks (release)\n  \
          ci       run .ci/run: rustfmt, clippy -D warnings, tests, fuzz, status\n  \
+         callgrind [BINARY [OUT]]  instructions per work item of every estimator (valgrind)\n  \
          help     this text"
     );
 }
@@ -316,6 +320,35 @@ fn status() -> ExitCode {
 }
 
 /// Runs `cargo <args>` for each argument list in turn; stops at the first failure.
+/// `cargo xtask callgrind [BINARY [OUTFILE]]`: instructions per work item of every estimator,
+/// counted by callgrind (`xtask/scripts/callgrind.sh`), for `BINARY` (default: the `spectrace`
+/// release build, built first) into `OUTFILE` (default `target/callgrind.md`).
+fn callgrind(args: &[String]) -> ExitCode {
+    let root = workspace_root();
+    let binary = match args.first() {
+        Some(b) => std::path::PathBuf::from(b),
+        None => match build_release(&SPECTRACE) {
+            Ok(b) => b,
+            Err(code) => return code,
+        },
+    };
+    let out =
+        args.get(1).map_or_else(|| root.join("target/callgrind.md"), std::path::PathBuf::from);
+    let script = root.join("xtask/scripts/callgrind.sh");
+    eprintln!("$ bash {} {} {}", script.display(), binary.display(), out.display());
+    match Command::new("bash").arg(&script).arg(&binary).arg(&out).status() {
+        Ok(s) if s.success() => ExitCode::SUCCESS,
+        Ok(s) => {
+            eprintln!("the callgrind script failed ({s})");
+            ExitCode::FAILURE
+        }
+        Err(e) => {
+            eprintln!("could not run bash: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
 /// `cargo xtask ci`: `bash .ci/run` from the workspace root.
 fn ci() -> ExitCode {
     let root = workspace_root();
