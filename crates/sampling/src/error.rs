@@ -93,6 +93,13 @@ pub enum SamplingError {
         /// Which input array.
         array: &'static str,
     },
+    /// The total mass (an integral) is positive but smaller than the least positive `f64`, so it
+    /// cannot be reported (it rounds to zero): tiny values on a narrow support.
+    #[error("the total mass of {array} underflows f64 (positive, but below 5e-324)")]
+    TotalUnderflow {
+        /// Which input array.
+        array: &'static str,
+    },
     /// The normalised density is too large for an `f64` (a huge value on a tiny segment).
     #[error("the normalised density of {array} overflows f64 at index {index}")]
     DensityOverflow {
@@ -117,7 +124,8 @@ impl SamplingError {
             | Self::TooFewPoints { .. }
             | Self::LengthMismatch { .. }
             | Self::ZeroTotal { .. }
-            | Self::TotalOverflow { .. } => None,
+            | Self::TotalOverflow { .. }
+            | Self::TotalUnderflow { .. } => None,
         }
     }
 
@@ -134,6 +142,7 @@ impl SamplingError {
             | Self::SpanOverflow { array, .. }
             | Self::ZeroTotal { array }
             | Self::TotalOverflow { array }
+            | Self::TotalUnderflow { array }
             | Self::DensityOverflow { array, .. } => {
                 if *array == from {
                     *array = to;
@@ -163,6 +172,7 @@ impl SamplingError {
             | Self::SpanOverflow { array, .. }
             | Self::ZeroTotal { array }
             | Self::TotalOverflow { array }
+            | Self::TotalUnderflow { array }
             | Self::DensityOverflow { array, .. } => array,
             Self::LengthMismatch { second, .. } => second,
         }

@@ -109,6 +109,9 @@ impl PiecewiseConstant {
         if !integral.is_finite() {
             return Err(SamplingError::TotalOverflow { array: "values" });
         }
+        if integral == 0.0 {
+            return Err(SamplingError::TotalUnderflow { array: "values" });
+        }
         Ok(Self {
             edges: edges.to_vec(),
             values: values.to_vec(),

@@ -119,7 +119,8 @@ impl PiecewiseLinear {
     /// [`SamplingError::NaN`] / [`SamplingError::Infinite`] for `xs` or `ys`,
     /// [`SamplingError::Negative`] for `ys`, [`SamplingError::NotIncreasing`] for `xs`, each naming
     /// the index; [`SamplingError::SpanOverflow`], [`SamplingError::ZeroTotal`],
-    /// [`SamplingError::TotalOverflow`] and [`SamplingError::DensityOverflow`] for tables whose
+    /// [`SamplingError::TotalOverflow`], [`SamplingError::TotalUnderflow`] and
+    /// [`SamplingError::DensityOverflow`] for tables whose
     /// integral or normalised density cannot be represented.
     pub fn new(xs: &[f64], ys: &[f64]) -> Result<Self, SamplingError> {
         if xs.is_empty() {
@@ -211,6 +212,9 @@ impl PiecewiseLinear {
         let integral = ldexp(cdf.total(), ey + ew);
         if !integral.is_finite() {
             return Err(SamplingError::TotalOverflow { array: "ys" });
+        }
+        if integral == 0.0 {
+            return Err(SamplingError::TotalUnderflow { array: "ys" });
         }
         Ok(Self {
             xs: xs.to_vec(),
