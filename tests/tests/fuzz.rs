@@ -8,7 +8,9 @@
 //!
 //! Bounded: `SPECTRACE_FUZZ_CASES` mutants per target (default 150, what CI runs in seconds) from
 //! seed `SPECTRACE_FUZZ_SEED` (default 1). `cargo xtask fuzz --cases N --seed S` runs a longer
-//! campaign in release mode.
+//! campaign in release mode. An abort or an out-of-memory kill cannot be caught in-process:
+//! with `SPECTRACE_FUZZ_TRACE=1` every case names itself on standard error before it runs, so
+//! the last name printed is the case that killed the run.
 
 use std::panic::AssertUnwindSafe;
 use std::path::{Path, PathBuf};
@@ -308,6 +310,9 @@ fn fuzz_scene_files() {
             text = String::from_utf8_lossy(&bytes).into_owned();
         }
         let what = format!("scene case {case}");
+        if std::env::var_os("SPECTRACE_FUZZ_TRACE").is_some() {
+            eprintln!("{what}: {}", text.replace('\n', " "));
+        }
         match guarded(&what, text.as_bytes(), || exercise_scene(&text)) {
             Ok(r) => reached.push(r),
             Err(f) => failures.push(f),

@@ -91,7 +91,7 @@ impl SpectralPowerDistribution for Uniform {
 
 /// A Gaussian line (laser lines, LEDs) truncated to `[min_nm, max_nm]` and normalised over it;
 /// sampled exactly through a tabulated inverse CDF of the truncated standard normal (built by the
-/// constructor, see [`crate::inverse`]), stable down to `fwhm_nm = 1e-6` and for centres outside
+/// constructor, see the `inverse` module), stable down to `fwhm_nm = 1e-6` and for centres outside
 /// the range (as long as some mass lies inside it).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "GaussianRepr", into = "GaussianRepr")]

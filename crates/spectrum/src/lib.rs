@@ -64,7 +64,7 @@ pub use photometric::{
     PEAK_LUMINOUS_EFFICACY, lumens_per_watt, luminous_efficacy, watts_from_lumens,
 };
 pub use reflectance::{Reflectance, Transmittance};
-pub use spd::{SpectralPowerDistribution, integrate_panels};
+pub use spd::{MAX_NM_PANELS, SpectralPowerDistribution, integrate_panels};
 pub use tabulated::{Binned, Tabulated};
 
 /// Clamps a uniform variate into `[0, 1)`; out-of-range or NaN `u` is a caller bug (debug

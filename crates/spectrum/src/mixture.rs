@@ -30,7 +30,7 @@ pub struct Component {
 /// A weighted sum of spectra.
 ///
 /// Without delta lines it is sampled by its own exact inverse CDF, tabulated by the constructor
-/// (see [`crate::inverse`]; monotone in `u`, one table lookup per sample). With a delta line, or
+/// (see the `inverse` module; monotone in `u`, one table lookup per sample). With a delta line, or
 /// when that table would exceed [`MAX_TABLE_PANELS`] panels (components with hundreds of kinks),
 /// it chooses a component in proportion to its weight and samples it with the same uniform,
 /// remapped (exact in distribution, but not monotone in `u`); so it does too if some panel of the

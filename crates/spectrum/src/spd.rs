@@ -70,15 +70,31 @@ pub(crate) fn gauss_legendre(f: &dyn Fn(f64) -> f64, a: f64, b: f64) -> f64 {
     half * GL4.iter().map(|&(x, w)| w * f(mid + half * x)).sum::<f64>()
 }
 
-/// Integrates `f` over `[min, max]` on panels split at every integer nm and at `extra` points.
+/// Most panels of one nm [`integrate_panels`] makes; a wider range is split into this many equal
+/// panels instead (8 MiB of points), so that a spectrum over 1e300 nm costs bounded memory and
+/// time instead of one panel per nm.
+pub const MAX_NM_PANELS: usize = 1 << 20;
+
+/// Integrates `f` over `[min, max]` on panels split at every integer nm (or, over more than
+/// [`MAX_NM_PANELS`] nm, at that many equal steps) and at `extra` points.
 pub fn integrate_panels(f: &dyn Fn(f64) -> f64, min: f64, max: f64, extra: &[f64]) -> f64 {
     if !(min < max) {
         return 0.0;
     }
     let mut points: Vec<f64> = extra.iter().copied().filter(|&x| x > min && x < max).collect();
     let first = min.floor() + 1.0;
-    let count = (max.ceil() - first).max(0.0) as usize;
-    points.extend((0..count).map(|k| first + k as f64).filter(|&x| x > min && x < max));
+    let span = (max.ceil() - first).max(0.0);
+    if span <= MAX_NM_PANELS as f64 {
+        let count = span as usize;
+        points.extend((0..count).map(|k| first + k as f64).filter(|&x| x > min && x < max));
+    } else {
+        // Steps of max/n - min/n, which stay finite where max - min would overflow.
+        let n = MAX_NM_PANELS as f64;
+        let step = max / n - min / n;
+        points.extend(
+            (1..MAX_NM_PANELS).map(|k| min + k as f64 * step).filter(|&x| x > min && x < max),
+        );
+    }
     points.push(min);
     points.push(max);
     points.sort_by(f64::total_cmp);
@@ -103,6 +119,18 @@ mod tests {
         let v = gauss_legendre(&|x: f64| x.powi(7) + 3.0 * x.powi(6) - x, 0.0, 2.0);
         let exact = 2f64.powi(8) / 8.0 + 3.0 * 2f64.powi(7) / 7.0 - 2.0;
         assert!((v - exact).abs() < 1e-12, "{v} vs {exact}");
+    }
+
+    #[test]
+    fn a_huge_range_is_integrated_in_bounded_panels() {
+        // One panel per nm would be 1e300 panels: bounded instead, and still right for a
+        // constant and for a function that lives in the first nanometres.
+        let v = integrate_panels(&|_| 1.0, 490.0, 1e300, &[]);
+        assert!((v / 1e300 - 1.0).abs() < 1e-12, "{v}");
+        let w = integrate_panels(&|_| 2.0, -1e300, 1e300, &[]);
+        assert!((w / 4e300 - 1.0).abs() < 1e-12, "{w}");
+        let narrow = integrate_panels(&|x| if x < 500.0 { 1.0 } else { 0.0 }, 490.0, 1e9, &[500.0]);
+        assert!((narrow - 10.0).abs() < 1e-9, "{narrow}");
     }
 
     #[test]
