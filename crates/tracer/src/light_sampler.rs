@@ -110,12 +110,6 @@ impl PowerLightSampler {
         }
     }
 
-    /// The admitted lights' spectrum at `lambda`: `sum_k pmf(k) spd_k(lambda)` (`O(n)`).
-    pub fn density_at(&self, lambda: f64) -> f64 {
-        let Some(choice) = &self.choice else { return 0.0 };
-        (0..self.ids.len()).map(|k| self.weight_given(choice, k, lambda)).sum()
-    }
-
     /// Chooses a light with probability [`pmf_given`](Self::pmf_given) from `u`: `O(1)` where
     /// the lights share one spectrum, a scan of the lights' spectra at `lambda` otherwise.
     pub fn sample_given(&self, u: f64, lambda: f64) -> Option<SampledLight> {
@@ -223,10 +217,9 @@ mod tests {
         // At 420 nm only lights 0 (1 W over 100 nm) and 2 (0.5 W over 300 nm) emit.
         let (w0, w2) = (1.0 / 100.0, 0.5 / 300.0);
         let expected = [w0 / (w0 + w2), 0.0, w2 / (w0 + w2)];
-        let density = sampler.density_at(420.0);
+        // The set's own spectrum is the mixture sum_k pmf(k) spd_k: the density `pmf_given` takes.
+        let density = LightSource::spd(&lights).value(420.0);
         assert!((density - (w0 + w2) / 4.5).abs() < 1e-15);
-        // The set's own spectrum is the same mixture.
-        assert!((LightSource::spd(&lights).value(420.0) - density).abs() < 1e-15);
         for (i, e) in expected.iter().enumerate() {
             let pmf = sampler.pmf_given(LightId(i as u32), 420.0, density);
             assert!((pmf - e).abs() < 1e-12, "light {i}");
@@ -243,6 +236,9 @@ mod tests {
         }
         // Where no light emits there is nothing to choose.
         assert!(sampler.sample_given(0.5, 800.0).is_none());
-        assert_eq!(sampler.pmf_given(LightId(1), 800.0, sampler.density_at(800.0)), 0.0);
+        assert_eq!(
+            sampler.pmf_given(LightId(1), 800.0, LightSource::spd(&lights).value(800.0)),
+            0.0
+        );
     }
 }

@@ -81,10 +81,18 @@ impl SampleLayout {
         if on { [uniform(rng), uniform(rng)] } else { [0.5; 2] }
     }
 
-    /// A point on the lens: two uniforms for a thin lens, none for a pinhole.
+    /// A point on the lens for a light path's connection: two uniforms for a thin lens, none
+    /// for a pinhole.
     #[inline]
     pub(crate) fn lens(&self, rng: &mut dyn rand::Rng) -> [f64; 2] {
         Self::pair(self.lens, rng)
+    }
+
+    /// A point on the lens for a camera path's own connection to the camera (its point lights
+    /// seen directly): two uniforms for a thin lens, none for a pinhole.
+    #[inline]
+    pub(crate) fn camera_lens(&self, rng: &mut dyn rand::Rng) -> [f64; 2] {
+        Self::pair(self.camera_lens, rng)
     }
 }
 
@@ -152,7 +160,7 @@ impl CameraSamples {
     #[inline]
     pub(crate) fn draw(layout: &SampleLayout, rng: &mut dyn rand::Rng) -> Self {
         let film = [uniform(rng), uniform(rng)];
-        let lens = SampleLayout::pair(layout.camera_lens, rng);
+        let lens = layout.camera_lens(rng);
         Self { film, lens, wavelength: uniform(rng) }
     }
 }

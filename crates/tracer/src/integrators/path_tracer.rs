@@ -380,10 +380,9 @@ impl<'a> PathTracer<'a> {
     ) {
         let scene = self.scene;
         let inv_y = 1.0 / *spectrace_spectrum::CIE_Y_INTEGRAL;
-        // One lens point per light and pass, as a light path's vertex draws it.
-        let lens = SampleLayout { lens: self.layout.camera_lens, ..SampleLayout::default() };
         for &id in scene.delta_lights() {
-            let u_lens = lens.lens(rng);
+            // One lens point per light and pass.
+            let u_lens = self.layout.camera_lens(rng);
             let (Some(light), Some(spd)) = (scene.lights.light(id), scene.light_spd(id)) else {
                 continue;
             };
