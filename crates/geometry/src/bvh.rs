@@ -1,5 +1,18 @@
-//! The BVH the world traverses: `obvhs`'s `Bvh2` converted into a compact array of nodes that
-//! each hold both children's f32 boxes, traversed front to back with a conservative f32 slab test.
+//! The BVH the world traverses: `obvhs`'s `Bvh2` collapsed into a wide tree whose nodes hold the
+//! f32 boxes of up to eight children side by side, so that one node test checks all eight boxes
+//! at once in SIMD lanes (`wide::f32x8`), with the same conservative slab test in every lane; the
+//! children a ray meets are visited nearest first.
+//!
+//! # The wide tree
+//!
+//! Each wide node stands for one `Bvh2` subtree cut at up to eight children: starting from the
+//! subtree's root, the inner child of largest surface area is replaced by its two children until
+//! there are eight or only leaves remain (the greedy collapse of Embree's BVH8 and of the CWBVH
+//! literature; it keeps `obvhs`'s SAH-optimised splits and leaves). Boxes are stored as structure
+//! of arrays (six rows of eight f32: the lower x, y, z and upper x, y, z of every child), so the
+//! per-ray choice of entry and exit planes (by the sign of the direction) is a choice of rows,
+//! not a per-node shuffle. Unused lanes hold an empty box (`+inf` lower, `-inf` upper), which no
+//! ray enters.
 //!
 //! # Why the f32 test never loses a hit
 //!
@@ -35,13 +48,17 @@
 //! [`F32_SAFE`] (the f32 subtraction could overflow) and a ray whose origin lies beyond it or is
 //! not finite.
 
-use glam::{BVec3A, DVec3, Vec3A, Vec4};
+use glam::{BVec3A, DVec3, Vec3A};
 use obvhs::bvh2::Bvh2;
+use wide::{CmpGt, CmpLe, CmpLt, f32x8};
 
 use crate::Bounds;
 
 /// Marks a child reference as a leaf (the low bits are then its first primitive slot).
 const LEAF: u32 = 1 << 31;
+
+/// Children per wide node (the SIMD width of the node test).
+pub(crate) const WIDTH: usize = 8;
 
 /// The largest coordinate (box or ray origin, absolute) the f32 slab test handles; beyond it the
 /// traversal runs in f64. Differences of two such values cannot overflow f32.
@@ -53,61 +70,62 @@ const GAMMA3_F32: f32 = 3.0 * (f32::EPSILON * 0.5) / (1.0 - 3.0 * (f32::EPSILON 
 /// The factor applied to exits and `t_max` in the f32 test.
 const WIDEN: f32 = 1.0 + 4.0 * GAMMA3_F32;
 
-/// One inner node, one cache line: the boxes of its two children, with the references to them
-/// in the otherwise unused fourth lanes (as f32 bit patterns).
-///
-/// `b[0]` = child 0's lower corner (w: child 0's reference), `b[1]` = its upper corner (w: child
-/// 1's reference), `b[2]`, `b[3]` = child 1's corners (w of `b[2]`: the two leaf counts, child 0
-/// in the low 16 bits). A reference is an inner node index, or `LEAF | first slot`.
+/// One wide node: the boxes of up to [`WIDTH`] children as six SIMD rows (lower x, y, z, then
+/// upper x, y, z), each child's reference (an inner node index, or `LEAF | first slot`) and its
+/// leaf primitive count (0 for inner children and unused lanes).
 #[derive(Debug, Clone, Copy)]
 #[repr(C, align(64))]
 pub(crate) struct Node {
-    b: [Vec4; 4],
+    planes: [f32x8; 6],
+    child: [u32; WIDTH],
+    count: [u16; WIDTH],
 }
 
 impl Node {
-    /// A node whose children are both empty leaves with empty boxes (placeholder).
+    /// A node whose lanes are all empty (empty boxes, empty leaves).
     fn empty() -> Self {
-        Self::new([Vec3A::INFINITY; 2], [Vec3A::NEG_INFINITY; 2], [LEAF; 2], [0; 2])
+        let lo = f32x8::splat(f32::INFINITY);
+        let hi = f32x8::splat(f32::NEG_INFINITY);
+        Self { planes: [lo, lo, lo, hi, hi, hi], child: [LEAF; WIDTH], count: [0; WIDTH] }
     }
 
-    /// Packs two children.
-    fn new(min: [Vec3A; 2], max: [Vec3A; 2], child: [u32; 2], count: [u16; 2]) -> Self {
-        let lane = |v: Vec3A, w: u32| Vec4::new(v.x, v.y, v.z, f32::from_bits(w));
-        let counts = count[0] as u32 | (count[1] as u32) << 16;
-        Self {
-            b: [
-                lane(min[0], child[0]),
-                lane(max[0], child[1]),
-                lane(min[1], counts),
-                lane(max[1], 0),
-            ],
+    /// Sets lane `lane` to a child with box `[min, max]`.
+    fn set(&mut self, lane: usize, min: Vec3A, max: Vec3A, child: u32, count: u16) {
+        for (axis, (lo, hi)) in min.to_array().into_iter().zip(max.to_array()).enumerate() {
+            self.planes[axis].as_array_mut()[lane] = lo;
+            self.planes[axis + 3].as_array_mut()[lane] = hi;
         }
+        self.child[lane] = child;
+        self.count[lane] = count;
     }
 
-    /// Child `c`'s lower corner.
-    #[inline(always)]
-    fn min(&self, c: usize) -> Vec3A {
-        Vec3A::from_vec4(self.b[2 * c])
-    }
-
-    /// Child `c`'s upper corner.
-    #[inline(always)]
-    fn max(&self, c: usize) -> Vec3A {
-        Vec3A::from_vec4(self.b[2 * c + 1])
-    }
-
-    /// Child `c`'s reference and leaf primitive count.
-    #[inline(always)]
-    fn child(&self, c: usize) -> (u32, u32) {
-        let child = self.b[c].w.to_bits();
-        let count = (self.b[2].w.to_bits() >> (16 * c)) & 0xffff;
-        (child, count)
+    /// Child `lane`'s box.
+    fn bounds(&self, lane: usize) -> (Vec3A, Vec3A) {
+        let row = |r: usize| self.planes[r].as_array_ref()[lane];
+        (Vec3A::new(row(0), row(1), row(2)), Vec3A::new(row(3), row(4), row(5)))
     }
 }
 
-/// The converted BVH. Node 0 is a pseudo-root whose first child is the real root (so a root that
-/// is a leaf needs no special case) and whose second child is an empty leaf with an empty box.
+/// The `obvhs` nodes that become the children of one wide node: starting from `root`, the inner
+/// node of largest surface area is replaced by its two children until there are [`WIDTH`] or
+/// only leaves.
+fn collapse(bvh: &Bvh2, root: usize) -> Vec<usize> {
+    let mut children = vec![root];
+    while children.len() < WIDTH {
+        let area = |&&i: &&usize| bvh.nodes[i].aabb().half_area();
+        let widest = children
+            .iter()
+            .filter(|&&i| !bvh.nodes[i].is_leaf())
+            .max_by(|a, b| area(a).total_cmp(&area(b)));
+        let Some(&i) = widest else { break };
+        let first = bvh.nodes[i].first_index as usize;
+        children.retain(|&c| c != i);
+        children.extend([first, first + 1]);
+    }
+    children
+}
+
+/// The wide BVH. Node 0 is the root (a root that is a leaf becomes a node with one child).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Bvh {
     nodes: Vec<Node>,
@@ -118,45 +136,37 @@ pub(crate) struct Bvh {
 }
 
 impl Bvh {
-    /// Converts `bvh`, whose boxes are relative to `center` (its primitive slots are
-    /// `bvh.primitive_indices`' positions).
+    /// Collapses `bvh`, whose boxes are relative to `center` (its primitive slots are
+    /// `bvh.primitive_indices`' positions), into wide nodes.
     pub(crate) fn from_bvh2(bvh: &Bvh2, center: DVec3) -> Self {
         if bvh.nodes.is_empty() {
             return Self::default();
         }
         let mut nodes = vec![Node::empty()];
-        let mut work: Vec<(usize, usize)> = Vec::new();
+        let mut work: Vec<(usize, usize)> = vec![(0, 0)];
         let mut wide = false;
-        // The reference, count and box of obvhs node `i`, queueing it if it is an inner node.
-        let mut child = |nodes: &mut Vec<Node>, work: &mut Vec<(usize, usize)>, i: usize| {
-            let n = &bvh.nodes[i];
-            let a = n.aabb();
-            let too_big = |v: Vec3A| !(v.abs().max_element() <= F32_SAFE);
-            wide |= too_big(a.min) || too_big(a.max);
-            if n.is_leaf() {
-                // obvhs leaves hold at most `max_prims_per_leaf` (<= 255) primitives.
-                let count = u16::try_from(n.prim_count).unwrap_or(u16::MAX);
-                (LEAF | n.first_index, count, a.min, a.max)
-            } else {
-                let index = nodes.len();
-                nodes.push(Node::empty());
-                work.push((i, index));
-                (index as u32, 0, a.min, a.max)
+        let too_big = |v: Vec3A| !(v.abs().max_element() <= F32_SAFE);
+        while let Some((root, k)) = work.pop() {
+            for (lane, i) in collapse(bvh, root).into_iter().enumerate() {
+                let n = &bvh.nodes[i];
+                let a = n.aabb();
+                wide |= too_big(a.min) || too_big(a.max);
+                if n.is_leaf() {
+                    // obvhs leaves hold at most `max_prims_per_leaf` (<= 255) primitives.
+                    let count = u16::try_from(n.prim_count).unwrap_or(u16::MAX);
+                    nodes[k].set(lane, a.min, a.max, LEAF | n.first_index, count);
+                } else {
+                    let index = nodes.len();
+                    nodes.push(Node::empty());
+                    work.push((i, index));
+                    nodes[k].set(lane, a.min, a.max, index as u32, 0);
+                }
             }
-        };
-        let (c0, n0, lo0, hi0) = child(&mut nodes, &mut work, 0);
-        nodes[0] =
-            Node::new([lo0, Vec3A::INFINITY], [hi0, Vec3A::NEG_INFINITY], [c0, LEAF], [n0, 0]);
-        while let Some((i, k)) = work.pop() {
-            let first = bvh.nodes[i].first_index as usize;
-            let (c0, n0, lo0, hi0) = child(&mut nodes, &mut work, first);
-            let (c1, n1, lo1, hi1) = child(&mut nodes, &mut work, first + 1);
-            nodes[k] = Node::new([lo0, lo1], [hi0, hi1], [c0, c1], [n0, n1]);
         }
         Self { nodes, center, wide }
     }
 
-    /// Number of nodes (each with two children).
+    /// Number of wide nodes.
     pub(crate) fn node_count(&self) -> usize {
         self.nodes.len()
     }
@@ -184,7 +194,8 @@ impl Bvh {
         self.walk(&mut slab, t_max, on_prim);
     }
 
-    /// The traversal loop, generic over the box test.
+    /// The traversal loop, generic over the box test: the children a node's test accepts are
+    /// pushed farthest first, so the nearest is popped next.
     #[inline]
     fn walk<S: Slab>(
         &self,
@@ -196,57 +207,60 @@ impl Bvh {
         let mut node = 0usize;
         loop {
             let n = &self.nodes[node];
-            let [h0, h1] = slab.test(n);
-            let mut next = match (h0, h1) {
-                (Some(a), Some(b)) => {
-                    let (near, far, far_t) = if b < a { (1, 0, a) } else { (0, 1, b) };
-                    let (child, count) = n.child(far);
-                    stack.push((child, count, far_t));
-                    Some(n.child(near))
+            let (mask, near) = slab.test(n);
+            if mask != 0 && mask & (mask - 1) == 0 {
+                // One child met (the common case): visit it without touching the stack.
+                let lane = mask.trailing_zeros() as usize;
+                let child = n.child[lane];
+                if child & LEAF == 0 {
+                    node = child as usize;
+                    continue;
                 }
-                (Some(_), None) => Some(n.child(0)),
-                (None, Some(_)) => Some(n.child(1)),
-                (None, None) => None,
-            };
+                stack.push((child, n.count[lane], near[lane]));
+            } else if mask != 0 {
+                let mut hits = [(0, 0, S::T::default()); WIDTH];
+                let mut len = 0;
+                let mut bits = mask;
+                while bits != 0 {
+                    let lane = bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    hits[len] = (n.child[lane], n.count[lane], near[lane]);
+                    len += 1;
+                }
+                stack.push_sorted(&mut hits[..len]);
+            }
             loop {
-                match next {
-                    Some((child, _)) if child & LEAF == 0 => {
-                        node = child as usize;
-                        break;
-                    }
-                    Some((child, count)) => {
-                        let first = child & !LEAF;
-                        for slot in first..first + count {
-                            match on_prim(slot, t_max) {
-                                Some(t) if t < 0.0 => return,
-                                Some(t) => {
-                                    t_max = t;
-                                    slab.set_limit(t);
-                                }
-                                None => {}
-                            }
+                let Some((child, count, near)) = stack.pop() else { return };
+                if !slab.alive(near) {
+                    continue;
+                }
+                if child & LEAF == 0 {
+                    node = child as usize;
+                    break;
+                }
+                let first = child & !LEAF;
+                for slot in first..first + u32::from(count) {
+                    match on_prim(slot, t_max) {
+                        Some(t) if t < 0.0 => return,
+                        Some(t) => {
+                            t_max = t;
+                            slab.set_limit(t);
                         }
-                        next = None;
+                        None => {}
                     }
-                    None => loop {
-                        let Some((child, count, near)) = stack.pop() else { return };
-                        if slab.alive(near) {
-                            next = Some((child, count));
-                            break;
-                        }
-                    },
                 }
             }
         }
     }
 }
 
-/// A ray/box test for both children of a node.
+/// A ray/box test for all children of a wide node.
 trait Slab {
     /// The entry distance type (for ordering and culling).
     type T: Copy + PartialOrd + Default;
-    /// The entry distances of the children the ray may meet within the current limit.
-    fn test(&self, node: &Node) -> [Option<Self::T>; 2];
+    /// The lanes (bit `i` for child `i`) the ray may meet within the current limit, and every
+    /// lane's entry distance.
+    fn test(&self, node: &Node) -> (u32, [Self::T; WIDTH]);
     /// A closer hit was found at `t_max`.
     fn set_limit(&mut self, t_max: f64);
     /// Whether a child entered at `near` (as `test` returned it) may still hold a closer hit.
@@ -271,20 +285,23 @@ fn f32_up(x: f64) -> f32 {
     if f64::from(f) < x { f.next_up() } else { f }
 }
 
-/// The conservative f32 slab test (see the module documentation).
+/// The conservative f32 slab test (see the module documentation), on all lanes of a node.
 struct SlabF32 {
-    /// Per axis: the ray direction is negative (sign bit set, so `-0` counts).
-    negative: BVec3A,
+    /// Per axis: the row of the entry plane (lower for a positive direction, upper for a
+    /// negative one: the sign bit decides, so `-0` counts as negative).
+    near_row: [usize; 3],
+    /// Per axis: the row of the exit plane.
+    far_row: [usize; 3],
     /// The origin bound used for entries (`o_hi` for positive axes, `o_lo` for negative).
-    o_near: Vec3A,
+    o_near: [f32x8; 3],
     /// The origin bound used for exits.
-    o_far: Vec3A,
+    o_far: [f32x8; 3],
     /// `1/D` rounded towards zero in magnitude.
-    inv_near: Vec3A,
+    inv_near: [f32x8; 3],
     /// `1/D` rounded away from zero in magnitude.
-    inv_far: Vec3A,
+    inv_far: [f32x8; 3],
     /// `t_max` rounded up, widened, plus `MIN_POSITIVE`.
-    t_max: f32,
+    t_max: f32x8,
 }
 
 impl SlabF32 {
@@ -326,58 +343,77 @@ impl SlabF32 {
             )
         };
         let signs = Vec3A::select(negative, Vec3A::NEG_ONE, Vec3A::ONE);
-        let inv_near = inv_lo * signs;
-        let inv_far = inv_hi * signs;
+        let lanes = |v: Vec3A| v.to_array().map(f32x8::splat);
+        let neg = d.map(|x| usize::from(x.is_sign_negative()));
         let mut s = Self {
-            negative,
-            o_near: Vec3A::select(negative, o_lo, o_hi),
-            o_far: Vec3A::select(negative, o_hi, o_lo),
-            inv_near,
-            inv_far,
-            t_max: 0.0,
+            near_row: [0, 1, 2].map(|a| a + 3 * neg[a]),
+            far_row: [0, 1, 2].map(|a| a + 3 * (1 - neg[a])),
+            o_near: lanes(Vec3A::select(negative, o_lo, o_hi)),
+            o_far: lanes(Vec3A::select(negative, o_hi, o_lo)),
+            inv_near: lanes(inv_lo * signs),
+            inv_far: lanes(inv_hi * signs),
+            t_max: f32x8::ZERO,
         };
         s.set_limit(t_max);
         Some(s)
-    }
-
-    /// The entry distance of one child box, if the ray may meet it within `t_max`.
-    #[inline(always)]
-    fn child(&self, min: Vec3A, max: Vec3A) -> Option<f32> {
-        let near_plane = Vec3A::select(self.negative, max, min);
-        let far_plane = Vec3A::select(self.negative, min, max);
-        let near = (near_plane - self.o_near) * self.inv_near;
-        let far = (far_plane - self.o_far) * self.inv_far;
-        // NaN lanes (and negative entries) become 0; NaN exits become +inf: only wider.
-        let near = Vec3A::select(near.cmpgt(Vec3A::ZERO), near, Vec3A::ZERO);
-        let far = Vec3A::select(far.cmplt(Vec3A::INFINITY), far, Vec3A::INFINITY);
-        let t0 = near.max_element();
-        let t1 = far.min_element() * WIDEN + f32::MIN_POSITIVE;
-        let t1 = if t1 < self.t_max { t1 } else { self.t_max };
-        if t0 <= t1 { Some(t0) } else { None }
     }
 }
 
 impl Slab for SlabF32 {
     type T = f32;
 
+    /// Per lane: entry `max(0, entries)` and exit `min(exits) * WIDEN + MIN_POSITIVE`, capped by
+    /// `t_max`; NaN entries count as 0 and NaN exits as `+inf` (only wider).
     #[inline(always)]
-    fn test(&self, node: &Node) -> [Option<f32>; 2] {
-        [self.child(node.min(0), node.max(0)), self.child(node.min(1), node.max(1))]
+    fn test(&self, node: &Node) -> (u32, [f32; WIDTH]) {
+        let mut t0 = f32x8::ZERO;
+        let mut t1 = f32x8::splat(f32::INFINITY);
+        for a in 0..3 {
+            let near = (node.planes[self.near_row[a]] - self.o_near[a]) * self.inv_near[a];
+            let far = (node.planes[self.far_row[a]] - self.o_far[a]) * self.inv_far[a];
+            t0 = max_keeping(near, t0);
+            t1 = min_keeping(far, t1);
+        }
+        let t1 = t1 * f32x8::splat(WIDEN) + f32x8::splat(f32::MIN_POSITIVE);
+        let t1 = t1.cmp_lt(self.t_max).blend(t1, self.t_max);
+        (t0.cmp_le(t1).move_mask() as u32, t0.to_array())
     }
 
     #[inline]
     fn set_limit(&mut self, t_max: f64) {
-        self.t_max = f32_up(t_max) * WIDEN + f32::MIN_POSITIVE;
+        self.t_max = f32x8::splat(f32_up(t_max) * WIDEN + f32::MIN_POSITIVE);
     }
 
     #[inline(always)]
     fn alive(&self, near: f32) -> bool {
-        near <= self.t_max
+        near <= self.t_max.as_array_ref()[0]
+    }
+}
+
+/// Lane-wise `max(x, keep)`, taking `keep` where `x` is NaN (`keep` is never NaN). On x86 this
+/// is one `maxps`, whose result is its second operand when either is NaN (Intel SDM, MAXPS).
+#[inline(always)]
+fn max_keeping(x: f32x8, keep: f32x8) -> f32x8 {
+    if cfg!(any(target_arch = "x86", target_arch = "x86_64")) {
+        x.fast_max(keep)
+    } else {
+        x.cmp_gt(keep).blend(x, keep)
+    }
+}
+
+/// Lane-wise `min(x, keep)`, taking `keep` where `x` is NaN (`keep` is never NaN): one `minps`
+/// on x86, as [`max_keeping`].
+#[inline(always)]
+fn min_keeping(x: f32x8, keep: f32x8) -> f32x8 {
+    if cfg!(any(target_arch = "x86", target_arch = "x86_64")) {
+        x.fast_min(keep)
+    } else {
+        x.cmp_lt(keep).blend(x, keep)
     }
 }
 
 /// pbrt's conservative slab test in f64 on exact f64 copies of the f32 boxes (the fallback for
-/// huge coordinates).
+/// huge coordinates), one lane at a time.
 struct SlabF64 {
     origin: DVec3,
     center: DVec3,
@@ -392,8 +428,11 @@ impl SlabF64 {
     }
 
     /// The entry distance of one child box (moved back to world coordinates, rounded outwards),
-    /// if the ray may meet it within `t_max`.
+    /// if the ray may meet it within `t_max`; `None` for an empty lane.
     fn child(&self, min: Vec3A, max: Vec3A) -> Option<f64> {
+        if !min.cmple(max).all() {
+            return None;
+        }
         let (lo, hi) = (min.as_dvec3() + self.center, max.as_dvec3() + self.center);
         let b = Bounds {
             min: DVec3::new(lo.x.next_down(), lo.y.next_down(), lo.z.next_down()),
@@ -406,8 +445,17 @@ impl SlabF64 {
 impl Slab for SlabF64 {
     type T = f64;
 
-    fn test(&self, node: &Node) -> [Option<f64>; 2] {
-        [self.child(node.min(0), node.max(0)), self.child(node.min(1), node.max(1))]
+    fn test(&self, node: &Node) -> (u32, [f64; WIDTH]) {
+        let mut mask = 0;
+        let mut near = [0.0; WIDTH];
+        for (lane, t) in near.iter_mut().enumerate() {
+            let (min, max) = node.bounds(lane);
+            if let Some(t0) = self.child(min, max) {
+                *t = t0;
+                mask |= 1 << lane;
+            }
+        }
+        (mask, near)
     }
 
     fn set_limit(&mut self, t_max: f64) {
@@ -422,19 +470,19 @@ impl Slab for SlabF64 {
 /// The traversal stack of `(child, count, entry distance)`: a fixed array on the call stack,
 /// spilling to the heap only for trees deeper than it (so a ray costs no allocation).
 struct Stack<T> {
-    inline: [(u32, u32, T); 32],
+    inline: [(u32, u16, T); 48],
     len: usize,
-    spill: Vec<(u32, u32, T)>,
+    spill: Vec<(u32, u16, T)>,
 }
 
-impl<T: Copy + Default> Stack<T> {
+impl<T: Copy + Default + PartialOrd> Stack<T> {
     #[inline(always)]
     fn new() -> Self {
-        Self { inline: [(0, 0, T::default()); 32], len: 0, spill: Vec::new() }
+        Self { inline: [(0, 0, T::default()); 48], len: 0, spill: Vec::new() }
     }
 
     #[inline(always)]
-    fn push(&mut self, entry: (u32, u32, T)) {
+    fn push(&mut self, entry: (u32, u16, T)) {
         if self.len < self.inline.len() {
             self.inline[self.len] = entry;
             self.len += 1;
@@ -444,7 +492,7 @@ impl<T: Copy + Default> Stack<T> {
     }
 
     #[inline(always)]
-    fn pop(&mut self) -> Option<(u32, u32, T)> {
+    fn pop(&mut self) -> Option<(u32, u16, T)> {
         if let Some(entry) = self.spill.pop() {
             return Some(entry);
         }
@@ -453,6 +501,22 @@ impl<T: Copy + Default> Stack<T> {
         }
         self.len -= 1;
         Some(self.inline[self.len])
+    }
+
+    /// Pushes `entries` (at most [`WIDTH`]) so that the nearest is on top: sorted by entry
+    /// distance, farthest first.
+    #[inline(always)]
+    fn push_sorted(&mut self, entries: &mut [(u32, u16, T)]) {
+        for i in 1..entries.len() {
+            let mut j = i;
+            while j > 0 && entries[j - 1].2 < entries[j].2 {
+                entries.swap(j - 1, j);
+                j -= 1;
+            }
+        }
+        for &e in entries.iter() {
+            self.push(e);
+        }
     }
 }
 
@@ -476,15 +540,22 @@ mod tests {
         let origin = DVec3::new(1e6 + 0.01, 5.0, 0.0);
         let x = (1e6_f32 + 0.0625) as f64; // the next f32 above 1e6
         assert!(x > origin.x);
-        let node = Node::new(
-            [Vec3A::new(1e6, 0.0, -1.0), Vec3A::INFINITY],
-            [Vec3A::new(x as f32, 1.0, 1.0), Vec3A::NEG_INFINITY],
-            [LEAF; 2],
-            [1, 0],
-        );
+        let mut node = Node::empty();
+        node.set(3, Vec3A::new(1e6, 0.0, -1.0), Vec3A::new(x as f32, 1.0, 1.0), LEAF, 1);
         let slab = SlabF32::new(origin, DVec3::new(0.0, -1.0, 0.0), f64::INFINITY).unwrap();
-        let [a, b] = slab.test(&node);
-        assert!(a.is_some_and(|t| t <= 4.0), "{a:?}");
-        assert!(b.is_none());
+        let (mask, near) = slab.test(&node);
+        assert_eq!(mask, 1 << 3, "only the box's lane is entered");
+        assert!(near[3] <= 4.0, "{near:?}");
+    }
+
+    #[test]
+    fn empty_lanes_are_never_entered_by_either_test() {
+        let node = Node::empty();
+        for d in [DVec3::X, -DVec3::X, DVec3::new(0.0, -0.0, 1.0), DVec3::new(1e-300, 1.0, -1.0)] {
+            let slab = SlabF32::new(DVec3::ZERO, d, f64::INFINITY).unwrap();
+            assert_eq!(slab.test(&node).0, 0, "{d}");
+            let slab = SlabF64::new(DVec3::ZERO, DVec3::ZERO, d, f64::INFINITY);
+            assert_eq!(slab.test(&node).0, 0, "{d}");
+        }
     }
 }

@@ -422,6 +422,7 @@ pub(crate) fn intersect_triangle(p: [DVec3; 3], ray: &Ray, t_max: f64) -> Option
 /// per-triangle work, with exactly the arithmetic of the single-triangle test.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct TriangleRay {
+    /// The origin, permuted (`[o[kx], o[ky], o[kz]]`).
     origin: [f64; 3],
     kx: usize,
     ky: usize,
@@ -447,8 +448,9 @@ impl TriangleRay {
         let kx = (kz + 1) % 3;
         let ky = (kx + 1) % 3;
         let d = d.to_array();
+        let o = ray.origin.to_array();
         let (dx, dy, dz) = (d[kx], d[ky], d[kz]);
-        Self { origin: ray.origin.to_array(), kx, ky, kz, sx: -dx / dz, sy: -dy / dz, sz: 1.0 / dz }
+        Self { origin: [o[kx], o[ky], o[kz]], kx, ky, kz, sx: -dx / dz, sy: -dy / dz, sz: 1.0 / dz }
     }
 
     /// The watertight test against the triangle `p` (world-space vertices): `(t, [b0, b1, b2])`
@@ -456,10 +458,11 @@ impl TriangleRay {
     #[inline]
     pub(crate) fn intersect(&self, p: &[[f64; 3]; 3], t_max: f64) -> Option<(f64, [f64; 3])> {
         let (o, kx, ky, kz) = (&self.origin, self.kx.min(2), self.ky.min(2), self.kz.min(2));
-        let mut q = p.map(|v| [v[kx] - o[kx], v[ky] - o[ky], v[kz] - o[kz]]);
-        for v in &mut q {
-            v[0] += self.sx * v[2];
-            v[1] += self.sy * v[2];
+        let mut q = [[0.0; 3]; 3];
+        for (q, v) in q.iter_mut().zip(p) {
+            *q = [v[kx] - o[0], v[ky] - o[1], v[kz] - o[2]];
+            q[0] += self.sx * q[2];
+            q[1] += self.sy * q[2];
         }
         let e0 = q[1][0] * q[2][1] - q[1][1] * q[2][0];
         let e1 = q[2][0] * q[0][1] - q[2][1] * q[0][0];
@@ -529,8 +532,20 @@ impl Primitives for Mesh {
 
     fn intersect(&self, index: u32, ray: &Ray, t_max: f64) -> Option<Hit> {
         let d = self.data.as_ref()?;
-        let (tri, p) = Self::vertices(d, index);
+        let p = Self::vertices(d, index).1;
         let (t, b) = intersect_triangle(p, ray, t_max)?;
+        self.hit_at(index, p, t, b)
+    }
+}
+
+impl Mesh {
+    /// The full hit on triangle `index` (vertices `p`) at distance `t` and barycentrics `b`, as
+    /// the watertight test found them (so [`Primitives::intersect`] and a BVH that ran the test
+    /// on its own copy of the vertices build the same hit); `None` for a triangle with a
+    /// zero-length normal. The vertex indices are read only for normals and texture coordinates.
+    pub(crate) fn hit_at(&self, index: u32, p: [DVec3; 3], t: f64, b: [f64; 3]) -> Option<Hit> {
+        let d = self.data.as_ref()?;
+        let tri = || d.triangles[index as usize];
         let n = (p[1] - p[0]).cross(p[2] - p[0]);
         let len = n.length();
         if !(len > 0.0) {
@@ -544,6 +559,7 @@ impl Primitives for Mesh {
             .normals
             .as_ref()
             .map(|ns| {
+                let tri = tri();
                 let s = (ns[tri[0] as usize] * b[0]
                     + ns[tri[1] as usize] * b[1]
                     + ns[tri[2] as usize] * b[2])
@@ -558,6 +574,7 @@ impl Primitives for Mesh {
             })
             .unwrap_or(n);
         let uv = d.uvs.as_ref().map_or(DVec2::new(b[1], b[2]), |uvs| {
+            let tri = tri();
             uvs[tri[0] as usize] * b[0] + uvs[tri[1] as usize] * b[1] + uvs[tri[2] as usize] * b[2]
         });
         Some(Hit {

@@ -18,8 +18,9 @@ use crate::{Bounds, GeometryError, Hit, Ray, Shape};
 enum Best {
     /// None yet.
     None,
-    /// A triangle slot and the `t_max` that accepted it (its hit is built at the end).
-    Triangle(u32, f64),
+    /// A triangle slot with the distance and barycentrics its test found (its hit is built at
+    /// the end).
+    Triangle(u32, f64, [f64; 3]),
     /// An analytic shape's full hit.
     Hit(Hit),
 }
@@ -209,19 +210,22 @@ impl World {
         }
     }
 
-    /// The full hit of the slot's primitive, with the world's indices filled in.
-    fn slot_hit(&self, slot: u32, ray: &Ray, t_max: f64) -> Option<Hit> {
+    /// The full hit of a triangle slot at the distance and barycentrics its test found, with
+    /// the world's indices filled in.
+    fn triangle_hit(&self, slot: u32, t: f64, b: [f64; 3]) -> Option<Hit> {
         let s = self.slots[slot as usize];
-        let mut hit = self.shapes[s.shape as usize].primitives().intersect(s.index, ray, t_max)?;
+        let p = s.vertices.map(DVec3::from_array);
+        let mut hit = self.shapes[s.shape as usize].triangle_mesh()?.hit_at(s.index, p, t, b)?;
         hit.primitive = s.shape;
         Some(hit)
     }
 
     /// The nearest hit with `0 < t < t_max`, or `None`.
     ///
-    /// Triangle candidates only compute `t` (with the ray's permutation and shear set up once);
-    /// the full [`Hit`] of a winning triangle is built once, by the same routine and `t_max` that
-    /// accepted it, so it is the hit a primitive-by-primitive search reports. An analytic shape
+    /// Triangle candidates run only the watertight test (with the ray's permutation and shear set
+    /// up once); the full [`Hit`] of the winning triangle is built once, from the distance and
+    /// barycentrics that test found: the same test on the same vertices as the mesh's own
+    /// routine, so it is the hit a primitive-by-primitive search reports. An analytic shape
     /// that is closer than the best so far returns its full hit directly (rather than solving
     /// its quadratic or quartic a second time for the winner: scenes hold few of them).
     ///
@@ -234,8 +238,8 @@ impl World {
             let s = &self.slots[slot as usize];
             match s.kind {
                 SlotKind::Triangle => {
-                    let (t, _) = triangle_ray.as_ref()?.intersect(&s.vertices, limit)?;
-                    best = Best::Triangle(slot, limit);
+                    let (t, b) = triangle_ray.as_ref()?.intersect(&s.vertices, limit)?;
+                    best = Best::Triangle(slot, t, b);
                     Some(t)
                 }
                 SlotKind::Analytic => {
@@ -251,7 +255,7 @@ impl World {
         match best {
             Best::None => None,
             Best::Hit(hit) => Some(hit),
-            Best::Triangle(slot, limit) => self.slot_hit(slot, ray, limit),
+            Best::Triangle(slot, t, b) => self.triangle_hit(slot, t, b),
         }
     }
 
