@@ -54,7 +54,7 @@ use wide::{CmpGt, CmpLe, CmpLt, f32x8};
 
 use crate::Bounds;
 
-/// Marks a child reference as a leaf (the low bits are then its first primitive slot).
+/// Marks a child reference as a leaf (the low bits are then its leaf index).
 const LEAF: u32 = 1 << 31;
 
 /// Children per wide node (the SIMD width of the node test).
@@ -71,14 +71,13 @@ const GAMMA3_F32: f32 = 3.0 * (f32::EPSILON * 0.5) / (1.0 - 3.0 * (f32::EPSILON 
 const WIDEN: f32 = 1.0 + 4.0 * GAMMA3_F32;
 
 /// One wide node: the boxes of up to [`WIDTH`] children as six SIMD rows (lower x, y, z, then
-/// upper x, y, z), each child's reference (an inner node index, or `LEAF | first slot`) and its
-/// leaf primitive count (0 for inner children and unused lanes).
+/// upper x, y, z) and each child's reference (an inner node index, or `LEAF | leaf index`; an
+/// unused lane refers to no leaf, its box being empty).
 #[derive(Debug, Clone, Copy)]
 #[repr(C, align(64))]
 pub(crate) struct Node {
     planes: [f32x8; 6],
     child: [u32; WIDTH],
-    count: [u16; WIDTH],
 }
 
 impl Node {
@@ -86,17 +85,16 @@ impl Node {
     fn empty() -> Self {
         let lo = f32x8::splat(f32::INFINITY);
         let hi = f32x8::splat(f32::NEG_INFINITY);
-        Self { planes: [lo, lo, lo, hi, hi, hi], child: [LEAF; WIDTH], count: [0; WIDTH] }
+        Self { planes: [lo, lo, lo, hi, hi, hi], child: [LEAF; WIDTH] }
     }
 
     /// Sets lane `lane` to a child with box `[min, max]`.
-    fn set(&mut self, lane: usize, min: Vec3A, max: Vec3A, child: u32, count: u16) {
+    fn set(&mut self, lane: usize, min: Vec3A, max: Vec3A, child: u32) {
         for (axis, (lo, hi)) in min.to_array().into_iter().zip(max.to_array()).enumerate() {
             self.planes[axis].as_array_mut()[lane] = lo;
             self.planes[axis + 3].as_array_mut()[lane] = hi;
         }
         self.child[lane] = child;
-        self.count[lane] = count;
     }
 
     /// Child `lane`'s box.
@@ -125,6 +123,15 @@ fn collapse(bvh: &Bvh2, root: usize) -> Vec<usize> {
     children
 }
 
+/// One leaf of the tree: a run of primitive slots (`obvhs`'s `primitive_indices` positions).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Leaf {
+    /// The first slot.
+    pub(crate) first: u32,
+    /// The number of slots.
+    pub(crate) count: u32,
+}
+
 /// The wide BVH. Node 0 is the root (a root that is a leaf becomes a node with one child).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Bvh {
@@ -137,10 +144,12 @@ pub(crate) struct Bvh {
 
 impl Bvh {
     /// Collapses `bvh`, whose boxes are relative to `center` (its primitive slots are
-    /// `bvh.primitive_indices`' positions), into wide nodes.
-    pub(crate) fn from_bvh2(bvh: &Bvh2, center: DVec3) -> Self {
+    /// `bvh.primitive_indices`' positions), into wide nodes; and its leaves, numbered as the
+    /// traversal reports them.
+    pub(crate) fn from_bvh2(bvh: &Bvh2, center: DVec3) -> (Self, Vec<Leaf>) {
+        let mut leaves = Vec::new();
         if bvh.nodes.is_empty() {
-            return Self::default();
+            return (Self::default(), leaves);
         }
         let mut nodes = vec![Node::empty()];
         let mut work: Vec<(usize, usize)> = vec![(0, 0)];
@@ -152,18 +161,19 @@ impl Bvh {
                 let a = n.aabb();
                 wide |= too_big(a.min) || too_big(a.max);
                 if n.is_leaf() {
-                    // obvhs leaves hold at most `max_prims_per_leaf` (<= 255) primitives.
-                    let count = u16::try_from(n.prim_count).unwrap_or(u16::MAX);
-                    nodes[k].set(lane, a.min, a.max, LEAF | n.first_index, count);
+                    // Fewer leaves than primitives (< 2^31, checked by `World::new`).
+                    let leaf = leaves.len() as u32;
+                    leaves.push(Leaf { first: n.first_index, count: n.prim_count });
+                    nodes[k].set(lane, a.min, a.max, LEAF | leaf);
                 } else {
                     let index = nodes.len();
                     nodes.push(Node::empty());
                     work.push((i, index));
-                    nodes[k].set(lane, a.min, a.max, index as u32, 0);
+                    nodes[k].set(lane, a.min, a.max, index as u32);
                 }
             }
         }
-        Self { nodes, center, wide }
+        (Self { nodes, center, wide }, leaves)
     }
 
     /// Number of wide nodes.
@@ -171,16 +181,16 @@ impl Bvh {
         self.nodes.len()
     }
 
-    /// Calls `on_prim(slot, t_max)` for every primitive slot whose leaf box the ray may meet
-    /// within the current `t_max`, nearest boxes first. `on_prim` returns `None` (no hit), the
-    /// new `t_max` (a closer hit), or a negative value to stop.
+    /// Calls `on_leaf(leaf, t_max)` for every leaf whose box the ray may meet within the current
+    /// `t_max`, nearest boxes first. `on_leaf` returns `None` (no closer hit), the new `t_max`
+    /// (a closer hit), or a negative value to stop.
     #[inline]
     pub(crate) fn traverse(
         &self,
         origin: DVec3,
         direction: DVec3,
         t_max: f64,
-        on_prim: impl FnMut(u32, f64) -> Option<f64>,
+        on_leaf: impl FnMut(u32, f64) -> Option<f64>,
     ) {
         if self.nodes.is_empty() || !(t_max > 0.0) {
             return;
@@ -188,10 +198,10 @@ impl Bvh {
         if !self.wide
             && let Some(mut slab) = SlabF32::new(origin - self.center, direction, t_max)
         {
-            return self.walk(&mut slab, t_max, on_prim);
+            return self.walk(&mut slab, t_max, on_leaf);
         }
         let mut slab = SlabF64::new(origin, self.center, direction, t_max);
-        self.walk(&mut slab, t_max, on_prim);
+        self.walk(&mut slab, t_max, on_leaf);
     }
 
     /// The traversal loop, generic over the box test: the children a node's test accepts are
@@ -201,7 +211,7 @@ impl Bvh {
         &self,
         slab: &mut S,
         mut t_max: f64,
-        mut on_prim: impl FnMut(u32, f64) -> Option<f64>,
+        mut on_leaf: impl FnMut(u32, f64) -> Option<f64>,
     ) {
         let mut stack = Stack::<S::T>::new();
         let mut node = 0usize;
@@ -216,21 +226,21 @@ impl Bvh {
                     node = child as usize;
                     continue;
                 }
-                stack.push((child, n.count[lane], near[lane]));
+                stack.push((child, near[lane]));
             } else if mask != 0 {
-                let mut hits = [(0, 0, S::T::default()); WIDTH];
+                let mut hits = [(0, S::T::default()); WIDTH];
                 let mut len = 0;
                 let mut bits = mask;
                 while bits != 0 {
                     let lane = bits.trailing_zeros() as usize;
                     bits &= bits - 1;
-                    hits[len] = (n.child[lane], n.count[lane], near[lane]);
+                    hits[len] = (n.child[lane], near[lane]);
                     len += 1;
                 }
                 stack.push_sorted(&mut hits[..len]);
             }
             loop {
-                let Some((child, count, near)) = stack.pop() else { return };
+                let Some((child, near)) = stack.pop() else { return };
                 if !slab.alive(near) {
                     continue;
                 }
@@ -238,16 +248,13 @@ impl Bvh {
                     node = child as usize;
                     break;
                 }
-                let first = child & !LEAF;
-                for slot in first..first + u32::from(count) {
-                    match on_prim(slot, t_max) {
-                        Some(t) if t < 0.0 => return,
-                        Some(t) => {
-                            t_max = t;
-                            slab.set_limit(t);
-                        }
-                        None => {}
+                match on_leaf(child & !LEAF, t_max) {
+                    Some(t) if t < 0.0 => return,
+                    Some(t) => {
+                        t_max = t;
+                        slab.set_limit(t);
                     }
+                    None => {}
                 }
             }
         }
@@ -467,22 +474,22 @@ impl Slab for SlabF64 {
     }
 }
 
-/// The traversal stack of `(child, count, entry distance)`: a fixed array on the call stack,
+/// The traversal stack of `(child, entry distance)`: a fixed array on the call stack,
 /// spilling to the heap only for trees deeper than it (so a ray costs no allocation).
 struct Stack<T> {
-    inline: [(u32, u16, T); 48],
+    inline: [(u32, T); 48],
     len: usize,
-    spill: Vec<(u32, u16, T)>,
+    spill: Vec<(u32, T)>,
 }
 
 impl<T: Copy + Default + PartialOrd> Stack<T> {
     #[inline(always)]
     fn new() -> Self {
-        Self { inline: [(0, 0, T::default()); 48], len: 0, spill: Vec::new() }
+        Self { inline: [(0, T::default()); 48], len: 0, spill: Vec::new() }
     }
 
     #[inline(always)]
-    fn push(&mut self, entry: (u32, u16, T)) {
+    fn push(&mut self, entry: (u32, T)) {
         if self.len < self.inline.len() {
             self.inline[self.len] = entry;
             self.len += 1;
@@ -492,7 +499,7 @@ impl<T: Copy + Default + PartialOrd> Stack<T> {
     }
 
     #[inline(always)]
-    fn pop(&mut self) -> Option<(u32, u16, T)> {
+    fn pop(&mut self) -> Option<(u32, T)> {
         if let Some(entry) = self.spill.pop() {
             return Some(entry);
         }
@@ -506,10 +513,10 @@ impl<T: Copy + Default + PartialOrd> Stack<T> {
     /// Pushes `entries` (at most [`WIDTH`]) so that the nearest is on top: sorted by entry
     /// distance, farthest first.
     #[inline(always)]
-    fn push_sorted(&mut self, entries: &mut [(u32, u16, T)]) {
+    fn push_sorted(&mut self, entries: &mut [(u32, T)]) {
         for i in 1..entries.len() {
             let mut j = i;
-            while j > 0 && entries[j - 1].2 < entries[j].2 {
+            while j > 0 && entries[j - 1].1 < entries[j].1 {
                 entries.swap(j - 1, j);
                 j -= 1;
             }
@@ -541,7 +548,7 @@ mod tests {
         let x = (1e6_f32 + 0.0625) as f64; // the next f32 above 1e6
         assert!(x > origin.x);
         let mut node = Node::empty();
-        node.set(3, Vec3A::new(1e6, 0.0, -1.0), Vec3A::new(x as f32, 1.0, 1.0), LEAF, 1);
+        node.set(3, Vec3A::new(1e6, 0.0, -1.0), Vec3A::new(x as f32, 1.0, 1.0), LEAF);
         let slab = SlabF32::new(origin, DVec3::new(0.0, -1.0, 0.0), f64::INFINITY).unwrap();
         let (mask, near) = slab.test(&node);
         assert_eq!(mask, 1 << 3, "only the box's lane is entered");

@@ -33,6 +33,7 @@ mod cylinder;
 mod disk;
 mod error;
 mod float;
+mod leaves;
 mod mesh;
 mod prism;
 mod ray;

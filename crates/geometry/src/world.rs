@@ -11,41 +11,8 @@ use obvhs::bvh2::Bvh2;
 use obvhs::bvh2::builder::build_bvh2;
 
 use crate::bvh::Bvh;
-use crate::mesh::TriangleRay;
+use crate::leaves::{Leaves, Nearest};
 use crate::{Bounds, GeometryError, Hit, Ray, Shape};
-
-/// The nearest candidate so far in [`World::intersect`].
-enum Best {
-    /// None yet.
-    None,
-    /// A triangle slot with the distance and barycentrics its test found (its hit is built at
-    /// the end).
-    Triangle(u32, f64, [f64; 3]),
-    /// An analytic shape's full hit.
-    Hit(Hit),
-}
-
-/// What a BVH primitive slot holds, so the per-candidate test is an enum match.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum SlotKind {
-    /// A mesh triangle: the watertight test on the slot's copied vertices.
-    Triangle,
-    /// A triangle that no ray hits (its normal has zero length, which `Mesh` refuses).
-    Never,
-    /// A whole analytic shape: its `t`-only routine.
-    Analytic,
-}
-
-/// One BVH primitive slot (in BVH leaf order): a whole analytic shape or one mesh triangle, with
-/// the triangle's world-space vertices copied in (zeros otherwise), so a leaf's primitives are
-/// contiguous and a candidate costs no further lookup.
-#[derive(Debug, Clone, Copy)]
-struct Slot {
-    vertices: [[f64; 3]; 3],
-    shape: u32,
-    index: u32,
-    kind: SlotKind,
-}
 
 /// The build settings of the BVH: `obvhs`'s medium-quality PLOC build with leaves of at most
 /// `MAX_PRIMS_PER_LEAF` primitives.
@@ -78,10 +45,8 @@ fn conservative_aabb(b: Bounds, center: DVec3) -> Aabb {
 #[derive(Clone)]
 pub struct World {
     shapes: Vec<Shape>,
-    /// Primitive slots in BVH leaf order.
-    slots: Vec<Slot>,
-    /// Some slot is a triangle (else the per-ray triangle setup is skipped).
-    has_triangles: bool,
+    /// The primitives of the BVH's leaves.
+    leaves: Leaves,
     bvh2: Bvh2,
     bvh: Bvh,
     bounds: Bounds,
@@ -91,7 +56,7 @@ impl std::fmt::Debug for World {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("World")
             .field("shapes", &self.shapes.len())
-            .field("primitives", &self.slots.len())
+            .field("primitives", &self.leaves.slot_count())
             .field("bvh_nodes", &self.bvh.node_count())
             .field("bounds", &self.bounds)
             .finish()
@@ -141,21 +106,9 @@ impl World {
         } else {
             build_bvh2(&aabbs, build_params(), &mut Duration::default())
         };
-        let bvh = Bvh::from_bvh2(&bvh2, center);
-        let mut slots = Vec::with_capacity(prims.len());
-        for &p in &bvh2.primitive_indices {
-            let (shape, index) = prims[p as usize];
-            let (kind, vertices) = match shapes[shape as usize].triangle_mesh() {
-                Some(mesh) => match mesh.triangle(index) {
-                    Some((v, true)) => (SlotKind::Triangle, v),
-                    _ => (SlotKind::Never, [[0.0; 3]; 3]),
-                },
-                None => (SlotKind::Analytic, [[0.0; 3]; 3]),
-            };
-            slots.push(Slot { vertices, shape, index, kind });
-        }
-        let has_triangles = slots.iter().any(|s| s.kind == SlotKind::Triangle);
-        Ok(Self { shapes, slots, has_triangles, bvh2, bvh, bounds })
+        let (bvh, leaves) = Bvh::from_bvh2(&bvh2, center);
+        let leaves = Leaves::new(&shapes, &prims, &bvh2.primitive_indices, &leaves);
+        Ok(Self { shapes, leaves, bvh2, bvh, bounds })
     }
 
     /// Loads every OBJ mesh relative to `base_dir` (the scene file's directory), then builds.
@@ -176,7 +129,7 @@ impl World {
 
     /// Number of BVH primitives (triangles count one each).
     pub fn primitive_count(&self) -> usize {
-        self.slots.len()
+        self.leaves.slot_count()
     }
 
     /// The box around all shapes (empty for an empty world).
@@ -191,83 +144,35 @@ impl World {
         &self.bvh2
     }
 
-    /// The `t` of the slot's primitive in `(0, t_max)`, without building a [`Hit`].
-    #[inline(always)]
-    fn slot_t(
-        &self,
-        slot: u32,
-        ray: &Ray,
-        triangle_ray: &Option<TriangleRay>,
-        t_max: f64,
-    ) -> Option<f64> {
-        let s = &self.slots[slot as usize];
-        match s.kind {
-            SlotKind::Triangle => {
-                triangle_ray.as_ref()?.intersect(&s.vertices, t_max).map(|(t, _)| t)
-            }
-            SlotKind::Analytic => self.shapes[s.shape as usize].hit_t(s.index, ray, t_max),
-            SlotKind::Never => None,
-        }
-    }
-
-    /// The full hit of a triangle slot at the distance and barycentrics its test found, with
-    /// the world's indices filled in.
-    fn triangle_hit(&self, slot: u32, t: f64, b: [f64; 3]) -> Option<Hit> {
-        let s = self.slots[slot as usize];
-        let p = s.vertices.map(DVec3::from_array);
-        let mut hit = self.shapes[s.shape as usize].triangle_mesh()?.hit_at(s.index, p, t, b)?;
-        hit.primitive = s.shape;
-        Some(hit)
-    }
-
     /// The nearest hit with `0 < t < t_max`, or `None`.
     ///
-    /// Triangle candidates run only the watertight test (with the ray's permutation and shear set
-    /// up once); the full [`Hit`] of the winning triangle is built once, from the distance and
-    /// barycentrics that test found: the same test on the same vertices as the mesh's own
-    /// routine, so it is the hit a primitive-by-primitive search reports. An analytic shape
+    /// A leaf's triangles are filtered four at a time by the first half of the watertight test
+    /// in SIMD (with the ray's permutation and shear set up once), and the survivors run the
+    /// whole scalar test; the full [`Hit`] of the winning triangle is built once, from the
+    /// distance and barycentrics that test found: the same test on the same vertices as the
+    /// mesh's own routine, so it is the hit a primitive-by-primitive search reports. An analytic shape
     /// that is closer than the best so far returns its full hit directly (rather than solving
     /// its quadratic or quartic a second time for the winner: scenes hold few of them).
     ///
     /// # Performance
     /// `O(log n)` box tests per ray on typical scenes, in f32 (conservative); primitives in f64.
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<Hit> {
-        let triangle_ray = self.has_triangles.then(|| TriangleRay::new(ray));
-        let mut best = Best::None;
-        self.bvh.traverse(ray.origin, ray.direction, t_max, |slot, limit| {
-            let s = &self.slots[slot as usize];
-            match s.kind {
-                SlotKind::Triangle => {
-                    let (t, b) = triangle_ray.as_ref()?.intersect(&s.vertices, limit)?;
-                    best = Best::Triangle(slot, t, b);
-                    Some(t)
-                }
-                SlotKind::Analytic => {
-                    let shape = &self.shapes[s.shape as usize];
-                    let mut hit = shape.primitives().intersect(s.index, ray, limit)?;
-                    hit.primitive = s.shape;
-                    best = Best::Hit(hit);
-                    Some(hit.t)
-                }
-                SlotKind::Never => None,
-            }
+        let triangle_ray = self.leaves.triangle_ray(ray);
+        let mut best = Nearest::None;
+        self.bvh.traverse(ray.origin, ray.direction, t_max, |leaf, limit| {
+            self.leaves.nearest(leaf, &self.shapes, ray, triangle_ray.as_ref(), limit, &mut best)
         });
-        match best {
-            Best::None => None,
-            Best::Hit(hit) => Some(hit),
-            Best::Triangle(slot, t, b) => self.triangle_hit(slot, t, b),
-        }
+        self.leaves.hit(best, &self.shapes)
     }
 
     /// Whether anything lies on the ray with `0 < t < t_max` (shadow rays): stops at the first
     /// primitive hit and builds no [`Hit`].
     pub fn occluded(&self, ray: &Ray, t_max: f64) -> bool {
-        let triangle_ray = self.has_triangles.then(|| TriangleRay::new(ray));
+        let triangle_ray = self.leaves.triangle_ray(ray);
         let mut hit = false;
-        self.bvh.traverse(ray.origin, ray.direction, t_max, |slot, limit| {
-            self.slot_t(slot, ray, &triangle_ray, limit)?;
-            hit = true;
-            Some(-1.0)
+        self.bvh.traverse(ray.origin, ray.direction, t_max, |leaf, limit| {
+            hit = self.leaves.any(leaf, &self.shapes, ray, triangle_ray.as_ref(), limit);
+            hit.then_some(-1.0)
         });
         hit
     }

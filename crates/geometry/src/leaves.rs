@@ -1,0 +1,247 @@
+//! The primitives behind the BVH's leaves, and the tests the traversal runs on a leaf.
+//!
+//! A primitive slot is a whole analytic shape or one mesh triangle, in BVH leaf order. Each leaf
+//! also keeps its triangles' world-space vertices as SIMD lanes ([`Triangles4`], four slots per
+//! packet), so the traversal filters all of a leaf's triangles with one
+//! [`TriangleRay::candidates4`] and runs the scalar watertight test only on the lanes that pass.
+//! The filter is the scalar test's first half with the same arithmetic in every lane, so it
+//! never drops a triangle the scalar test accepts, and every reported hit comes from the scalar
+//! test: results are those of a primitive-by-primitive search.
+
+use glam::DVec3;
+use wide::f64x4;
+
+use crate::bvh::Leaf;
+use crate::mesh::{TriangleRay, Triangles4};
+use crate::{Hit, Ray, Shape};
+
+/// Lanes per triangle packet.
+const LANES: usize = 4;
+
+/// What a primitive slot holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SlotKind {
+    /// A mesh triangle, tested in its leaf's packet lane.
+    Triangle,
+    /// A triangle that no ray hits (its normal has zero length, which `Mesh` refuses).
+    Never,
+    /// A whole analytic shape: its own routine.
+    Analytic,
+}
+
+/// One primitive slot: the shape and its primitive index.
+#[derive(Debug, Clone, Copy)]
+struct Slot {
+    shape: u32,
+    index: u32,
+    kind: SlotKind,
+}
+
+/// One leaf: its slots `first..first + count`, its first packet (one per four slots) and
+/// whether it holds any analytic shape.
+#[derive(Debug, Clone, Copy)]
+struct LeafRecord {
+    first: u32,
+    count: u32,
+    packet: u32,
+    analytic: bool,
+}
+
+/// The nearest candidate so far of a closest-hit query.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Nearest {
+    /// None yet.
+    None,
+    /// A triangle slot, its vertices, and the distance and barycentrics its test found (the
+    /// full hit is built once, at the end).
+    Triangle { slot: u32, vertices: [DVec3; 3], t: f64, b: [f64; 3] },
+    /// An analytic shape's full hit.
+    Hit(Hit),
+}
+
+/// All slots and leaves of a world's BVH.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Leaves {
+    slots: Vec<Slot>,
+    leaves: Vec<LeafRecord>,
+    packets: Vec<Triangles4>,
+    has_triangles: bool,
+}
+
+impl Leaves {
+    /// The slots of `prims` (`(shape, primitive)` pairs) in the BVH's leaf order `order`
+    /// (`obvhs`'s `primitive_indices`), and the packets of `leaves`.
+    pub(crate) fn new(
+        shapes: &[Shape],
+        prims: &[(u32, u32)],
+        order: &[u32],
+        leaves: &[Leaf],
+    ) -> Self {
+        let mut vertices = Vec::with_capacity(order.len());
+        let mut slots = Vec::with_capacity(order.len());
+        for &p in order {
+            let (shape, index) = prims[p as usize];
+            let (kind, v) = match shapes[shape as usize].triangle_mesh() {
+                Some(mesh) => match mesh.triangle(index) {
+                    Some((v, true)) => (SlotKind::Triangle, v),
+                    _ => (SlotKind::Never, [[0.0; 3]; 3]),
+                },
+                None => (SlotKind::Analytic, [[0.0; 3]; 3]),
+            };
+            slots.push(Slot { shape, index, kind });
+            vertices.push(v);
+        }
+        let mut packets = Vec::new();
+        let records = leaves
+            .iter()
+            .map(|leaf| {
+                let range = leaf.first as usize..(leaf.first + leaf.count) as usize;
+                let packet = packets.len() as u32;
+                for chunk in range.clone().collect::<Vec<_>>().chunks(LANES) {
+                    packets.push(packet_of(chunk.iter().map(|&s| (slots[s].kind, vertices[s]))));
+                }
+                let analytic = slots[range].iter().any(|s| s.kind == SlotKind::Analytic);
+                LeafRecord { first: leaf.first, count: leaf.count, packet, analytic }
+            })
+            .collect();
+        let has_triangles = slots.iter().any(|s| s.kind == SlotKind::Triangle);
+        Self { slots, leaves: records, packets, has_triangles }
+    }
+
+    /// Number of primitive slots.
+    pub(crate) fn slot_count(&self) -> usize {
+        self.slots.len()
+    }
+
+    /// The per-ray triangle setup, if any slot is a triangle.
+    #[inline]
+    pub(crate) fn triangle_ray(&self, ray: &Ray) -> Option<TriangleRay> {
+        self.has_triangles.then(|| TriangleRay::new(ray))
+    }
+
+    /// Tests every primitive of `leaf` closer than `limit`, recording the nearest in `best`;
+    /// the new limit if one was closer.
+    #[inline]
+    pub(crate) fn nearest(
+        &self,
+        leaf: u32,
+        shapes: &[Shape],
+        ray: &Ray,
+        triangle_ray: Option<&TriangleRay>,
+        mut limit: f64,
+        best: &mut Nearest,
+    ) -> Option<f64> {
+        let record = self.leaves[leaf as usize];
+        let mut closer = None;
+        if let Some(tr) = triangle_ray {
+            for (k, packet) in self.packets_of(record).iter().enumerate() {
+                let mut lanes = tr.candidates4(packet, limit);
+                while lanes != 0 {
+                    let lane = lanes.trailing_zeros() as usize;
+                    lanes &= lanes - 1;
+                    let vertices = lane_vertices(packet, lane);
+                    let Some((t, b)) = tr.intersect(&vertices.map(|v| v.to_array()), limit) else {
+                        continue;
+                    };
+                    let slot = record.first + (k * LANES + lane) as u32;
+                    *best = Nearest::Triangle { slot, vertices, t, b };
+                    limit = t;
+                    closer = Some(t);
+                }
+            }
+        }
+        if record.analytic {
+            for slot in self.analytic_slots(record) {
+                let shape = &shapes[slot.shape as usize];
+                if let Some(mut hit) = shape.primitives().intersect(slot.index, ray, limit) {
+                    hit.primitive = slot.shape;
+                    *best = Nearest::Hit(hit);
+                    limit = hit.t;
+                    closer = Some(hit.t);
+                }
+            }
+        }
+        closer
+    }
+
+    /// Whether any primitive of `leaf` lies on the ray with `0 < t < limit`.
+    #[inline]
+    pub(crate) fn any(
+        &self,
+        leaf: u32,
+        shapes: &[Shape],
+        ray: &Ray,
+        triangle_ray: Option<&TriangleRay>,
+        limit: f64,
+    ) -> bool {
+        let record = self.leaves[leaf as usize];
+        if let Some(tr) = triangle_ray {
+            for packet in self.packets_of(record) {
+                let mut lanes = tr.candidates4(packet, limit);
+                while lanes != 0 {
+                    let lane = lanes.trailing_zeros() as usize;
+                    lanes &= lanes - 1;
+                    let vertices = lane_vertices(packet, lane).map(|v| v.to_array());
+                    if tr.intersect(&vertices, limit).is_some() {
+                        return true;
+                    }
+                }
+            }
+        }
+        record.analytic
+            && self
+                .analytic_slots(record)
+                .any(|slot| shapes[slot.shape as usize].hit_t(slot.index, ray, limit).is_some())
+    }
+
+    /// The full hit of the nearest candidate, with the world's indices filled in.
+    pub(crate) fn hit(&self, nearest: Nearest, shapes: &[Shape]) -> Option<Hit> {
+        match nearest {
+            Nearest::None => None,
+            Nearest::Hit(hit) => Some(hit),
+            Nearest::Triangle { slot, vertices, t, b } => {
+                let s = self.slots[slot as usize];
+                let mesh = shapes[s.shape as usize].triangle_mesh()?;
+                let mut hit = mesh.hit_at(s.index, vertices, t, b)?;
+                hit.primitive = s.shape;
+                Some(hit)
+            }
+        }
+    }
+
+    /// The packets of a leaf's slots.
+    #[inline(always)]
+    fn packets_of(&self, record: LeafRecord) -> &[Triangles4] {
+        let n = (record.count as usize).div_ceil(LANES);
+        &self.packets[record.packet as usize..record.packet as usize + n]
+    }
+
+    /// The analytic slots of a leaf.
+    fn analytic_slots(&self, record: LeafRecord) -> impl Iterator<Item = &Slot> {
+        let range = record.first as usize..(record.first + record.count) as usize;
+        self.slots[range].iter().filter(|s| s.kind == SlotKind::Analytic)
+    }
+}
+
+/// A packet of up to four slots: triangles' vertices in their lanes, zeros (which
+/// [`TriangleRay::candidates4`] rejects) for other slots and unused lanes.
+fn packet_of(slots: impl Iterator<Item = (SlotKind, [[f64; 3]; 3])>) -> Triangles4 {
+    let mut lanes = [[[0.0; LANES]; 3]; 3];
+    for (lane, (kind, v)) in slots.enumerate() {
+        if kind == SlotKind::Triangle {
+            for (vertex, p) in v.iter().enumerate() {
+                for axis in 0..3 {
+                    lanes[vertex][axis][lane] = p[axis];
+                }
+            }
+        }
+    }
+    lanes.map(|v| v.map(f64x4::from))
+}
+
+/// The vertices in lane `lane` of a packet.
+#[inline(always)]
+fn lane_vertices(packet: &Triangles4, lane: usize) -> [DVec3; 3] {
+    let c = |vertex: usize, axis: usize| packet[vertex][axis].as_array_ref()[lane];
+    [0, 1, 2].map(|v| DVec3::new(c(v, 0), c(v, 1), c(v, 2)))
+}
