@@ -19,6 +19,9 @@ TITLES = {
 }
 README_BEGIN = "<!-- peer:begin (written by cargo xtask peer) -->"
 README_END = "<!-- peer:end -->"
+# The geometry comparison's section of docs/peer.md (written by geometry.py), kept on a rewrite.
+GEOMETRY_BEGIN = "<!-- geometry:begin (written by cargo xtask peer --geometry) -->"
+GEOMETRY_END = "<!-- geometry:end -->"
 
 
 def time_to(points, target):
@@ -218,6 +221,17 @@ def targets_text(report):
     return "\n".join(lines)
 
 
+def kept_geometry_section(path):
+    """The geometry comparison's block (markers included) of the docs/peer.md at `path`, or ""."""
+    try:
+        with open(path) as f:
+            text = f.read()
+    except OSError:
+        return ""
+    found = re.search(re.escape(GEOMETRY_BEGIN) + ".*?" + re.escape(GEOMETRY_END), text, flags=re.S)
+    return found.group(0) if found else ""
+
+
 def write(report, root, method_path=None):
     docs = os.path.join(root, "docs")
     with open(os.path.join(docs, "peer.svg"), "w") as f:
@@ -250,7 +264,11 @@ def write(report, root, method_path=None):
                 )
         parts.append("Ladders:\n\n" + "\n".join(pts) + "\n")
     parts.append(method)
-    with open(os.path.join(docs, "peer.md"), "w") as f:
+    path = os.path.join(docs, "peer.md")
+    geometry = kept_geometry_section(path)
+    if geometry:
+        parts.append(geometry + "\n")
+    with open(path, "w") as f:
         f.write("\n".join(parts))
     readme = os.path.join(root, "README.md")
     with open(readme) as f:

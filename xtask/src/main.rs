@@ -26,6 +26,11 @@
 //!   and a libLLVM of version 16 or newer. Never run by CI.
 //! - `cargo xtask peer --materials [options]`: the materials cross-check against Mitsuba 3
 //!   (`docs/materials-peer.md`, `xtask/peer/materials.py`), with the same prerequisites.
+//! - `cargo xtask peer --geometry [--rays N] [--reps K] [--cpu C] [--no-docs]`: the geometry
+//!   benchmark beside Embree 4 (`docs/peer.md`, `xtask/peer/geometry.py`): closest-hit and shadow
+//!   rays/s of Spectrace and of Embree (`embreex`, pinned, in the same virtual environment) on the
+//!   same mesh and rays, both on one pinned core, and their ratio. Needs python3 with venv and pip
+//!   and network access for the first install; no libLLVM. Never run by CI.
 
 use std::process::{Command, ExitCode};
 
@@ -156,17 +161,20 @@ fn accuracy(args: &[String]) -> ExitCode {
     run_binary_in(LAB, &command, Some(&workspace_root()))
 }
 
-/// A binary of the workspace that the xtask builds and runs: its package and name.
+/// A binary of the workspace that the xtask builds and runs: its package and name, and whether
+/// it is an example (`cargo build --example`) rather than a binary target.
 struct Binary {
     package: &'static str,
     name: &'static str,
+    example: bool,
 }
 
 /// The renderer's command line.
-const SPECTRACE: Binary = Binary { package: "spectrace-renderer", name: "spectrace" };
+const SPECTRACE: Binary =
+    Binary { package: "spectrace-renderer", name: "spectrace", example: false };
 
 /// The experiment harness's command line (the accuracy report).
-const LAB: Binary = Binary { package: "spectrace-lab", name: "spectrace-lab" };
+const LAB: Binary = Binary { package: "spectrace-lab", name: "spectrace-lab", example: false };
 
 /// `cargo xtask fuzz [--cases N] [--seed S]`: the fuzz tests with N mutants per target (default
 /// 5000) from seed S (default: the time), in release mode.
@@ -250,7 +258,8 @@ fn build_spectrace() -> Result<std::path::PathBuf, ExitCode> {
 /// Builds `binary` in release mode; its path, or the exit code of the failure (reported).
 fn build_release(binary: &Binary) -> Result<std::path::PathBuf, ExitCode> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
-    let args = ["build", "--release", "-p", binary.package, "--bin", binary.name];
+    let kind = if binary.example { "--example" } else { "--bin" };
+    let args = ["build", "--release", "-p", binary.package, kind, binary.name];
     eprintln!("$ cargo {}", args.join(" "));
     match Command::new(&cargo).args(args).status() {
         Ok(s) if s.success() => {}
@@ -263,11 +272,9 @@ fn build_release(binary: &Binary) -> Result<std::path::PathBuf, ExitCode> {
             return Err(ExitCode::FAILURE);
         }
     }
-    Ok(target_dir().join("release").join(format!(
-        "{}{}",
-        binary.name,
-        std::env::consts::EXE_SUFFIX
-    )))
+    let dir = target_dir().join("release");
+    let dir = if binary.example { dir.join("examples") } else { dir };
+    Ok(dir.join(format!("{}{}", binary.name, std::env::consts::EXE_SUFFIX)))
 }
 
 fn print_help() {
@@ -287,6 +294,8 @@ fn print_help() {
                   the race against Mitsuba 3 (docs/peer.md); needs python3, pip, libLLVM >= 16\n  \
          peer --materials [--spp N] [--seeds K] [--cases A,B] [--no-docs]\n           \
                   the materials cross-check against Mitsuba 3 (docs/materials-peer.md)\n  \
+         peer --geometry [--rays N] [--reps K] [--cpu C] [--no-docs]\n           \
+                  closest-hit and shadow rays/s beside Embree 4 on one core (docs/peer.md)\n  \
          bench    run every crate's benchmarks (release)\n  \
          ci       run .ci/run: rustfmt, clippy -D warnings, tests, fuzz, status\n  \
          callgrind [BINARY [OUT]]  instructions per work item of every estimator (valgrind)\n  \

@@ -1,18 +1,50 @@
-//! `cargo xtask peer`: the race against Mitsuba 3 (method and results in `docs/peer.md`), and
-//! `cargo xtask peer --materials`: the materials cross-check (`docs/materials-peer.md`).
+//! `cargo xtask peer`: the race against Mitsuba 3 (method and results in `docs/peer.md`),
+//! `cargo xtask peer --materials`: the materials cross-check (`docs/materials-peer.md`), and
+//! `cargo xtask peer --geometry`: the geometry benchmark beside Embree 4 (`docs/peer.md`).
 //!
-//! The Rust side checks the prerequisites and prepares the tools; the race itself (scene
-//! translation, renders, errors, report) is `xtask/peer/peer.py`, run in a virtual environment
-//! under the target directory (`target/peer-venv`) that holds the pinned Mitsuba. Prerequisites,
-//! each refused with a message saying what to install when missing: `python3` with its `venv`
-//! module, `pip` inside the environment, and a shared libLLVM of major version 16 or newer (the
-//! `llvm_ad_spectral` variant of Mitsuba compiles its kernels with it; Debian: `libllvm19`).
+//! The Rust side checks the prerequisites and prepares the tools; the comparison itself (scene
+//! translation, renders or ray casts, errors, report) is a Python script in `xtask/peer/`, run in a
+//! virtual environment under the target directory (`target/peer-venv`) that holds the pinned
+//! peers. Prerequisites, each refused with a message saying what to install when missing:
+//! `python3` with its `venv` module, `pip` inside the environment, and, for Mitsuba only, a shared
+//! libLLVM of major version 16 or newer (the `llvm_ad_spectral` variant of Mitsuba compiles its
+//! kernels with it; Debian: `libllvm19`). The geometry comparison needs neither libLLVM nor
+//! Mitsuba: only `embreex` (Embree 4's Python binding, with its own Embree) and numpy.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode, Stdio};
 
 /// The Mitsuba release the race is pinned to (PyPI `mitsuba`; it pins its Dr.Jit).
 pub(crate) const MITSUBA_VERSION: &str = "3.9.1";
+
+/// The `embreex` release (PyPI; Embree 4's Python binding, which ships Embree) the geometry
+/// comparison is pinned to.
+pub(crate) const EMBREEX_VERSION: &str = "4.4.0.post1";
+
+/// A Python package a peer's environment must hold: its PyPI (and import) name and the exact
+/// version it is pinned to (`None`: any).
+#[derive(Debug, PartialEq, Eq)]
+struct Pin {
+    name: &'static str,
+    version: Option<&'static str>,
+}
+
+/// What the Mitsuba jobs (the race, the materials cross-check) install.
+const MITSUBA_PINS: &[Pin] = &[
+    Pin { name: "mitsuba", version: Some(MITSUBA_VERSION) },
+    Pin { name: "numpy", version: None },
+];
+
+/// What the geometry comparison installs.
+const EMBREE_PINS: &[Pin] = &[
+    Pin { name: "embreex", version: Some(EMBREEX_VERSION) },
+    Pin { name: "numpy", version: None },
+];
+
+/// The geometry comparison's Rust side: the release example that times Spectrace's ray casts and
+/// dumps the mesh and rays for Embree.
+const RAY_RATE: crate::Binary =
+    crate::Binary { package: "spectrace-geometry", name: "ray_rate", example: true };
 
 /// The oldest libLLVM major version Dr.Jit's LLVM backend accepts.
 pub(crate) const MIN_LLVM: u32 = 16;
@@ -26,11 +58,21 @@ const LLVM_DIRS: &[&str] = &[
     "/usr/local/lib",
 ];
 
-/// Runs the race, or with `--materials` first the materials cross-check; the other `args` go to
-/// `peer.py` (see `--help` there) or `materials.py`.
+/// Runs the race; with `--materials` first the materials cross-check, with `--geometry` first
+/// the geometry comparison. The other `args` go to the job's script (`peer.py`, `materials.py`,
+/// `geometry.py`; see `--help` there).
 pub(crate) fn run(args: &[String]) -> ExitCode {
     let (job, args) = job(args);
-    match prepare().and_then(|(python, llvm, binary)| race(&job, &python, &llvm, &binary, args)) {
+    let result = match job.peer {
+        Peer::Mitsuba => prepare().and_then(|(python, llvm, binary)| {
+            let mut command = script(&job, &python, "--spectrace", &binary, args);
+            finish(&job, command.env("DRJIT_LIBLLVM_PATH", llvm))
+        }),
+        Peer::Embree => prepare_geometry().and_then(|(python, example)| {
+            finish(&job, &mut script(&job, &python, "--ray-rate", &example, args))
+        }),
+    };
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(message) => {
             eprintln!("cargo xtask peer: {message}");
@@ -39,58 +81,80 @@ pub(crate) fn run(args: &[String]) -> ExitCode {
     }
 }
 
-/// What `cargo xtask peer` runs: its script in `xtask/peer` and its work folder in the target
-/// directory.
+/// The engine a job compares Spectrace with.
+#[derive(Debug, PartialEq, Eq, Clone, Copy)]
+enum Peer {
+    /// Mitsuba 3 (needs libLLVM and the release `spectrace`).
+    Mitsuba,
+    /// Embree 4 through `embreex` (needs the release `ray_rate` example only).
+    Embree,
+}
+
+/// What `cargo xtask peer` runs: its script in `xtask/peer`, its work folder in the target
+/// directory, and the peer it needs.
 #[derive(Debug, PartialEq, Eq)]
 struct Job {
     script: &'static str,
     work: &'static str,
+    peer: Peer,
 }
 
-/// The race (`peer.py`, `target/peer`), or the materials cross-check (`materials.py`,
-/// `target/peer-materials`) when the first argument is `--materials`; and the arguments left.
+/// The race (`peer.py`, `target/peer`); the materials cross-check (`materials.py`,
+/// `target/peer-materials`) when the first argument is `--materials`; the geometry comparison
+/// (`geometry.py`, `target/peer-geometry`) when it is `--geometry`; and the arguments left.
 fn job(args: &[String]) -> (Job, &[String]) {
     match args.split_first() {
         Some((first, rest)) if first == "--materials" => {
-            (Job { script: "materials.py", work: "peer-materials" }, rest)
+            (Job { script: "materials.py", work: "peer-materials", peer: Peer::Mitsuba }, rest)
         }
-        _ => (Job { script: "peer.py", work: "peer" }, args),
+        Some((first, rest)) if first == "--geometry" => {
+            (Job { script: "geometry.py", work: "peer-geometry", peer: Peer::Embree }, rest)
+        }
+        _ => (Job { script: "peer.py", work: "peer", peer: Peer::Mitsuba }, args),
     }
 }
 
-/// Checks the prerequisites and builds what the race needs: the virtual environment's python,
-/// the libLLVM to use and the release `spectrace`.
+/// Checks the prerequisites and builds what the Mitsuba jobs need: the virtual environment's
+/// python, the libLLVM to use and the release `spectrace`.
 fn prepare() -> Result<(PathBuf, PathBuf, PathBuf), String> {
     let llvm = find_llvm()?;
     eprintln!("libLLVM: {}", llvm.display());
-    let python = venv()?;
+    let python = venv(MITSUBA_PINS)?;
     let binary = crate::build_spectrace().map_err(|_| "building spectrace failed".to_owned())?;
     Ok((python, llvm, binary))
 }
 
-/// Runs the job's script with the environment's python.
-fn race(
-    job: &Job,
-    python: &Path,
-    llvm: &Path,
-    binary: &Path,
-    args: &[String],
-) -> Result<(), String> {
+/// Checks the prerequisites and builds what the geometry comparison needs: the virtual
+/// environment's python (with `embreex`) and the release `ray_rate` example.
+fn prepare_geometry() -> Result<(PathBuf, PathBuf), String> {
+    let python = venv(EMBREE_PINS)?;
+    let example =
+        crate::build_release(&RAY_RATE).map_err(|_| "building the ray_rate example failed")?;
+    Ok((python, example))
+}
+
+/// The job's script run by the environment's python, given `binary` (as `flag`), the workspace
+/// root, its work folder, and then `args`.
+fn script(job: &Job, python: &Path, flag: &str, binary: &Path, args: &[String]) -> Command {
     let root = crate::workspace_root();
-    let script = root.join("xtask").join("peer").join(job.script);
-    let work = absolute(&crate::target_dir().join(job.work));
-    let status = Command::new(python)
-        .arg(&script)
-        .arg("--spectrace")
+    let mut command = Command::new(python);
+    command
+        .arg(root.join("xtask").join("peer").join(job.script))
+        .arg(flag)
         .arg(absolute(binary))
         .arg("--root")
         .arg(&root)
         .arg("--work")
-        .arg(&work)
-        .args(args)
-        .env("DRJIT_LIBLLVM_PATH", llvm)
+        .arg(absolute(&crate::target_dir().join(job.work)))
+        .args(args);
+    command
+}
+
+/// Runs the job's script; an error naming it when it cannot be started or fails.
+fn finish(job: &Job, command: &mut Command) -> Result<(), String> {
+    let status = command
         .status()
-        .map_err(|e| format!("could not run {}: {e}", python.display()))?;
+        .map_err(|e| format!("could not run {}: {e}", command.get_program().to_string_lossy()))?;
     if status.success() { Ok(()) } else { Err(format!("{} failed ({status})", job.script)) }
 }
 
@@ -165,15 +229,15 @@ pub(crate) fn llvm_major(name: &str) -> Option<u32> {
     version.parse().ok()
 }
 
-/// The virtual environment's python, created under the target directory and given the pinned
-/// Mitsuba (and numpy) on first use.
-fn venv() -> Result<PathBuf, String> {
+/// The virtual environment's python, created under the target directory on first use and given
+/// the `pins` it lacks (one environment serves every job: Mitsuba and `embreex` live side by side).
+fn venv(pins: &[Pin]) -> Result<PathBuf, String> {
     let python3 = std::env::var("PYTHON").unwrap_or_else(|_| "python3".to_owned());
     match Command::new(&python3).arg("--version").stdout(Stdio::null()).status() {
         Ok(s) if s.success() => {}
         _ => {
             return Err(format!(
-                "`{python3}` not found: the race needs Python 3 (3.8 or newer) with venv and \
+                "`{python3}` not found: `cargo xtask peer` needs Python 3 (3.8 or newer) with venv and \
                  pip, e.g. `apt-get install python3 python3-venv python3-pip` (or set PYTHON)"
             ));
         }
@@ -199,44 +263,96 @@ fn venv() -> Result<PathBuf, String> {
             dir.display()
         ));
     }
-    let check =
-        format!("import mitsuba, numpy, sys; sys.exit(mitsuba.__version__ != '{MITSUBA_VERSION}')");
     let installed = Command::new(&python)
-        .args(["-c", &check])
+        .args(["-c", &install_check(pins)])
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .status();
     if !matches!(installed, Ok(s) if s.success()) {
-        let pin = format!("mitsuba=={MITSUBA_VERSION}");
-        eprintln!("$ {} -m pip install {pin} numpy", python.display());
-        let ok = Command::new(&python).args(["-m", "pip", "install", &pin, "numpy"]).status();
+        let specs = pip_specs(pins);
+        eprintln!("$ {} -m pip install {}", python.display(), specs.join(" "));
+        let ok = Command::new(&python).args(["-m", "pip", "install"]).args(&specs).status();
         if !matches!(ok, Ok(s) if s.success()) {
             return Err(format!(
-                "`pip install {pin} numpy` failed (it needs network access to PyPI, and a \
-                 platform Mitsuba publishes wheels for)"
+                "`pip install {}` failed (it needs network access to PyPI, and a platform the \
+                 packages publish wheels for)",
+                specs.join(" ")
             ));
         }
     }
     Ok(python)
 }
 
+/// A Python program that exits with 0 only if every pinned package imports and has its pinned
+/// version (as its installed distribution reports it).
+fn install_check(pins: &[Pin]) -> String {
+    let mut check = String::from("import importlib.metadata as m, sys\n");
+    for pin in pins {
+        check.push_str(&format!("import {}\n", pin.name));
+        if let Some(version) = pin.version {
+            check.push_str(&format!("if m.version('{}') != '{version}': sys.exit(1)\n", pin.name));
+        }
+    }
+    check
+}
+
+/// The arguments of `pip install` for `pins` (`name==version`, or the bare name).
+fn pip_specs(pins: &[Pin]) -> Vec<String> {
+    pins.iter()
+        .map(|p| p.version.map_or_else(|| p.name.to_owned(), |v| format!("{}=={v}", p.name)))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used)]
 
-    use super::{Job, find_llvm_in, job, llvm_major};
+    use super::{
+        EMBREE_PINS, EMBREEX_VERSION, Job, MITSUBA_PINS, Peer, Pin, find_llvm_in, install_check,
+        job, llvm_major, pip_specs,
+    };
 
     #[test]
     fn materials_flag_selects_the_materials_script() {
         let args: Vec<String> = ["--materials", "--spp", "64"].map(String::from).to_vec();
         let (chosen, rest) = job(&args);
-        assert_eq!(chosen, Job { script: "materials.py", work: "peer-materials" });
+        let materials = Job { script: "materials.py", work: "peer-materials", peer: Peer::Mitsuba };
+        assert_eq!(chosen, materials);
         assert_eq!(rest, &args[1..]);
         let race: Vec<String> = ["--scenes", "cornell", "--materials"].map(String::from).to_vec();
         let (chosen, rest) = job(&race);
-        assert_eq!(chosen, Job { script: "peer.py", work: "peer" });
+        assert_eq!(chosen, Job { script: "peer.py", work: "peer", peer: Peer::Mitsuba });
         assert_eq!(rest, &race[..]);
         assert_eq!(job(&[]).0.script, "peer.py");
+    }
+
+    #[test]
+    fn geometry_flag_selects_embree_and_the_geometry_script() {
+        let args: Vec<String> = ["--geometry", "--rays", "1000"].map(String::from).to_vec();
+        let (chosen, rest) = job(&args);
+        assert_eq!(
+            chosen,
+            Job { script: "geometry.py", work: "peer-geometry", peer: Peer::Embree }
+        );
+        assert_eq!(rest, &args[1..]);
+        // Only as the first argument: elsewhere it is the race's (which will refuse it).
+        let race: Vec<String> = ["--no-docs", "--geometry"].map(String::from).to_vec();
+        assert_eq!(job(&race).0.peer, Peer::Mitsuba);
+    }
+
+    #[test]
+    fn pins_become_pip_specs_and_a_version_check() {
+        assert_eq!(pip_specs(EMBREE_PINS), [format!("embreex=={EMBREEX_VERSION}"), "numpy".into()]);
+        assert_eq!(pip_specs(MITSUBA_PINS)[1], "numpy");
+        let check = install_check(&[
+            Pin { name: "embreex", version: Some("4.4.0.post1") },
+            Pin { name: "numpy", version: None },
+        ]);
+        assert_eq!(
+            check,
+            "import importlib.metadata as m, sys\nimport embreex\n\
+             if m.version('embreex') != '4.4.0.post1': sys.exit(1)\nimport numpy\n"
+        );
     }
 
     #[test]

@@ -27,6 +27,7 @@
 //!
 //! Layering: this crate depends on none of Spectrace's crates.
 
+pub mod bench_scenes;
 mod bounds;
 mod bvh;
 mod cylinder;
