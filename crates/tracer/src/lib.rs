@@ -37,12 +37,10 @@
 
 mod camera;
 mod effects;
-mod estimate;
 mod film;
 mod integrators;
 mod light_sampler;
 mod object_light;
-mod raster;
 mod render;
 mod sampler;
 mod scene;
@@ -76,9 +74,10 @@ pub use integrators::{
 };
 
 // The film, the render loop and its error estimate.
-pub use estimate::{ErrorEstimate, MIN_BATCHES, Moments};
-pub use film::{ExactSum, Film, FilmWriter, Splat, spectral_xyz};
-pub use raster::{FilmError, MAX_PIXELS};
+pub use film::{
+    ErrorEstimate, ExactSum, Film, FilmError, FilmWriter, MAX_PIXELS, MIN_BATCHES, Moments, Splat,
+    spectral_xyz,
+};
 pub use render::{
     DEFAULT_CHUNK_BEAMS, FALLBACK_MEMORY_LIMIT, MemoryLimit, Progress, RenderOutput, RenderPlan,
     render, render_observed,

@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
 
-use crate::estimate::ChunkTally;
+use crate::film::moments::ChunkTally;
 use crate::{
     ChunkWork, ErrorEstimate, Film, FilmError, FilmWriter, Integrator, Moments, TraceStats,
 };

@@ -28,7 +28,7 @@ use std::sync::{Mutex, PoisonError};
 use serde::{Deserialize, Serialize};
 use spectrace_spectrum::Xyz;
 
-use crate::raster::{FilmError, film_pixels, raster_bytes, same_size};
+use super::raster::{FilmError, film_pixels, raster_bytes, same_size};
 
 /// Chunks (batches) a render needs before its error estimate is trusted to stop it.
 pub const MIN_BATCHES: u64 = 16;

@@ -1,0 +1,31 @@
+//! [`Film`]: per-pixel CIE XYZ accumulated in exact fixed-point sums.
+//!
+//! Floating-point addition is not associative, so a film summed in a different order (more
+//! threads, another chunk order, several machines) would differ in the last bits. Spectrace
+//! instead rounds every contribution once to a fixed-point integer with 64 fractional bits and
+//! adds integers, which is exact and associative: any split of the work gives a bit-identical
+//! image. The cost is a resolution of 2^-64 (5.4e-20) per contribution and a range of 2^62
+//! (4.6e18) per pixel sum, both in the film's unscaled units (before the factor `power / beams`);
+//! contributions outside the range, NaN and infinities are rejected and counted, never added.
+//!
+//! The module's parts: [`ExactSum`] (`exact.rs`), the [`Splat`] trait and [`spectral_xyz`]
+//! (`splat.rs`), the [`Film`] itself (`buffer.rs`), a thread's buffered [`FilmWriter`]
+//! (`writer.rs`), the chunk [`Moments`] behind the live error estimate (`moments.rs`) and the
+//! pixel-count and size checks every buffer shares (`raster.rs`).
+
+mod buffer;
+mod exact;
+pub(crate) mod moments;
+pub(crate) mod raster;
+mod splat;
+mod writer;
+
+pub use buffer::Film;
+pub use exact::ExactSum;
+pub use moments::{ErrorEstimate, MIN_BATCHES, Moments};
+pub use raster::{FilmError, MAX_PIXELS};
+pub use splat::{Splat, spectral_xyz};
+pub use writer::FilmWriter;
+
+#[cfg(test)]
+mod tests;
