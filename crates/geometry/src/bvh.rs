@@ -49,6 +49,7 @@
 //! not finite.
 
 use glam::{BVec3A, DVec3, Vec3A};
+use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
 use wide::{CmpGt, CmpLe, CmpLt, f32x8};
 
@@ -144,9 +145,20 @@ pub(crate) struct Bvh {
 
 impl Bvh {
     /// Collapses `bvh`, whose boxes are relative to `center` (its primitive slots are
-    /// `bvh.primitive_indices`' positions), into wide nodes; and its leaves, numbered as the
-    /// traversal reports them.
-    pub(crate) fn from_bvh2(bvh: &Bvh2, center: DVec3) -> (Self, Vec<Leaf>) {
+    /// `bvh.primitive_indices`' positions, `boxes` its primitives' boxes by primitive index),
+    /// into wide nodes; and its leaves, numbered as the traversal reports them.
+    ///
+    /// A node's lanes left free by the collapse are not wasted: a leaf for which `split` says
+    /// so is split into one leaf per primitive, each with its own box, as long as lanes remain
+    /// (the box test of eight lanes costs the same as of one, and a primitive test saved is
+    /// worth far more: analytic shapes in a Cornell box otherwise share leaves whose boxes span
+    /// the room).
+    pub(crate) fn from_bvh2(
+        bvh: &Bvh2,
+        center: DVec3,
+        boxes: &[Aabb],
+        split: impl Fn(Leaf) -> bool,
+    ) -> (Self, Vec<Leaf>) {
         let mut leaves = Vec::new();
         if bvh.nodes.is_empty() {
             return (Self::default(), leaves);
@@ -156,20 +168,42 @@ impl Bvh {
         let mut wide = false;
         let too_big = |v: Vec3A| !(v.abs().max_element() <= F32_SAFE);
         while let Some((root, k)) = work.pop() {
-            for (lane, i) in collapse(bvh, root).into_iter().enumerate() {
+            let children = collapse(bvh, root);
+            let mut free = WIDTH - children.len();
+            let mut lane = 0;
+            for i in children {
                 let n = &bvh.nodes[i];
                 let a = n.aabb();
                 wide |= too_big(a.min) || too_big(a.max);
                 if n.is_leaf() {
-                    // Fewer leaves than primitives (< 2^31, checked by `World::new`).
-                    let leaf = leaves.len() as u32;
-                    leaves.push(Leaf { first: n.first_index, count: n.prim_count });
-                    nodes[k].set(lane, a.min, a.max, LEAF | leaf);
+                    let leaf = Leaf { first: n.first_index, count: n.prim_count };
+                    let parts = n.prim_count as usize;
+                    let singles = if parts > 1 && parts - 1 <= free && split(leaf) {
+                        free -= parts - 1;
+                        (leaf.first..leaf.first + leaf.count)
+                            .map(|s| Leaf { first: s, count: 1 })
+                            .collect()
+                    } else {
+                        vec![leaf]
+                    };
+                    for part in singles {
+                        let b = if part.count == 1 && leaf.count > 1 {
+                            boxes[bvh.primitive_indices[part.first as usize] as usize]
+                        } else {
+                            *a
+                        };
+                        // Fewer leaves than primitives (< 2^31, checked by `World::new`).
+                        let id = leaves.len() as u32;
+                        leaves.push(part);
+                        nodes[k].set(lane, b.min, b.max, LEAF | id);
+                        lane += 1;
+                    }
                 } else {
                     let index = nodes.len();
                     nodes.push(Node::empty());
                     work.push((i, index));
                     nodes[k].set(lane, a.min, a.max, index as u32);
+                    lane += 1;
                 }
             }
         }
@@ -315,7 +349,7 @@ impl SlabF32 {
     /// The per-ray setup from the origin relative to the boxes' centre, rounded once in f64 (so
     /// the exact value lies within one f64 ulp of it); `None` when it is beyond [`F32_SAFE`] or
     /// not finite.
-    #[inline]
+    #[inline(always)]
     fn new(origin: DVec3, direction: DVec3, t_max: f64) -> Option<Self> {
         if !(origin.abs().max_element() <= f64::from(F32_SAFE)) {
             return None;
@@ -474,10 +508,14 @@ impl Slab for SlabF64 {
     }
 }
 
+/// Entries the traversal stack holds on the call stack: it is filled (zeroed) for every ray, so
+/// it is kept small; a BVH8 over millions of primitives rarely needs more, and deeper trees spill.
+const STACK: usize = 24;
+
 /// The traversal stack of `(child, entry distance)`: a fixed array on the call stack,
 /// spilling to the heap only for trees deeper than it (so a ray costs no allocation).
 struct Stack<T> {
-    inline: [(u32, T); 48],
+    inline: [(u32, T); STACK],
     len: usize,
     spill: Vec<(u32, T)>,
 }
@@ -485,7 +523,7 @@ struct Stack<T> {
 impl<T: Copy + Default + PartialOrd> Stack<T> {
     #[inline(always)]
     fn new() -> Self {
-        Self { inline: [(0, T::default()); 48], len: 0, spill: Vec::new() }
+        Self { inline: [(0, T::default()); STACK], len: 0, spill: Vec::new() }
     }
 
     #[inline(always)]
@@ -553,6 +591,38 @@ mod tests {
         let (mask, near) = slab.test(&node);
         assert_eq!(mask, 1 << 3, "only the box's lane is entered");
         assert!(near[3] <= 4.0, "{near:?}");
+    }
+
+    #[test]
+    fn free_lanes_take_the_primitives_of_leaves_that_may_be_split() {
+        use obvhs::BvhBuildParams;
+        use obvhs::bvh2::builder::build_bvh2;
+        // Six boxes along x; leaves of up to four primitives.
+        let boxes: Vec<Aabb> = (0..6)
+            .map(|i| {
+                let x = i as f32 * 2.0;
+                Aabb::new(Vec3A::new(x, 0.0, 0.0), Vec3A::new(x + 1.0, 1.0, 1.0))
+            })
+            .collect();
+        let params = BvhBuildParams { max_prims_per_leaf: 4, ..BvhBuildParams::medium_build() };
+        let bvh2 = build_bvh2(&boxes, params, &mut std::time::Duration::default());
+        let kept = Bvh::from_bvh2(&bvh2, DVec3::ZERO, &boxes, |_| false).1;
+        assert!(kept.len() < 6, "the build groups primitives: {kept:?}");
+        assert_eq!(kept.iter().map(|l| l.count).sum::<u32>(), 6);
+        let (bvh, split) = Bvh::from_bvh2(&bvh2, DVec3::ZERO, &boxes, |_| true);
+        assert_eq!(split.len(), 6, "{split:?}");
+        assert!(split.iter().all(|l| l.count == 1));
+        // Each single-primitive lane carries that primitive's own box.
+        let root = &bvh.nodes[0];
+        for lane in 0..WIDTH {
+            let child = root.child[lane];
+            let (min, max) = root.bounds(lane);
+            if child & LEAF != 0 && min.cmple(max).all() {
+                let leaf = split[(child & !LEAF) as usize];
+                let b = boxes[bvh2.primitive_indices[leaf.first as usize] as usize];
+                assert_eq!((min, max), (b.min, b.max));
+            }
+        }
     }
 
     #[test]

@@ -21,7 +21,7 @@ use serde::{Deserialize, Serialize};
 use spectrace_sampling::Frame;
 
 use crate::float::{finite_point, positive, unit_direction};
-use crate::rectangle::plane_hit;
+use crate::rectangle::{plane_error, plane_hit};
 use crate::shape::{Primitives, SurfacePoint, similarity};
 use crate::{Bounds, GeometryError, Hit, Ray, Transform};
 
@@ -98,16 +98,16 @@ impl Disk {
 }
 
 impl Disk {
-    /// The plane crossing inside the radius: `(t, point, error, local point, rho)`.
+    /// The plane crossing inside the radius: `(t, point, local point, rho)`.
     #[inline]
-    fn solve(&self, ray: &Ray, t_max: f64) -> Option<(f64, DVec3, DVec3, DVec3, f64)> {
-        let (t, point, error) = plane_hit(self.center, self.frame.n(), ray, t_max)?;
+    fn solve(&self, ray: &Ray, t_max: f64) -> Option<(f64, DVec3, DVec3, f64)> {
+        let (t, point) = plane_hit(self.center, self.frame.n(), ray, t_max)?;
         let local = self.frame.to_local(point - self.center);
         let rho = local.x.hypot(local.y);
         if !(rho <= self.radius) {
             return None;
         }
-        Some((t, point, error, local, rho))
+        Some((t, point, local, rho))
     }
 }
 
@@ -131,7 +131,8 @@ impl Primitives for Disk {
     }
 
     fn intersect(&self, _index: u32, ray: &Ray, t_max: f64) -> Option<Hit> {
-        let (t, point, error, local, rho) = self.solve(ray, t_max)?;
+        let (t, point, local, rho) = self.solve(ray, t_max)?;
+        let error = plane_error(point, self.center);
         let phi = local.y.atan2(local.x);
         let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
         Some(Hit {

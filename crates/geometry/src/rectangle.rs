@@ -189,41 +189,49 @@ impl Rectangle {
     }
 }
 
-/// The ray's crossing of the plane through `origin_point` with unit `normal`, in `(0, t_max)`,
-/// re-projected onto the plane: `(t, point, error)`.
+/// The ray's crossing of the plane through `anchor` with unit `normal`, in `(0, t_max)`,
+/// re-projected onto the plane: `(t, point)`. A plane behind the ray (numerator and
+/// denominator of `t` of opposite signs) is rejected before the division.
+#[inline]
 pub(crate) fn plane_hit(
     anchor: DVec3,
     normal: DVec3,
     ray: &Ray,
     t_max: f64,
-) -> Option<(f64, DVec3, DVec3)> {
+) -> Option<(f64, DVec3)> {
     let den = ray.direction.dot(normal);
-    if den == 0.0 {
+    let num = (anchor - ray.origin).dot(normal);
+    if den == 0.0 || (num > 0.0) != (den > 0.0) {
         return None;
     }
-    let t = (anchor - ray.origin).dot(normal) / den;
+    let t = num / den;
     if !(t > 0.0 && t < t_max) {
         return None;
     }
     let p = ray.at(t);
-    let p = p - normal * (p - anchor).dot(normal);
+    Some((t, p - normal * (p - anchor).dot(normal)))
+}
+
+/// The rounding error bound of a point `p` that [`plane_hit`] re-projected onto the plane
+/// through `anchor` (computed only for accepted hits).
+#[inline]
+pub(crate) fn plane_error(p: DVec3, anchor: DVec3) -> DVec3 {
     let q = (p - anchor).abs().max_element();
-    let error = (p.abs() + anchor.abs()) * gamma(12) + DVec3::splat(gamma(6) * q);
-    Some((t, p, error))
+    (p.abs() + anchor.abs()) * gamma(12) + DVec3::splat(gamma(6) * q)
 }
 
 impl Rectangle {
-    /// The plane crossing inside the parallelogram: `(t, point, error, s, t)`.
+    /// The plane crossing inside the parallelogram: `(t, point, s, t)`.
     #[inline]
-    fn solve(&self, ray: &Ray, t_max: f64) -> Option<(f64, DVec3, DVec3, f64, f64)> {
-        let (t, point, error) = plane_hit(self.corner, self.normal, ray, t_max)?;
+    fn solve(&self, ray: &Ray, t_max: f64) -> Option<(f64, DVec3, f64, f64)> {
+        let (t, point) = plane_hit(self.corner, self.normal, ray, t_max)?;
         let q = point - self.corner;
         let s = q.dot(self.dual_u);
         let v = q.dot(self.dual_v);
         if !((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&v)) {
             return None;
         }
-        Some((t, point, error, s, v))
+        Some((t, point, s, v))
     }
 }
 
@@ -242,7 +250,8 @@ impl Primitives for Rectangle {
     }
 
     fn intersect(&self, _index: u32, ray: &Ray, t_max: f64) -> Option<Hit> {
-        let (t, point, error, s, v) = self.solve(ray, t_max)?;
+        let (t, point, s, v) = self.solve(ray, t_max)?;
+        let error = plane_error(point, self.corner);
         Some(Hit {
             t,
             point,

@@ -31,6 +31,8 @@ pub struct LightTracerScene<'a> {
     spds: Vec<Arc<dyn SpectralPowerDistribution>>,
     /// What each shape emits, indexed like `materials` (empty: nothing emits).
     emitters: Vec<Option<Emitter>>,
+    /// Some shape emits (so a ray may find light by hitting a surface).
+    surfaces_emit: bool,
     /// The shape that is the surface of each light of the set, if any.
     light_shapes: Vec<Option<u32>>,
     /// How many of the shapes are the scene's objects (the first ones); the rest are the
@@ -111,6 +113,7 @@ impl<'a> LightTracerScene<'a> {
             camera,
             spds,
             emitters: Vec::new(),
+            surfaces_emit: false,
             light_shapes: Vec::new(),
             object_shapes: materials.len(),
             sampler: SamplerKind::Independent,
@@ -189,6 +192,7 @@ impl<'a> LightTracerScene<'a> {
             }
         }
         self.light_shapes = light_shapes;
+        self.surfaces_emit = emitters.iter().any(Option::is_some);
         self.emitters = emitters;
         self.object_shapes = object_shapes.min(self.materials.len());
         self
@@ -207,6 +211,13 @@ impl<'a> LightTracerScene<'a> {
             return self.world.intersect(&next, t_max - travelled);
         }
         Some(hit)
+    }
+
+    /// Whether any shape emits (an area light's surface or a glowing object): when none does,
+    /// a ray traced only for the emission it may hit finds nothing.
+    #[inline]
+    pub fn surfaces_emit(&self) -> bool {
+        self.surfaces_emit
     }
 
     /// What shape `primitive` emits.

@@ -27,6 +27,12 @@ pub const HERO: usize = 4;
 const VISIBLE_K: f64 = 0.0072;
 /// The centre of the visible density (nm).
 const VISIBLE_CENTRE: f64 = 538.0;
+/// `tanh(K (CAMERA_LAMBDA_MIN - centre))`: the visible density's CDF is affine in `tanh`, from
+/// this value to [`VISIBLE_TANH_MAX`] (a constant, checked against `tanh` by a test, so the hot
+/// path needs no lazy initialisation).
+const VISIBLE_TANH_MIN: f64 = -0.856_910_625_469_828;
+/// `tanh(K (CAMERA_LAMBDA_MAX - centre))`.
+const VISIBLE_TANH_MAX: f64 = 0.970_591_346_940_269_8;
 
 /// How camera paths draw their wavelengths.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -46,11 +52,7 @@ impl CameraWavelengths {
         let u = spectrace_sampling::clamp_uniform(u);
         let lambda = match self {
             Self::Uniform => CAMERA_LAMBDA_MIN + u * (CAMERA_LAMBDA_MAX - CAMERA_LAMBDA_MIN),
-            Self::Visible => {
-                let (a, b) = visible_tanh_range();
-                let t = a + u * (b - a);
-                VISIBLE_CENTRE + t.atanh() / VISIBLE_K
-            }
+            Self::Visible => return visible(u).0,
         };
         lambda.clamp(CAMERA_LAMBDA_MIN, CAMERA_LAMBDA_MAX)
     }
@@ -63,9 +65,8 @@ impl CameraWavelengths {
         match self {
             Self::Uniform => 1.0 / (CAMERA_LAMBDA_MAX - CAMERA_LAMBDA_MIN),
             Self::Visible => {
-                let (a, b) = visible_tanh_range();
                 let c = (VISIBLE_K * (lambda - VISIBLE_CENTRE)).cosh();
-                VISIBLE_K / ((b - a) * c * c)
+                VISIBLE_K / ((VISIBLE_TANH_MAX - VISIBLE_TANH_MIN) * c * c)
             }
         }
     }
@@ -75,26 +76,38 @@ impl CameraWavelengths {
     pub fn sample_hero(self, u: f64) -> ([f64; HERO], [f64; HERO]) {
         let mut lambdas = [0.0; HERO];
         let mut weights = [0.0; HERO];
+        let u = spectrace_sampling::clamp_uniform(u);
         for j in 0..HERO {
-            let uj = (u + j as f64 / HERO as f64).fract();
-            lambdas[j] = self.sample(uj);
-            let p = self.pdf(lambdas[j]);
+            // `(u + j / HERO) mod 1`, exactly (`x - 1` is exact for `x` in `[1, 2)`).
+            let shifted = u + j as f64 / HERO as f64;
+            let uj = if shifted >= 1.0 { shifted - 1.0 } else { shifted };
+            let p = match self {
+                Self::Visible => {
+                    // The density from the `tanh` the sample came from: `1 / cosh^2 = 1 - tanh^2`
+                    // (no `cosh` per wavelength).
+                    let (lambda, t) = visible(uj);
+                    lambdas[j] = lambda;
+                    VISIBLE_K * (1.0 - t * t) / (VISIBLE_TANH_MAX - VISIBLE_TANH_MIN)
+                }
+                Self::Uniform => {
+                    lambdas[j] = self.sample(uj);
+                    self.pdf(lambdas[j])
+                }
+            };
             weights[j] = if p > 0.0 { 1.0 / (HERO as f64 * p) } else { 0.0 };
         }
         (lambdas, weights)
     }
 }
 
-/// `tanh` of the visible density's argument at both ends of the range (computed once: two
-/// `tanh` per density evaluation were 6% of a path-traced Cornell box).
-fn visible_tanh_range() -> (f64, f64) {
-    static RANGE: std::sync::LazyLock<(f64, f64)> = std::sync::LazyLock::new(|| {
-        (
-            (VISIBLE_K * (CAMERA_LAMBDA_MIN - VISIBLE_CENTRE)).tanh(),
-            (VISIBLE_K * (CAMERA_LAMBDA_MAX - VISIBLE_CENTRE)).tanh(),
-        )
-    });
-    *RANGE
+/// The visible density's wavelength at `u` in `[0, 1]` (clamped to the range) and the `tanh`
+/// of its argument, `t = tanh(K (lambda - centre))`, which is uniform over
+/// `[VISIBLE_TANH_MIN, VISIBLE_TANH_MAX]`.
+#[inline]
+fn visible(u: f64) -> (f64, f64) {
+    let t = VISIBLE_TANH_MIN + u * (VISIBLE_TANH_MAX - VISIBLE_TANH_MIN);
+    let lambda = VISIBLE_CENTRE + t.atanh() / VISIBLE_K;
+    (lambda.clamp(CAMERA_LAMBDA_MIN, CAMERA_LAMBDA_MAX), t)
 }
 
 #[cfg(test)]
@@ -132,6 +145,13 @@ mod tests {
         let v = CameraWavelengths::Visible;
         // cosh^2(0.0072 * 138) = 2.36 at 400 nm and cosh^2(0.0072 * 182) = 3.9 at 720 nm.
         assert!(v.pdf(555.0) > 2.2 * v.pdf(400.0) && v.pdf(555.0) > 3.8 * v.pdf(720.0));
+    }
+
+    #[test]
+    fn the_tanh_constants_are_the_range_ends() {
+        let end = |lambda: f64| (VISIBLE_K * (lambda - VISIBLE_CENTRE)).tanh();
+        assert!((VISIBLE_TANH_MIN - end(CAMERA_LAMBDA_MIN)).abs() < 1e-15);
+        assert!((VISIBLE_TANH_MAX - end(CAMERA_LAMBDA_MAX)).abs() < 1e-15);
     }
 
     #[test]

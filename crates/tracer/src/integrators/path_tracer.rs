@@ -116,6 +116,9 @@ struct PathState {
     last_bounce: bool,
     /// A dispersive surface has left the hero alone.
     collapsed: bool,
+    /// The last light spectrum evaluated at `transport` (a path mostly meets one light, at
+    /// wavelengths that change only at a fluorescent re-emission).
+    spd_cache: Option<(LightId, [f64; HERO], [f64; HERO])>,
 }
 
 impl PathState {
@@ -131,17 +134,38 @@ impl PathState {
             depth: 0,
             last_bounce: false,
             collapsed: false,
+            spd_cache: None,
         }
+    }
+
+    /// Light `light`'s SPD at the path's transport wavelengths (cached while the light and the
+    /// wavelengths stay the same); `None` for a light without one.
+    #[inline]
+    fn light_values(
+        &mut self,
+        scene: &LightTracerScene<'_>,
+        light: LightId,
+    ) -> Option<[f64; HERO]> {
+        if let Some((id, at, values)) = self.spd_cache
+            && id == light
+            && at == self.transport
+        {
+            return Some(values);
+        }
+        let spd = scene.light_spd(light)?;
+        let values = self.transport.map(|l| spd.value(l));
+        self.spd_cache = Some((light, self.transport, values));
+        Some(values)
     }
 
     /// Adds `le` (whole spectrum, times light `light`'s SPD) weighted by `weight`.
     #[inline]
     fn add_emission(&mut self, scene: &LightTracerScene<'_>, light: LightId, le: f64, weight: f64) {
-        let Some(spd) = scene.light_spd(light) else { return };
         if weight > 0.0 {
-            for j in 0..HERO {
-                if self.beta[j] != 0.0 {
-                    self.radiance[j] += self.beta[j] * le * spd.value(self.transport[j]) * weight;
+            let Some(spd) = self.light_values(scene, light) else { return };
+            for ((r, &b), s) in self.radiance.iter_mut().zip(&self.beta).zip(spd) {
+                if b != 0.0 {
+                    *r += b * le * s * weight;
                 }
             }
         }
@@ -257,8 +281,12 @@ impl<'a> PathTracer<'a> {
                 self.next_event(&mut p, &at, u.light, stats);
                 if !self.effects.continue_after_diffuse {
                     // No light can come back to a non-specular surface by interreflection:
-                    // only an emitter seen by the BSDF-sampled ray remains (for MIS).
+                    // only an emitter seen by the BSDF-sampled ray remains (for MIS), and
+                    // without emitting surfaces not even that.
                     p.last_bounce = true;
+                    if !scene.surfaces_emit() {
+                        break;
+                    }
                 }
             }
             let go = ScatterSamples::draw(rng, p.depth >= self.settings.rr_depth);
@@ -356,13 +384,13 @@ impl<'a> PathTracer<'a> {
             return;
         }
         stats.splats += 1;
-        let Some(spd) = scene.light_spd(id) else { return };
+        let Some(spd) = p.light_values(scene, id) else { return };
         let g = sample.intensity * cos / (sample.distance * sample.distance * pmf) * weight;
         let mut f = [0.0; HERO];
         material.eval_bundle(wi, wo, n, &p.transport, Transport::Radiance, &mut f);
         for (j, f) in f.into_iter().enumerate() {
             if p.beta[j] != 0.0 && f > 0.0 {
-                p.radiance[j] += p.beta[j] * f * g * spd.value(p.transport[j]);
+                p.radiance[j] += p.beta[j] * f * g * spd[j];
             }
         }
     }
