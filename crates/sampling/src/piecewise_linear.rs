@@ -29,11 +29,11 @@
 use rand::{Rng, RngExt, distr::Distribution};
 use serde::{Deserialize, Serialize};
 
-use crate::SamplingError;
 use crate::table::{
     Cdf, exponent, first_float_where, last_float_where, ldexp, unit, validate_grid,
     validate_nonnegative,
 };
+use crate::{GridLocator, SamplingError};
 
 /// One linear segment, with everything `sample` needs in one 64-byte cache line.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -88,6 +88,8 @@ pub struct PiecewiseLinear {
     integral: f64,
     /// `pdf(x) = interpolated ys_scaled(x) * pdf_factor`, computed without overflow.
     pdf_factor: f64,
+    /// Finds the segment of a point (in `O(1)` on evenly spaced grids).
+    locator: GridLocator,
 }
 
 /// The serialised form of a [`PiecewiseLinear`]: its grid and values.
@@ -224,6 +226,7 @@ impl PiecewiseLinear {
             cdf,
             integral,
             pdf_factor,
+            locator: GridLocator::new(xs),
         })
     }
 
@@ -292,7 +295,7 @@ impl PiecewiseLinear {
         if !(x >= self.xs[0] && x <= self.xs[n - 1]) {
             return None;
         }
-        let i = (self.xs.partition_point(|&v| v <= x).max(1) - 1).min(n - 2);
+        let i = self.locator.last_at_or_below(&self.xs, x).min(n - 2);
         let seg = &self.segments[i];
         Some((i, ((x - seg.x0) / seg.width).clamp(0.0, 1.0)))
     }

@@ -18,7 +18,7 @@ use serde::de::{self, DeserializeSeed, MapAccess, SeqAccess, Unexpected, Visitor
 use serde::{Deserialize, Serialize};
 
 use crate::error::SpectrumError;
-use spectrace_sampling::SamplingError;
+use spectrace_sampling::{GridLocator, SamplingError};
 
 /// A spectral reflectance: a fraction in `[0, 1]` at each wavelength, linear between tabulated
 /// points and constant beyond the ends.
@@ -26,6 +26,8 @@ use spectrace_sampling::SamplingError;
 pub struct Reflectance {
     nm: Vec<f64>,
     values: Vec<f64>,
+    /// Finds the segment of a wavelength (in `O(1)` on evenly spaced tables).
+    locator: GridLocator,
 }
 
 /// A spectral transmittance: the same representation and rules as a [`Reflectance`], but its
@@ -443,12 +445,12 @@ impl Reflectance {
     /// [`Reflectance::constant`] with messages for `kind`.
     /// The fraction 1 at every wavelength (a white, lossless surface).
     pub fn white() -> Self {
-        Self { nm: Vec::new(), values: vec![1.0] }
+        Self { nm: Vec::new(), values: vec![1.0], locator: GridLocator::default() }
     }
 
     fn constant_of(kind: Kind, value: f64) -> Result<Self, SpectrumError> {
         check_fraction(kind, "constant", 0, value)?;
-        Ok(Self { nm: Vec::new(), values: vec![value] })
+        Ok(Self { nm: Vec::new(), values: vec![value], locator: GridLocator::default() })
     }
 
     /// A table of fractions at strictly increasing wavelengths.
@@ -495,7 +497,7 @@ impl Reflectance {
         for (index, &value) in values.iter().enumerate() {
             check_fraction(kind, "values", index, value)?;
         }
-        Ok(Self { nm: nm.to_vec(), values: values.to_vec() })
+        Ok(Self { nm: nm.to_vec(), values: values.to_vec(), locator: GridLocator::new(nm) })
     }
 
     /// The fraction at `lambda` (nm); in `[0, 1]` for every input (NaN gives the first value).
@@ -511,7 +513,7 @@ impl Reflectance {
         if lambda >= self.nm[n - 1] {
             return self.values[n - 1];
         }
-        let i = self.nm.partition_point(|&x| x <= lambda) - 1;
+        let i = self.locator.last_at_or_below(&self.nm, lambda);
         let t = (lambda - self.nm[i]) / (self.nm[i + 1] - self.nm[i]);
         self.values[i] * (1.0 - t) + self.values[i + 1] * t
     }
