@@ -48,6 +48,7 @@
 //! [`F32_SAFE`] (the f32 subtraction could overflow) and a ray whose origin lies beyond it or is
 //! not finite.
 
+use arrayvec::ArrayVec;
 use glam::{BVec3A, DVec3, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
@@ -508,44 +509,33 @@ impl Slab for SlabF64 {
     }
 }
 
-/// Entries the traversal stack holds on the call stack: it is filled (zeroed) for every ray, so
-/// it is kept small; a BVH8 over millions of primitives rarely needs more, and deeper trees spill.
-const STACK: usize = 24;
+/// Entries the traversal stack holds on the call stack; deeper trees spill to the heap.
+const STACK: usize = 64;
 
-/// The traversal stack of `(child, entry distance)`: a fixed array on the call stack,
-/// spilling to the heap only for trees deeper than it (so a ray costs no allocation).
+/// The traversal stack of `(child, entry distance)`: a fixed array on the call stack (not
+/// zeroed per ray), spilling to the heap only for trees deeper than it (so a ray costs no
+/// allocation).
 struct Stack<T> {
-    inline: [(u32, T); STACK],
-    len: usize,
+    inline: ArrayVec<(u32, T), STACK>,
     spill: Vec<(u32, T)>,
 }
 
 impl<T: Copy + Default + PartialOrd> Stack<T> {
     #[inline(always)]
     fn new() -> Self {
-        Self { inline: [(0, T::default()); STACK], len: 0, spill: Vec::new() }
+        Self { inline: ArrayVec::new(), spill: Vec::new() }
     }
 
     #[inline(always)]
     fn push(&mut self, entry: (u32, T)) {
-        if self.len < self.inline.len() {
-            self.inline[self.len] = entry;
-            self.len += 1;
-        } else {
-            self.spill.push(entry);
+        if let Err(full) = self.inline.try_push(entry) {
+            self.spill.push(full.element());
         }
     }
 
     #[inline(always)]
     fn pop(&mut self) -> Option<(u32, T)> {
-        if let Some(entry) = self.spill.pop() {
-            return Some(entry);
-        }
-        if self.len == 0 {
-            return None;
-        }
-        self.len -= 1;
-        Some(self.inline[self.len])
+        self.spill.pop().or_else(|| self.inline.pop())
     }
 
     /// Pushes `entries` (at most [`WIDTH`]) so that the nearest is on top: sorted by entry
