@@ -113,6 +113,11 @@ impl Leaves {
         self.slots.len()
     }
 
+    /// Number of leaves.
+    pub(crate) fn leaf_count(&self) -> usize {
+        self.leaves.len()
+    }
+
     /// The per-ray triangle setup, if any slot is a triangle.
     #[inline]
     pub(crate) fn triangle_ray(&self, ray: &Ray) -> Option<TriangleRay> {

@@ -20,6 +20,12 @@ fn build_params() -> BvhBuildParams {
     BvhBuildParams { max_prims_per_leaf: MAX_PRIMS_PER_LEAF, ..BvhBuildParams::medium_build() }
 }
 
+/// Worlds of at most this many primitives, none of them a torus, are not traversed: every
+/// primitive is tested (the same tests, so the same hits). The wide tree's per-ray setup (the
+/// SIMD slab's broadcasts) costs more than a plane or quadric test, and a light tracer's beams
+/// over one plane would pay it for nothing; a torus's quartic is worth culling.
+const DIRECT_PRIMITIVES: usize = 2;
+
 /// The most primitives per BVH leaf (chosen by benchmark, see the crate README).
 const MAX_PRIMS_PER_LEAF: u32 = 4;
 
@@ -47,6 +53,8 @@ pub struct World {
     shapes: Vec<Shape>,
     /// The primitives of the BVH's leaves.
     leaves: Leaves,
+    /// Test every leaf instead of traversing (see [`DIRECT_PRIMITIVES`]).
+    direct: bool,
     bvh2: Bvh2,
     bvh: Bvh,
     bounds: Bounds,
@@ -115,7 +123,9 @@ impl World {
         let split = |leaf: Leaf| (leaf.first..leaf.first + leaf.count).any(analytic);
         let (bvh, leaves) = Bvh::from_bvh2(&bvh2, center, &aabbs, split);
         let leaves = Leaves::new(&shapes, &prims, &bvh2.primitive_indices, &leaves);
-        Ok(Self { shapes, leaves, bvh2, bvh, bounds })
+        let direct = leaves.slot_count() <= DIRECT_PRIMITIVES
+            && !shapes.iter().any(|s| matches!(s, Shape::Torus(_)));
+        Ok(Self { shapes, leaves, direct, bvh2, bvh, bounds })
     }
 
     /// Loads every OBJ mesh relative to `base_dir` (the scene file's directory), then builds.
@@ -166,9 +176,20 @@ impl World {
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<Hit> {
         let triangle_ray = self.leaves.triangle_ray(ray);
         let mut best = Nearest::None;
-        self.bvh.traverse(ray.origin, ray.direction, t_max, |leaf, limit| {
-            self.leaves.nearest(leaf, &self.shapes, ray, triangle_ray.as_ref(), limit, &mut best)
-        });
+        let tr = triangle_ray.as_ref();
+        if self.direct {
+            let mut limit = t_max;
+            for leaf in 0..self.leaves.leaf_count() as u32 {
+                if let Some(t) = self.leaves.nearest(leaf, &self.shapes, ray, tr, limit, &mut best)
+                {
+                    limit = t;
+                }
+            }
+        } else {
+            self.bvh.traverse(ray.origin, ray.direction, t_max, |leaf, limit| {
+                self.leaves.nearest(leaf, &self.shapes, ray, tr, limit, &mut best)
+            });
+        }
         self.leaves.hit(best, &self.shapes)
     }
 
@@ -176,9 +197,14 @@ impl World {
     /// primitive hit and builds no [`Hit`].
     pub fn occluded(&self, ray: &Ray, t_max: f64) -> bool {
         let triangle_ray = self.leaves.triangle_ray(ray);
+        let tr = triangle_ray.as_ref();
+        if self.direct {
+            return (0..self.leaves.leaf_count() as u32)
+                .any(|leaf| self.leaves.any(leaf, &self.shapes, ray, tr, t_max));
+        }
         let mut hit = false;
         self.bvh.traverse(ray.origin, ray.direction, t_max, |leaf, limit| {
-            hit = self.leaves.any(leaf, &self.shapes, ray, triangle_ray.as_ref(), limit);
+            hit = self.leaves.any(leaf, &self.shapes, ray, tr, limit);
             hit.then_some(-1.0)
         });
         hit

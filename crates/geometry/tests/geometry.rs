@@ -1450,3 +1450,40 @@ fn occluded_equals_intersect_is_some_with_finite_distances() {
     }
     assert!(blocked > 500 && free > 500, "{blocked} {free}");
 }
+
+#[test]
+fn worlds_of_one_or_two_primitives_tested_directly_equal_brute_force() {
+    // Up to two primitives (no torus), the world tests every primitive instead of traversing;
+    // with a torus it traverses. Both must be the brute-force search, for rays from anywhere.
+    let mut r = rng(31);
+    let two_triangles = Mesh::from_triangles(
+        vec![v(-1.0, 0.0, -1.0), v(1.0, 0.0, -1.0), v(1.0, 0.0, 1.0), v(-1.0, 0.2, 1.0)],
+        vec![[0, 1, 2], [0, 2, 3]],
+    )
+    .unwrap();
+    let worlds: Vec<Vec<Shape>> = vec![
+        vec![
+            Rectangle::new(v(-1.0, 0.0, -1.0), v(2.0, 0.0, 0.0), v(0.0, 0.0, 2.0)).unwrap().into(),
+        ],
+        vec![
+            Sphere::new(v(0.0, 0.5, 0.0), 0.5).unwrap().into(),
+            Disk::new(v(0.0, -0.5, 0.0), DVec3::Y, 1.0).unwrap().into(),
+        ],
+        vec![two_triangles.into()],
+        vec![
+            Rectangle::new(v(-1.0, 0.0, -1.0), v(2.0, 0.0, 0.0), v(0.0, 0.0, 2.0)).unwrap().into(),
+            Torus::new(v(0.0, 0.5, 0.0), DVec3::Y, 0.6, 0.2).unwrap().into(),
+        ],
+    ];
+    let mut hits = 0;
+    for shapes in worlds {
+        let world = World::new(shapes).unwrap();
+        for _ in 0..2000 {
+            let origin = unit(&mut r) * r.random_range(0.0..3.0);
+            let ray = Ray::new(origin, unit(&mut r));
+            let t_max = if r.random_bool(0.2) { r.random_range(0.0..3.0) } else { f64::INFINITY };
+            hits += usize::from(check_ray(&world, &ray, t_max).is_some());
+        }
+    }
+    assert!(hits > 1000, "too few hits to test anything: {hits}");
+}
