@@ -10,6 +10,10 @@ use super::moments::Moments;
 use super::raster::pixel_index;
 use super::{Film, Splat};
 
+/// Films with more pixels than this (48 bytes of sums each: 3 MiB) have a flush's contributions
+/// sorted by pixel before they are added.
+const SORT_ABOVE_PIXELS: u64 = 1 << 16;
+
 /// One buffered contribution: pixel index and fixed-point XYZ.
 type Entry = (u32, [i128; 3]);
 
@@ -95,7 +99,12 @@ impl<'a> FilmWriter<'a> {
         if self.entries.is_empty() && self.rejected == 0 {
             return;
         }
-        self.entries.sort_unstable_by_key(|e| e.0);
+        // Sorting by pixel makes the adds below sweep a large film in order (its sums far
+        // exceed the caches); a small film stays cached and sorting would cost more than it
+        // saves. The film's sums are exact, so the order never changes the image.
+        if u64::from(self.width) * u64::from(self.height) > SORT_ABOVE_PIXELS {
+            self.entries.sort_unstable_by_key(|e| e.0);
+        }
         let mut film = self.film.lock().unwrap_or_else(PoisonError::into_inner);
         for &(index, fixed) in &self.entries {
             // Only what the film accepts counts for the estimate.
