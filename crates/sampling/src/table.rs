@@ -156,7 +156,7 @@ pub(crate) struct Cdf {
 }
 
 /// Tables with at least this many entries get a guide table.
-const GUIDE_MIN_LEN: usize = 64;
+const GUIDE_MIN_LEN: usize = 16;
 
 impl Cdf {
     /// Builds the table. `masses` must already be validated (finite, non-negative, not empty).
