@@ -18,7 +18,29 @@ pub(super) const PIXEL_BYTES: u64 = std::mem::size_of::<[ExactSum; 3]>() as u64;
 /// 2^62.
 #[inline]
 pub(super) fn to_fixed(x: f64) -> Option<i128> {
-    (x.abs() <= MAX_CONTRIBUTION).then(|| (x * SCALE).round() as i128)
+    (x.abs() <= MAX_CONTRIBUTION).then(|| round_to_i128(x * SCALE))
+}
+
+/// `y.round() as i128` (to nearest, ties away from zero) for finite `|y| <= 2^126`, through
+/// 64-bit integer conversions (single instructions) instead of the library's `round` and
+/// 128-bit conversion calls that baseline x86-64 needs.
+#[inline]
+fn round_to_i128(y: f64) -> i128 {
+    const TWO_52: f64 = 4_503_599_627_370_496.0;
+    const TWO_63: f64 = 9_223_372_036_854_775_808.0;
+    let t = y.abs();
+    let magnitude = if t < TWO_52 {
+        // Truncate, then round the exact remainder up from one half.
+        let i = t as i64;
+        let rest = t - i as f64;
+        i128::from(i + i64::from(rest >= 0.5))
+    } else if t < TWO_63 {
+        // Already an integer.
+        i128::from(t as i64)
+    } else {
+        t as i128
+    };
+    if y < 0.0 { -magnitude } else { magnitude }
 }
 
 /// A fixed-point value as `f64`, to within a few units in the last place (for the error

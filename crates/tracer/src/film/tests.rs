@@ -151,3 +151,20 @@ fn film_bytes_are_48_per_pixel() {
     assert!((48 << 25..(48 << 25) + 1024).contains(&b), "{b}");
     assert_eq!(Film::bytes_for(u32::MAX, u32::MAX), u64::MAX);
 }
+
+#[test]
+fn fixed_point_rounding_is_the_library_round() {
+    // Halves, both signs, every binade from 2^-80 to 2^62, and the fast path's edges.
+    let mut values = vec![0.0, -0.0, 0.5, -0.5, 1.5, 2.5, -2.5, 4503599627370495.5];
+    for e in -80..=62 {
+        let p = 2f64.powi(e);
+        for m in [1.0, 1.1, 1.5, 1.75, 1.999_999_999] {
+            values.extend([p * m, -p * m, (p * m).next_up(), (p * m).next_down()]);
+        }
+    }
+    for x in values {
+        if let Some(fixed) = to_fixed(x) {
+            assert_eq!(fixed, (x * SCALE).round() as i128, "{x:e}");
+        }
+    }
+}
