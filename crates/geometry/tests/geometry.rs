@@ -1289,28 +1289,11 @@ fn scale_then_move(s: f64, far: DVec3) -> String {
     format!(r#"{{"scale": {}, "translate": {}}}"#, js(s), jv(far.to_array()))
 }
 
-/// A bumpy UV sphere of radius ~1 (`4 n^2` triangles) as a Mesh, scaled by `s` and moved to `far`.
+/// The benchmark's bumpy UV sphere of radius ~1 (`4 n^2` triangles,
+/// `bench_scenes::bumpy_sphere_triangles`) as a Mesh, scaled by `s` and moved to `far`.
 fn bumpy_mesh(n: u32, s: f64, far: DVec3) -> Shape {
-    let mut positions = Vec::new();
-    for i in 0..=n {
-        let theta = PI * f64::from(i) / f64::from(n);
-        for j in 0..2 * n {
-            let phi = PI * f64::from(j) / f64::from(n);
-            let r = 1.0 + 0.05 * (7.0 * theta).sin() * (5.0 * phi).cos();
-            positions.push(
-                [theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin()].map(|c| c * r),
-            );
-        }
-    }
-    let idx = |i: u32, j: u32| i * 2 * n + j % (2 * n);
-    let mut triangles = Vec::new();
-    for i in 0..n {
-        for j in 0..2 * n {
-            triangles.push([idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)]);
-            triangles.push([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]);
-        }
-    }
-    let positions: Vec<String> = positions.into_iter().map(jv).collect();
+    let (positions, triangles) = spectrace_geometry::bench_scenes::bumpy_sphere_triangles(n);
+    let positions: Vec<String> = positions.into_iter().map(|p| jv(p.to_array())).collect();
     let triangles: Vec<String> = triangles.iter().map(|t| format!("{t:?}")).collect();
     shape(&format!(
         r#"{{"type": "Mesh", "positions": [{}], "triangles": [{}], "transform": {}}}"#,
