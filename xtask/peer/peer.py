@@ -3,7 +3,11 @@
 Run by the xtask inside the virtual environment it builds (target/peer-venv), with
 DRJIT_LIBLLVM_PATH set. Translates the Spectrace scenes of xtask/peer/scenes into Mitsuba
 dictionaries, renders a shared reference per scene, then every integrator of both renderers at
-doubling effort (2 threads each), and writes docs/peer.md, docs/peer.svg and the README table.
+doubling effort (2 threads each), then the samples per second of Spectrace's path and light
+tracers beside Mitsuba's path and ptracer in its llvm_ad_spectral and scalar_spectral variants
+at one equal effort (throughput.py), and writes docs/peer.md, docs/peer.svg and the README table.
+With --throughput-only, only the samples per second (about a minute): no reference, no ladders;
+it rewrites only the throughput sections of docs/peer.md and of the README's race block.
 """
 
 import argparse
@@ -360,6 +364,9 @@ class Spectrace:
     def __init__(self, binary, work):
         self.binary, self.work = binary, work
         self.out = os.path.join(work, "spectrace")
+        # The wall time of the last render's whole process (start, scene load, probe, render,
+        # outputs written), beside the sidecar's render-only `wall_seconds`.
+        self.process_seconds = None
 
     def cached(self, tag, meta):
         """The image, time and work of an earlier render `tag` made with `meta`, or None."""
@@ -397,7 +404,9 @@ class Spectrace:
         with open(copy, "w") as f:
             json.dump(scene, f)
         cmd[2] = copy
+        started = time.perf_counter()
         done = subprocess.run(cmd, capture_output=True, text=True)
+        self.process_seconds = time.perf_counter() - started
         if done.returncode != 0:
             raise RuntimeError(f"spectrace failed: {' '.join(cmd)}\n{done.stderr}")
         xyz, sidecar = read_spectrace(out, name)
@@ -405,24 +414,36 @@ class Spectrace:
 
 
 class Mitsuba:
-    def __init__(self):
+    """Mitsuba renders in one variant: the race's JIT-compiled `llvm_ad_spectral` by default, or
+    another (the throughput's `scalar_spectral`), switched to before each render (Mitsuba 3 keeps
+    every variant loaded in one process). Only JIT variants are warmed up: scalar ones compile
+    nothing."""
+
+    def __init__(self, variant=VARIANT):
+        self.variant = variant
+        self.jit = variant.startswith(("llvm", "cuda"))
         self.scenes = {}
         self.warm = set()
+        self.compile_seconds = 0.0
 
     def render(self, scene, name, integrator, spp, seed):
+        """The XYZ image of `spp` samples per pixel and the seconds of the timed render."""
+        if mi.variant() != self.variant:
+            mi.set_variant(self.variant)
         key = (name, integrator)
         if key not in self.scenes:
             self.scenes[key] = mi.load_dict(translate(scene, {"type": integrator, "max_depth": 65}))
-            # Warm-up: trace and compile the kernels once (Dr.Jit caches them) so the timed
-            # renders measure rendering, not the LLVM compiler. Sample counts only ever grow:
-            # a render asking for fewer samples than the one before it was seen to render the
-            # earlier count (a 2-spp render after a 4-spp one had the 4-spp image and time).
-            t = time.perf_counter()
-            self._go(self.scenes[key], 1, 0)
-            self.warm.add((key, 1))
-            self.compile_seconds = time.perf_counter() - t
+            if self.jit:
+                # Warm-up: trace and compile the kernels once (Dr.Jit caches them) so the timed
+                # renders measure rendering, not the LLVM compiler. Sample counts only ever grow:
+                # a render asking for fewer samples than the one before it was seen to render the
+                # earlier count (a 2-spp render after a 4-spp one had the 4-spp image and time).
+                t = time.perf_counter()
+                self._go(self.scenes[key], 1, 0)
+                self.warm.add((key, 1))
+                self.compile_seconds = time.perf_counter() - t
         sc = self.scenes[key]
-        if (key, spp) not in self.warm:
+        if (key, spp) not in self.warm and self.jit:
             # Mitsuba's ptracer compiles a kernel per sample count: warm it up untimed too.
             self._go(sc, spp, seed + 100_000)
             self.warm.add((key, spp))
@@ -530,24 +551,40 @@ def race_scene(args, name, spectrace, mitsuba):
     }
 
 
-def main():
-    p = argparse.ArgumentParser(description=__doc__)
+def arguments():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--spectrace", required=True, help="the release `spectrace` binary")
     p.add_argument("--root", required=True, help="the workspace root")
     p.add_argument("--work", required=True, help="scratch directory (target/peer)")
-    p.add_argument("--scenes", default=",".join(SCENES))
+    p.add_argument("--scenes", default=",".join(SCENES), help="the race scenes, comma-separated")
     p.add_argument("--reference-scale", type=float, default=1.0, help="multiplies the references' times")
     p.add_argument("--max-seconds", type=float, default=30.0, help="stop a ladder after a render this long")
     p.add_argument("--overshoot", type=float, default=0.9, help="stop a ladder below overshoot x 5%%")
+    p.add_argument(
+        "--throughput-only",
+        action="store_true",
+        help="measure only the samples per second at equal spp (no reference, no ladders; about a "
+        "minute); writes target/peer/throughput.json and only the throughput sections of the docs",
+    )
+    p.add_argument(
+        "--throughput-spp",
+        type=int,
+        default=64,
+        help="the equal effort of the throughput: samples per pixel, and spp x pixels light paths",
+    )
+    p.add_argument("--throughput-reps", type=int, default=3, help="repetitions of the throughput (best kept)")
     p.add_argument("--no-docs", action="store_true", help="do not write docs/peer.md and the README")
     args = p.parse_args()
     args.scenes_dir = os.path.join(args.root, "xtask", "peer", "scenes")
-    os.makedirs(args.work, exist_ok=True)
+    return args
 
+
+def main():
+    args = arguments()
+    os.makedirs(args.work, exist_ok=True)
     mi.set_variant(VARIANT)
     dr.set_thread_count(THREADS)
     spectrace = Spectrace(args.spectrace, args.work)
-    mitsuba = Mitsuba()
     started = time.time()
     report = {
         "mitsuba": mi.__version__,
@@ -558,8 +595,16 @@ def main():
         "date": time.strftime("%Y-%m-%d"),
         "scenes": [],
     }
-    for name in args.scenes.split(","):
+    names = args.scenes.split(",")
+    import throughput
+
+    if args.throughput_only:
+        throughput.alone(args, report, spectrace, names, started)
+        return
+    mitsuba = Mitsuba()
+    for name in names:
         report["scenes"].append(race_scene(args, name, spectrace, mitsuba))
+    report["throughput"] = throughput.run(args, spectrace, names, race=report, rmse=True)
     report["total_seconds"] = time.time() - started
     with open(os.path.join(args.work, "results.json"), "w") as f:
         json.dump(report, f, indent=1)
@@ -584,6 +629,8 @@ def machine():
 
 
 if __name__ == "__main__":
+    # throughput.py imports this script as `peer`: let it find this module, not load a second copy.
+    sys.modules.setdefault("peer", sys.modules[__name__])
     try:
         main()
     except SceneError as e:

@@ -1,4 +1,5 @@
-"""docs/peer.md, docs/peer.svg and the README's race table from the race's results (peer.py)."""
+"""docs/peer.md, docs/peer.svg and the README's race table from the race's results (peer.py);
+the samples-per-second section and block come from throughput_docs.py."""
 
 import math
 import os
@@ -263,6 +264,11 @@ def write(report, root, method_path=None):
                     f"{sig(p['seconds'])} s: {100 * p['rmse']:.2f}%, mean {p['mean_ratio']:.4f} of the reference{extra}"
                 )
         parts.append("Ladders:\n\n" + "\n".join(pts) + "\n")
+    throughput = None
+    if report.get("throughput"):
+        import throughput_docs as throughput  # imported here: it needs Mitsuba, geometry.py does not
+
+        parts.append(throughput.section(report) + "\n")
     parts.append(method)
     path = os.path.join(docs, "peer.md")
     geometry = kept_geometry_section(path)
@@ -276,7 +282,9 @@ def write(report, root, method_path=None):
     section = (
         f"{README_BEGIN}\n{header(report)}\n\n{summary_table(report)}\n\nTargets (Spectrace's light "
         f"tracer in at most half of Mitsuba's `ptracer` time to 10%, Spectrace's best in at most half of "
-        f"Mitsuba's best):\n\n{targets_text(report)}\n{README_END}"
+        f"Mitsuba's best):\n\n{targets_text(report)}\n"
+        + (f"\n{throughput.readme_block(report)}\n" if throughput else "")
+        + README_END
     )
     if README_BEGIN in text and README_END in text:
         text = re.sub(re.escape(README_BEGIN) + ".*?" + re.escape(README_END), lambda _: section, text, flags=re.S)

@@ -22,8 +22,10 @@
 //!   (`tests/tests/fuzz.rs`) in release mode.
 //! - `cargo xtask peer [options]`: the race against Mitsuba 3 (`docs/peer.md`): builds a Python
 //!   virtual environment under the target directory with a pinned Mitsuba, then runs
-//!   `xtask/peer/peer.py`. Needs python3 with venv and pip, network access for the first install,
-//!   and a libLLVM of version 16 or newer. Never run by CI.
+//!   `xtask/peer/peer.py`: times to 10% and 5%, then samples per second at equal spp beside
+//!   Mitsuba's `llvm_ad_spectral` and `scalar_spectral` variants (`--throughput-only`: only
+//!   those, about a minute). Needs python3 with venv and pip, network access for the first
+//!   install, and a libLLVM of version 16 or newer. Never run by CI.
 //! - `cargo xtask peer --materials [options]`: the materials cross-check against Mitsuba 3
 //!   (`docs/materials-peer.md`, `xtask/peer/materials.py`), with the same prerequisites.
 //! - `cargo xtask peer --geometry [--rays N] [--reps K] [--cpu C] [--no-docs]`: the geometry
@@ -292,6 +294,8 @@ fn print_help() {
          fuzz [--cases N] [--seed S]  fuzz the scene and part-file loaders (release)\n  \
          peer [--scenes A,B] [--max-seconds S] [--reference-scale F] [--no-docs]\n           \
                   the race against Mitsuba 3 (docs/peer.md); needs python3, pip, libLLVM >= 16\n  \
+         peer --throughput-only [--scenes A,B] [--throughput-spp N] [--throughput-reps K] [--no-docs]\n           \
+                  only the race's samples/s at equal spp beside Mitsuba's llvm and scalar variants\n  \
          peer --materials [--spp N] [--seeds K] [--cases A,B] [--no-docs]\n           \
                   the materials cross-check against Mitsuba 3 (docs/materials-peer.md)\n  \
          peer --geometry [--rays N] [--reps K] [--cpu C] [--no-docs]\n           \

@@ -1,4 +1,5 @@
-//! `cargo xtask peer`: the race against Mitsuba 3 (method and results in `docs/peer.md`),
+//! `cargo xtask peer`: the race against Mitsuba 3 (method and results in `docs/peer.md`; with
+//! `--throughput-only`, only its samples per second at equal spp, passed on to `peer.py`),
 //! `cargo xtask peer --materials`: the materials cross-check (`docs/materials-peer.md`), and
 //! `cargo xtask peer --geometry`: the geometry benchmark beside Embree 4 (`docs/peer.md`).
 //!
@@ -324,6 +325,15 @@ mod tests {
         assert_eq!(chosen, Job { script: "peer.py", work: "peer", peer: Peer::Mitsuba });
         assert_eq!(rest, &race[..]);
         assert_eq!(job(&[]).0.script, "peer.py");
+    }
+
+    #[test]
+    fn throughput_only_is_the_race_script_s_flag() {
+        let args: Vec<String> =
+            ["--throughput-only", "--scenes", "cornell"].map(String::from).to_vec();
+        let (chosen, rest) = job(&args);
+        assert_eq!(chosen, Job { script: "peer.py", work: "peer", peer: Peer::Mitsuba });
+        assert_eq!(rest, &args[..]);
     }
 
     #[test]
