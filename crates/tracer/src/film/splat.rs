@@ -5,6 +5,9 @@ use std::sync::LazyLock;
 
 use spectrace_spectrum::{CIE_Y_INTEGRAL, Xyz, cmf};
 
+#[cfg(doc)]
+use super::{Film, FilmWriter};
+
 /// Where contributions go: a [`Film`] directly, or a [`FilmWriter`] that buffers them for a
 /// film shared between threads. The light tracer ([`crate::trace_chunk`]) writes through it.
 pub trait Splat {
