@@ -16,16 +16,18 @@
 //! the point is small and known. [`Hit::spawn_ray`] then offsets the next ray's origin just past
 //! that error along the normal, so a bounce never re-hits its own surface at `t ~ 0`, at the
 //! origin or `1e5` m away, without a scene-dependent epsilon. The BVH is built by `obvhs` from f32
-//! boxes rounded outwards from the exact f64 bounds, then converted into compact nodes traversed
-//! here with a conservative f32 slab test (the origin's f32 rounding widens the interval), so the
-//! BVH can only cost time, never a hit; candidates compute only `t`, and the full [`Hit`] is built
-//! once, for the nearest.
+//! boxes rounded outwards from the exact f64 bounds, then collapsed into 8-wide nodes whose boxes
+//! are tested together in SIMD lanes with a conservative f32 slab test (the origin's f32 rounding
+//! widens the interval), so the BVH can only cost time, never a hit; a leaf's triangles are
+//! filtered four at a time by the watertight test's first half in SIMD (the scalar test's own
+//! arithmetic per lane), and the full [`Hit`] is built once, for the nearest.
 //!
 //! For emitting objects, [`Shape::area`] and [`Shape::sample_area`] draw a [`SurfacePoint`]
 //! uniformly by area on any shape (the torus by inverting its tube-angle CDF, meshes by a
 //! cumulative-area table built with the mesh).
 //!
-//! Layering: this crate depends on none of Spectrace's crates.
+//! Layering: of Spectrace's crates this one depends only on `spectrace-sampling` (shading frames,
+//! bounded file reading).
 
 pub mod bench_scenes;
 mod bounds;
