@@ -25,7 +25,6 @@ import datetime
 import json
 import os
 import platform
-import re
 import statistics
 import subprocess
 import sys
@@ -36,6 +35,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from peer_docs import GEOMETRY_BEGIN as BEGIN  # noqa: E402  (the markers the race's report keeps)
 from peer_docs import GEOMETRY_END as END  # noqa: E402
+from peer_docs import replace_between  # noqa: E402
 
 TARGET = 0.6  # the target: Spectrace >= 0.6 x Embree's closest-hit rays/s on one core
 
@@ -250,10 +250,8 @@ def write_docs(root, section):
     with open(path) as f:
         text = f.read()
     block = f"{BEGIN}\n{section}{END}"
-    if BEGIN in text and END in text:
-        text = re.sub(re.escape(BEGIN) + ".*?" + re.escape(END), lambda _: block, text, flags=re.S)
-    else:
-        text = text.rstrip("\n") + "\n\n" + block + "\n"
+    replaced = replace_between(text, BEGIN, END, block)
+    text = replaced if replaced is not None else text.rstrip("\n") + "\n\n" + block + "\n"
     with open(path, "w") as f:
         f.write(text)
     print(f"wrote {path}", file=sys.stderr)

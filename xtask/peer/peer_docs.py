@@ -222,6 +222,14 @@ def targets_text(report):
     return "\n".join(lines)
 
 
+def replace_between(text, begin, end, block):
+    """`text` with the part from marker `begin` to marker `end` (markers included) replaced by
+    `block`, or None if it lacks either marker: the one place docs blocks are rewritten."""
+    if begin not in text or end not in text:
+        return None
+    return re.sub(re.escape(begin) + ".*?" + re.escape(end), lambda _: block, text, flags=re.S)
+
+
 def kept_geometry_section(path):
     """The geometry comparison's block (markers included) of the docs/peer.md at `path`, or ""."""
     try:
@@ -286,8 +294,9 @@ def write(report, root, method_path=None):
         + (f"\n{throughput.readme_block(report)}\n" if throughput else "")
         + README_END
     )
-    if README_BEGIN in text and README_END in text:
-        text = re.sub(re.escape(README_BEGIN) + ".*?" + re.escape(README_END), lambda _: section, text, flags=re.S)
+    replaced = replace_between(text, README_BEGIN, README_END, section)
+    if replaced is not None:
+        text = replaced
     else:
         text = text.rstrip("\n") + "\n\n## The race against Mitsuba 3\n\n" + section + "\n"
     with open(readme, "w") as f:

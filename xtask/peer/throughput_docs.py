@@ -3,9 +3,9 @@ docs/peer.md and a compact block inside the README's race block, both between ma
 `--throughput-only` can rewrite them alone."""
 
 import os
-import re
 
 import peer_docs
+from peer_docs import replace_between as replace
 from peer_docs import sig
 from throughput import PAIRS, VARIANTS, find, label, ratios
 
@@ -143,13 +143,6 @@ def readme_block(report):
         f"spot_plane and cornell, its light tracer at least 1x Mitsuba llvm `ptracer`'s paths/s):\n\n"
         f"{verdict_lines(t)}\n{README_END}"
     )
-
-
-def replace(text, begin, end, block):
-    """`text` with the part from `begin` to `end` replaced by `block`, or None if it has none."""
-    if begin not in text or end not in text:
-        return None
-    return re.sub(re.escape(begin) + ".*?" + re.escape(end), lambda _: block, text, flags=re.S)
 
 
 def refresh_method(text, method):
