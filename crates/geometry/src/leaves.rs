@@ -37,13 +37,14 @@ struct Slot {
     kind: SlotKind,
 }
 
-/// One leaf: its slots `first..first + count`, its first packet (one per four slots) and
-/// whether it holds any analytic shape.
+/// One leaf: its slots `first..first + count`, its packets `packet..packet + packets` (one per
+/// four slots, none when the leaf holds no triangle) and whether it holds any analytic shape.
 #[derive(Debug, Clone, Copy)]
 struct LeafRecord {
     first: u32,
     count: u32,
     packet: u32,
+    packets: u32,
     analytic: bool,
 }
 
@@ -96,12 +97,16 @@ impl Leaves {
             .iter()
             .map(|leaf| {
                 let range = leaf.first as usize..(leaf.first + leaf.count) as usize;
+                let (kinds, vertices) = (&slots[range.clone()], &vertices[range]);
                 let packet = packets.len() as u32;
-                for chunk in range.clone().collect::<Vec<_>>().chunks(LANES) {
-                    packets.push(packet_of(chunk.iter().map(|&s| (slots[s].kind, vertices[s]))));
+                if kinds.iter().any(|s| s.kind == SlotKind::Triangle) {
+                    for (k, v) in kinds.chunks(LANES).zip(vertices.chunks(LANES)) {
+                        packets.push(packet_of(k.iter().map(|s| s.kind).zip(v.iter().copied())));
+                    }
                 }
-                let analytic = slots[range].iter().any(|s| s.kind == SlotKind::Analytic);
-                LeafRecord { first: leaf.first, count: leaf.count, packet, analytic }
+                let packets = packets.len() as u32 - packet;
+                let analytic = kinds.iter().any(|s| s.kind == SlotKind::Analytic);
+                LeafRecord { first: leaf.first, count: leaf.count, packet, packets, analytic }
             })
             .collect();
         let has_triangles = slots.iter().any(|s| s.kind == SlotKind::Triangle);
@@ -214,11 +219,11 @@ impl Leaves {
         }
     }
 
-    /// The packets of a leaf's slots.
+    /// The packets of a leaf's slots (none for a leaf without triangles).
     #[inline(always)]
     fn packets_of(&self, record: LeafRecord) -> &[Triangles4] {
-        let n = (record.count as usize).div_ceil(LANES);
-        &self.packets[record.packet as usize..record.packet as usize + n]
+        let first = record.packet as usize;
+        &self.packets[first..first + record.packets as usize]
     }
 
     /// The analytic slots of a leaf.
