@@ -6,6 +6,7 @@ mod fluorescence;
 mod fuzz;
 mod hostile;
 mod integrators;
+mod kernels;
 mod photometry;
 mod rendering;
 mod rough_materials;

@@ -21,7 +21,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use spectrace_tracer::{EffectsMode, IntegratorChoice};
+use spectrace_tracer::{EffectsMode, IntegratorChoice, Kernel};
 
 use crate::{RenderOptions, merge_parts, render_file};
 
@@ -50,6 +50,10 @@ enum Command {
         /// settings.integrator).
         #[arg(long, value_parser = parse_integrator)]
         integrator: Option<IntegratorChoice>,
+        /// The kernel of the path tracer's camera paths: batched (the default) or scalar, the
+        /// reference (overrides settings.kernel; the image is the same).
+        #[arg(long, value_parser = parse_kernel)]
+        kernel: Option<Kernel>,
         /// Render for this many seconds instead of a fixed number of beams (with
         /// --target-error: at most this long).
         #[arg(long, allow_negative_numbers = true, value_parser = parse_seconds)]
@@ -128,6 +132,11 @@ enum Command {
         #[arg(long, default_value = "out")]
         out: PathBuf,
     },
+}
+
+/// A kernel name.
+fn parse_kernel(s: &str) -> Result<Kernel, String> {
+    Kernel::from_name(s).ok_or_else(|| format!("`{s}`: must be batched or scalar"))
 }
 
 /// An integrator name.
@@ -336,8 +345,10 @@ where
             spp,
             integrator,
             target_error,
+            kernel,
         } => {
             let options = RenderOptions {
+                kernel,
                 target_error,
                 spp,
                 integrator,

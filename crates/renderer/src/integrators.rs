@@ -6,8 +6,8 @@
 //! are said elsewhere.
 
 use spectrace_tracer::{
-    Effects, INTEGRATORS, Integrator, IntegratorChoice, IntegratorSettings, LightTracerScene,
-    build_integrator, registered,
+    Effects, INTEGRATORS, Integrator, IntegratorChoice, IntegratorSettings, Kernel,
+    LightTracerScene, build_integrator, registered,
 };
 
 use crate::Scene;
@@ -78,11 +78,31 @@ pub fn with_integrator_filling<R>(
     sensors: bool,
     f: impl FnOnce(&dyn Integrator) -> R,
 ) -> R {
+    with_kernel(scene, choice, effects, sensors, scene.settings.kernel, f)
+}
+
+/// As [`with_integrator_filling`], with the path tracer's camera paths traced by `kernel`.
+pub(crate) fn with_kernel<R>(
+    scene: &Scene,
+    choice: IntegratorChoice,
+    effects: Effects,
+    sensors: bool,
+    kernel: Kernel,
+    f: impl FnOnce(&dyn Integrator) -> R,
+) -> R {
     let none = spectrace_tracer::SensorSet::default();
     let tracer_scene =
         if sensors { tracer_scene(scene) } else { tracer_scene(scene).with_sensors(&none) };
-    let integrator = build_integrator(choice, &tracer_scene, &integrator_settings(scene), effects);
+    let mut settings = integrator_settings(scene);
+    settings.path.kernel = kernel;
+    let integrator = build_integrator(choice, &tracer_scene, &settings, effects);
     f(integrator.as_ref())
+}
+
+/// The kernel that traces `choice`'s paths given the path tracer's `kernel` setting: only the
+/// path tracer has a batched kernel; the others are scalar.
+pub(crate) fn kernel_of(choice: IntegratorChoice, kernel: Kernel) -> Kernel {
+    if choice == IntegratorChoice::Path { kernel } else { Kernel::Scalar }
 }
 
 #[cfg(test)]

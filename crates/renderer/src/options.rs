@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use spectrace_tracer::{EffectsMode, IntegratorChoice};
+use spectrace_tracer::{EffectsMode, IntegratorChoice, Kernel};
 
 use crate::SceneError;
 
@@ -35,6 +35,8 @@ pub struct RenderOptions {
     /// Render until the estimated relative error reaches this (overrides
     /// `settings.target_error`).
     pub target_error: Option<f64>,
+    /// The kernel of the path tracer's camera paths (overrides `settings.kernel`).
+    pub kernel: Option<Kernel>,
 }
 
 /// Why a render failed.

@@ -1,7 +1,9 @@
 //! What a render did: the JSON sidecar's contents ([`RenderReport`]) and its accuracy estimate.
 
 use serde::{Deserialize, Serialize};
-use spectrace_tracer::{Effects, LightTracer, RenderOutput, RenderPlan, SamplerKind, TraceStats};
+use spectrace_tracer::{
+    Effects, Kernel, LightTracer, RenderOutput, RenderPlan, SamplerKind, TraceStats,
+};
 
 use crate::warnings::rejected_warning;
 use crate::{SensorReport, Written};
@@ -32,6 +34,10 @@ pub struct RenderReport {
     /// Where the random numbers came from (`settings.sampler`): `"independent"` or `"sobol"`.
     #[serde(default = "independent_sampler")]
     pub sampler: String,
+    /// The kernel that traced the paths (`settings.kernel`, `--kernel`): `"batched"` or
+    /// `"scalar"` (the light tracer and BDPT are scalar).
+    #[serde(default = "scalar_kernel")]
+    pub kernel: String,
     /// Beams traced.
     pub beams: u64,
     /// Wall time (s).
@@ -180,6 +186,11 @@ fn light_integrator() -> String {
     LightTracer::NAME.to_owned()
 }
 
+/// The kernel of sidecars written before the field existed: one path at a time.
+fn scalar_kernel() -> String {
+    Kernel::Scalar.name().to_owned()
+}
+
 /// The sampler of sidecars written before the field existed.
 fn independent_sampler() -> String {
     SamplerKind::Independent.name().to_owned()
@@ -211,6 +222,7 @@ pub(crate) fn report(
         integrator: integrator.to_owned(),
         integrator_reason: String::new(),
         sampler: independent_sampler(),
+        kernel: scalar_kernel(),
         beams: output.beams,
         wall_seconds: wall,
         beams_per_second: if wall > 0.0 { output.beams as f64 / wall } else { 0.0 },

@@ -5,8 +5,10 @@ use std::path::Path;
 
 use spectrace_lights::LightSource;
 use spectrace_tracer::{
-    Effects, Integrator, IntegratorChoice, MemoryLimit, RenderOutput, RenderPlan, render,
+    Effects, Integrator, IntegratorChoice, Kernel, MemoryLimit, RenderOutput, RenderPlan, render,
 };
+
+use crate::integrators::{kernel_of, with_kernel};
 
 use crate::plan::scene_normalisation;
 use crate::progress::render_with_progress;
@@ -19,7 +21,7 @@ use crate::{
     LoadOptions, MAX_PART_BYTES, PARTIAL_VERSION, PartialFilm, ProbeOutcome, RenderError,
     RenderOptions, RenderReport, Scene, Written, check_sensor_names, choose_integrator,
     decide_effects, image, plan_with, planned_sensor_outputs, probe_with, sensor_summary,
-    with_integrator, with_integrator_filling, write_outputs,
+    write_outputs,
 };
 
 /// Renders a scene file with overrides and writes its outputs (or, with a shard, its partial film).
@@ -54,8 +56,12 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
         eprintln!("{}", effects.summary());
         eprintln!("integrator: {reason}");
     }
-    with_integrator_filling(scene, choice, effects, plan.shard.is_none(), |tracer| {
-        let setup = Setup { choice, reason: &reason, effects, plan, name: &name };
+    let kernel = options.kernel.unwrap_or(scene.settings.kernel);
+    if options.verbose && choice == IntegratorChoice::Path {
+        eprintln!("kernel: {}", kernel.name());
+    }
+    with_kernel(scene, choice, effects, plan.shard.is_none(), kernel, |tracer| {
+        let setup = Setup { choice, reason: &reason, effects, plan, name: &name, kernel };
         render_with(scene, options, &setup, estimate_warning.into_iter().collect(), tracer)
     })
 }
@@ -127,8 +133,10 @@ pub fn render_in_memory(
     let (choice, _) = choose_integrator(scene, options.integrator);
     let plan = plan_with(scene, options, choice)?;
     let effects = decide_effects(scene, options.effects);
-    let output = with_integrator(scene, choice, effects, |tracer| render(tracer, &plan, &|_| {}))
-        .map_err(|e| RenderError::Options(e.to_string()))?;
+    let kernel = options.kernel.unwrap_or(scene.settings.kernel);
+    let output =
+        with_kernel(scene, choice, effects, true, kernel, |tracer| render(tracer, &plan, &|_| {}))
+            .map_err(|e| RenderError::Options(e.to_string()))?;
     scene.lights.reset_count();
     let image = image(&output, scene_normalisation(scene, choice));
     Ok(InMemoryRender { output, image, integrator: choice })
@@ -141,6 +149,8 @@ struct Setup<'a> {
     effects: Effects,
     plan: RenderPlan,
     name: &'a str,
+    /// The path tracer's kernel (the setting, or its command-line override).
+    kernel: Kernel,
 }
 
 /// The rest of [`render_scene`], once the estimator is built; `warnings` are the ones found so
@@ -212,6 +222,7 @@ impl Finished<'_> {
         );
         r.integrator_reason = setup.reason.to_owned();
         r.sampler = scene.settings.sampler.name().to_owned();
+        r.kernel = kernel_of(setup.choice, setup.kernel).name().to_owned();
         r
     }
 }

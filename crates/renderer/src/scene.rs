@@ -14,8 +14,8 @@ use spectrace_materials::Material;
 use spectrace_spectrum::Reflectance;
 use spectrace_tracer::{
     BdptSettings, CameraWavelengths, DEFAULT_CHUNK_BEAMS, EffectsMode, Emitter, IntegratorChoice,
-    LightTracerSettings, MAX_DEPTH, ObjectEmission, ObjectLight, PathTracerSettings, PinholeCamera,
-    RenderPlan, SamplerKind, SceneFeatures,
+    Kernel, LightTracerSettings, MAX_DEPTH, ObjectEmission, ObjectLight, PathTracerSettings,
+    PinholeCamera, RenderPlan, SamplerKind, SceneFeatures,
 };
 use spectrace_tracer::{IrradianceSensor, SensorSet};
 
@@ -112,6 +112,10 @@ pub struct Settings {
     /// Render until the estimated relative RMSE of the image is at most this (e.g. `0.05`),
     /// instead of a fixed number of beams or samples; `time_seconds` caps it.
     pub target_error: Option<f64>,
+    /// Which kernel traces the path tracer's camera paths: `"batched"` (many paths stage by
+    /// stage, the default) or `"scalar"` (one path at a time, the reference); the image is the
+    /// same, bit for bit.
+    pub kernel: Kernel,
 }
 
 impl Default for Settings {
@@ -132,6 +136,7 @@ impl Default for Settings {
             camera_wavelengths: CameraWavelengths::Visible,
             sampler: SamplerKind::Independent,
             target_error: None,
+            kernel: Kernel::Batched,
         }
     }
 }
@@ -398,6 +403,7 @@ impl Scene {
             max_depth: self.settings.max_depth,
             rr_depth: self.settings.rr_depth,
             wavelengths: self.settings.camera_wavelengths,
+            kernel: self.settings.kernel,
         }
     }
 

@@ -19,6 +19,7 @@ fn negative_and_malformed_numbers_are_explained() {
         (&["render", "x.json", "--threads", "-2"][..], "--threads", "whole number of threads"),
         (&["render", "x.json", "--seed", "-3"][..], "--seed", "whole number"),
         (&["bench", "x.json", "--beams", "-1"][..], "--beams", "whole number"),
+        (&["render", "x.json", "--kernel", "simd"][..], "--kernel", "batched or scalar"),
     ];
     for (args, option, cause) in cases {
         let (code, err) = spectrace(args);

@@ -35,6 +35,7 @@
 //! are independent, the render loop also estimates the image's error as it goes, from the spread
 //! between chunks ([`Moments`]), with no reference.
 
+mod batch;
 mod camera;
 mod effects;
 mod film;
@@ -49,6 +50,7 @@ mod stats;
 mod wavelengths;
 
 // The scene and what it is made of.
+pub use batch::{Kernel, LANES};
 pub use camera::{
     CameraError, CameraRay, CameraRepr, CameraSample, FovAxis, PinholeCamera, Projection,
 };

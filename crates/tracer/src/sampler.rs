@@ -11,9 +11,15 @@
 //! - the path tracer and BDPT: stream = the pixel, index = the pass (the chunk), so the samples
 //!   of one pixel over the passes are the points of one sequence, stratified pixel by pixel.
 //!
+//! Camera paths each have a stream of their own ([`ChunkSampler::for_path`]): the independent
+//! stream of `(seed, pass, pixel)`, or the Sobol point over it, so a camera path's result does
+//! not depend on which paths were traced before it or beside it (the batched kernel interleaves
+//! them). Light paths draw from their chunk's stream, one after the other.
+//!
 //! Both depend only on the seed and the chunk, so images stay bit-identical for any thread count
 //! or shard split. Draws past the sampler's table (256 dimensions), the low bits of every draw
-//! and draws outside a path come from the chunk's independent stream (`chunk_rng`).
+//! and draws outside a path come from the independent stream (`chunk_rng`, or the camera path's
+//! own).
 //! Lights that draw a variable number of uniforms (rejection loops) shift the dimensions of the
 //! rest of their path: unbiased, but those draws lose their stratification.
 
@@ -33,6 +39,21 @@ pub(crate) fn chunk_rng(seed: u64, chunk: u64) -> Pcg64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     Pcg64::seed_from_u64(z ^ (z >> 31))
+}
+
+/// The independent stream of item `item` of chunk `chunk` of a render with seed `seed` (a camera
+/// path's own stream): unrelated to every chunk stream and to every other item's.
+pub(crate) fn path_rng(seed: u64, chunk: u64, item: u64) -> Pcg64 {
+    let z = split_mix(split_mix(seed ^ 0x5851_F42D_4C95_7F2D) ^ chunk);
+    Pcg64::seed_from_u64(split_mix(z ^ item.wrapping_mul(0xD6E8_FEB8_6659_FD93)))
+}
+
+/// SplitMix64's finaliser of `x` (after its increment).
+fn split_mix(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
 }
 
 /// Which random numbers the integrators draw (`settings.sampler` in scene files).
@@ -72,6 +93,22 @@ impl ChunkSampler {
         match kind {
             SamplerKind::Independent => Self::Independent(rng),
             SamplerKind::Sobol => Self::Sobol(SobolSampler::new(seed, rng)),
+        }
+    }
+
+    /// The sampler of one camera path, item `item` of pass (chunk) `chunk` of a render with seed
+    /// `seed`, already started: its own independent stream ([`path_rng`]), or point `chunk` of
+    /// the item's Sobol sequence over it. It depends on nothing else, so a path gives the same
+    /// result whichever paths are traced before it or beside it.
+    pub fn for_path(kind: SamplerKind, seed: u64, chunk: u64, item: u64) -> Self {
+        let rng = path_rng(seed, chunk, item);
+        match kind {
+            SamplerKind::Independent => Self::Independent(rng),
+            SamplerKind::Sobol => {
+                let mut sobol = SobolSampler::new(seed, rng);
+                sobol.start_path(item, chunk);
+                Self::Sobol(sobol)
+            }
         }
     }
 
@@ -125,6 +162,24 @@ mod tests {
         for _ in 0..10 {
             assert_eq!(a.next_u64(), b.next_u64());
         }
+    }
+
+    #[test]
+    fn camera_path_streams_depend_on_seed_pass_and_item_alone() {
+        for kind in [SamplerKind::Independent, SamplerKind::Sobol] {
+            let mut a = ChunkSampler::for_path(kind, 3, 8, 5);
+            let mut b = ChunkSampler::for_path(kind, 3, 8, 5);
+            let first: Vec<u64> = (0..6).map(|_| a.next_u64()).collect();
+            assert_eq!(first, (0..6).map(|_| b.next_u64()).collect::<Vec<_>>(), "{kind:?}");
+            // Another item, pass or seed: another stream.
+            for (seed, chunk, item) in [(3, 8, 6), (3, 9, 5), (4, 8, 5)] {
+                let mut c = ChunkSampler::for_path(kind, seed, chunk, item);
+                assert_ne!(c.next_u64(), first[0], "{kind:?} {seed} {chunk} {item}");
+            }
+        }
+        // Unrelated to the chunk's own stream.
+        let mut chunk = chunk_rng(3, 8);
+        assert_ne!(path_rng(3, 8, 0).next_u64(), chunk.next_u64());
     }
 
     #[test]

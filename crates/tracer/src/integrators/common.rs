@@ -201,21 +201,59 @@ impl End<'_> {
 /// same policy with the lens sample's direction).
 #[inline(always)]
 pub(crate) fn unoccluded(scene: &LightTracerScene<'_>, from: End<'_>, to: End<'_>) -> bool {
-    let origin = from.offset_towards(to.point());
-    let target = to.offset_towards(from.point());
-    let d = target - origin;
-    let distance = d.length();
-    if !(distance > 0.0 && distance.is_finite()) {
-        return distance == 0.0;
+    ShadowRay::between(from, to).visible(scene)
+}
+
+/// The shadow ray between two [`End`]s, built apart from its test so that a batched kernel can
+/// queue it ([`unoccluded`] is both steps).
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum ShadowRay {
+    /// No ray is needed: the ends coincide (visible) or are not a finite distance apart.
+    Decided(bool),
+    /// Test `ray` up to `reach`, skipping light `skip`'s own surface where it leaves a light.
+    Ray {
+        /// The ray, from the offset origin towards the other end.
+        ray: Ray,
+        /// How far it must be clear.
+        reach: f64,
+        /// The light it leaves from, whose surface does not occlude it.
+        skip: Option<LightId>,
+    },
+}
+
+impl ShadowRay {
+    /// The shadow ray from `from` to `to` under the module's epsilon policy.
+    #[inline(always)]
+    pub(crate) fn between(from: End<'_>, to: End<'_>) -> Self {
+        let origin = from.offset_towards(to.point());
+        let target = to.offset_towards(from.point());
+        let d = target - origin;
+        let distance = d.length();
+        if !(distance > 0.0 && distance.is_finite()) {
+            return Self::Decided(distance == 0.0);
+        }
+        let ray = Ray { origin, direction: d / distance };
+        let reach = match to {
+            End::Surface(_) => distance,
+            End::Light(..) | End::Point(_) => distance * (1.0 - SHADOW_EPSILON),
+        };
+        let skip = match from {
+            End::Light(id, _) => Some(id),
+            End::Surface(_) | End::Point(_) => None,
+        };
+        Self::Ray { ray, reach, skip }
     }
-    let ray = Ray { origin, direction: d / distance };
-    let reach = match to {
-        End::Surface(_) => distance,
-        End::Light(..) | End::Point(_) => distance * (1.0 - SHADOW_EPSILON),
-    };
-    match from {
-        End::Light(id, _) => scene.intersect_from_light(&ray, id, reach).is_none(),
-        End::Surface(_) | End::Point(_) => !scene.world.occluded(&ray, reach),
+
+    /// Whether nothing blocks it.
+    #[inline(always)]
+    pub(crate) fn visible(&self, scene: &LightTracerScene<'_>) -> bool {
+        match *self {
+            Self::Decided(visible) => visible,
+            Self::Ray { ray, reach, skip: Some(id) } => {
+                scene.intersect_from_light(&ray, id, reach).is_none()
+            }
+            Self::Ray { ray, reach, skip: None } => !scene.world.occluded(&ray, reach),
+        }
     }
 }
 

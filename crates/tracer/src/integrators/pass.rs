@@ -3,7 +3,9 @@
 //!
 //! Item `i` of pass `c` is `(i + pass_start(c)) mod items`: whole passes cover every item once,
 //! and the one-item chunks of the pre-render probe spread over the image. Each item starts its
-//! own path in the chunk's sampler (Sobol: point `c` of the item's own sequence). A pass is never
+//! //! own path with a sampler of its own ([`ChunkSampler::for_path`]: the stream of `(seed, c, i)`;
+//! Sobol: point `c` of the item's own sequence), so its result does not depend on the items
+//! traced before it or beside it. A pass is never
 //! cut short, so every pixel has the same sample count and the image is their plain mean:
 //! `image = film x power x items / samples` ([`camera_image_scale`]).
 
@@ -44,7 +46,19 @@ pub(crate) trait PassEstimator: Send + Sync {
     /// from the chunk's stream outside any path.
     fn start_pass(&self, _rng: &mut ChunkSampler, _film: &mut dyn Splat, _stats: &mut TraceStats) {}
 
-    /// One sample of item `item`, its path already started in `rng`.
+    /// Renders the `work.items` items of pass `work.chunk` into `film` (counted in
+    /// `stats.beams`): by default the scalar kernel, [`Self::sample`] for one item after the
+    /// other, each with its own sampler.
+    fn render_items(&self, work: ChunkWork, film: &mut dyn Splat) -> TraceStats {
+        let mut scratch = self.scratch();
+        let kind = self.scene().sampler();
+        run_pass(work.chunk, work.items, self.items(), |item, stats| {
+            let mut rng = ChunkSampler::for_path(kind, work.seed, work.chunk, item);
+            self.sample(item, &mut scratch, &mut rng, film, stats);
+        })
+    }
+
+    /// One sample of item `item`, drawing from `rng`, the path's own sampler.
     fn sample(
         &self,
         item: u64,
@@ -72,10 +86,7 @@ impl<E: PassEstimator> Integrator for E {
         if work.items >= items.max(1) {
             self.start_pass(&mut rng, film, &mut before);
         }
-        let mut scratch = self.scratch();
-        let mut stats = run_pass(&mut rng, work.chunk, work.items, items, |item, rng, stats| {
-            self.sample(item, &mut scratch, rng, film, stats);
-        });
+        let mut stats = self.render_items(work, film);
         stats.merge(&before);
         stats
     }
@@ -112,24 +123,24 @@ pub(crate) fn camera_image_scale(power: f64, items: u64, samples_done: u64) -> f
     if samples_done == 0 { 0.0 } else { power * items as f64 / samples_done as f64 }
 }
 
-/// Runs `samples` items of pass `chunk` over `items` items, drawing from `rng` (the chunk's
-/// sampler): `sample(item, rng, stats)` for each, with the item's path started in the sampler;
+/// The items of a chunk: `samples` items of pass `chunk` over `items` items, in order.
+pub(crate) fn pass_items(chunk: u64, samples: u64, items: u64) -> impl Iterator<Item = u64> {
+    let items = items.max(1);
+    let start = pass_start(chunk, items);
+    (0..samples).map(move |i| (i + start) % items)
+}
+
+/// Runs `samples` items of pass `chunk` over `items` items: `sample(item, stats)` for each;
 /// counts the items in `stats.beams`.
 pub(crate) fn run_pass(
-    rng: &mut ChunkSampler,
     chunk: u64,
     samples: u64,
     items: u64,
-    mut sample: impl FnMut(u64, &mut ChunkSampler, &mut TraceStats),
+    mut sample: impl FnMut(u64, &mut TraceStats),
 ) -> TraceStats {
     let mut stats = TraceStats::default();
-    let items = items.max(1);
-    let start = pass_start(chunk, items);
-    for i in 0..samples {
-        let item = (i + start) % items;
-        // Sobol: the item's own sequence, one point per pass.
-        rng.start_path(item, chunk);
-        sample(item, rng, &mut stats);
+    for item in pass_items(chunk, samples, items) {
+        sample(item, &mut stats);
         stats.beams += 1;
     }
     stats
@@ -143,8 +154,7 @@ mod tests {
     fn a_whole_pass_visits_every_item_once_from_a_scrambled_start() {
         for chunk in [0, 1, 7, 1000] {
             let mut seen = [0u32; 37];
-            let mut rng = ChunkSampler::new(crate::SamplerKind::Independent, 1, chunk);
-            let stats = run_pass(&mut rng, chunk, 37, 37, |item, _, _| {
+            let stats = run_pass(chunk, 37, 37, |item, _| {
                 seen[item as usize] += 1;
             });
             assert!(seen.iter().all(|&n| n == 1), "chunk {chunk}");

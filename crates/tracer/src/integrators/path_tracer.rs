@@ -48,13 +48,17 @@ use spectrace_lights::{LightId, LightSource};
 use spectrace_materials::{ExcitationSampler, Material, ScatterKind, Transport};
 
 use super::common::{
-    CameraSamples, Direction, End, SampleLayout, ScatterSamples, VertexSamples, choose_lobe,
-    connect_light_to_camera, power_heuristic, relative_throughput, roulette, sample_light,
-    unoccluded,
+    CameraSamples, Direction, End, SampleLayout, ScatterSamples, ShadowRay, VertexSamples,
+    choose_lobe, connect_light_to_camera, power_heuristic, relative_throughput, roulette,
+    sample_light,
 };
 use super::pass::{PassEstimator, pixel_of};
+use crate::batch::path::{PassSource, render_pass};
 use crate::light_sampler::LightSampler;
-use crate::{CameraWavelengths, ChunkSampler, Effects, HERO, LightTracerScene, Splat, TraceStats};
+use crate::{
+    CameraWavelengths, ChunkSampler, ChunkWork, Effects, HERO, Kernel, LightTracerScene, Splat,
+    TraceStats,
+};
 
 /// Settings of the path tracer.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -66,11 +70,18 @@ pub struct PathTracerSettings {
     pub rr_depth: u32,
     /// How camera paths draw their wavelengths.
     pub wavelengths: CameraWavelengths,
+    /// Which kernel traces the paths (the same image either way).
+    pub kernel: Kernel,
 }
 
 impl Default for PathTracerSettings {
     fn default() -> Self {
-        Self { max_depth: 64, rr_depth: 4, wavelengths: CameraWavelengths::Visible }
+        Self {
+            max_depth: 64,
+            rr_depth: 4,
+            wavelengths: CameraWavelengths::Visible,
+            kernel: Kernel::Batched,
+        }
     }
 }
 
@@ -90,15 +101,69 @@ pub struct PathTracer<'a> {
 /// A vertex as next-event estimation sees it: the hit, the direction back along the path and
 /// what scatters there.
 #[derive(Clone, Copy)]
-struct Shading<'h> {
-    hit: &'h Hit,
-    wo: DVec3,
-    material: &'h dyn Material,
+pub(crate) struct Shading<'h> {
+    /// The surface point.
+    pub hit: &'h Hit,
+    /// The direction back along the path.
+    pub wo: DVec3,
+    /// The lobe that scatters there.
+    pub material: &'h dyn Material,
+}
+
+/// A scattering vertex a path has reached ([`PathTracer::arrive`]): its lobe, its light
+/// uniforms and whether next-event estimation runs there.
+#[derive(Clone, Copy)]
+pub(crate) struct Vertex<'m> {
+    /// The lobe that scatters (the material, or the re-emission lobe).
+    pub material: &'m dyn Material,
+    /// The uniforms of next-event estimation's light choice.
+    pub light: [f64; 2],
+    /// The lobe is not specular: next-event estimation samples lights here.
+    pub next_event: bool,
+}
+
+/// One light next-event estimation samples: which, with what probability, from what uniforms.
+#[derive(Clone, Copy)]
+pub(crate) struct LightChoice {
+    /// The light.
+    pub id: LightId,
+    /// The probability it was chosen with.
+    pub pmf: f64,
+    /// The uniforms of the point on it.
+    pub u: [f64; 2],
+}
+
+/// A light sample seen from a vertex, waiting for its shadow ray.
+#[derive(Clone, Copy)]
+pub(crate) struct Connection {
+    /// The light.
+    pub id: LightId,
+    /// The direction from the vertex to the light.
+    pub wi: DVec3,
+    /// Intensity, cosine, inverse square and MIS weight over the light's probability.
+    pub g: f64,
+    /// The shadow ray that decides it.
+    pub shadow: ShadowRay,
+}
+
+/// A camera sample: its pixel, wavelengths and path.
+pub(crate) struct CameraPath {
+    /// Pixel column.
+    pub px: u32,
+    /// Pixel row.
+    pub py: u32,
+    /// The path's film wavelengths.
+    pub lambdas: [f64; HERO],
+    /// Their film weights (the hero's alone after a dispersive surface).
+    pub lambda_weights: [f64; HERO],
+    /// The path.
+    pub state: PathState,
 }
 
 /// The state of one camera path between bounces.
-struct PathState {
-    ray: Ray,
+pub(crate) struct PathState {
+    /// The ray it follows next.
+    pub ray: Ray,
     /// Throughput per hero wavelength.
     beta: [f64; HERO],
     /// Radiance gathered so far per hero wavelength.
@@ -210,6 +275,28 @@ impl<'a> PathTracer<'a> {
         u64::from(self.scene.camera.width()) * u64::from(self.scene.camera.height())
     }
 
+    /// Starts the camera sample of pixel `(px, py)`: its ray, wavelengths and state, from the
+    /// path's own sampler `rng`.
+    #[inline]
+    pub(crate) fn start(&self, px: u32, py: u32, rng: &mut ChunkSampler) -> CameraPath {
+        let u = CameraSamples::draw(&self.layout, rng);
+        let camera_ray = self.scene.camera.generate_ray(px, py, u.film, u.lens);
+        let ray = Ray { origin: camera_ray.origin, direction: camera_ray.direction };
+        let (lambdas, lambda_weights) = self.settings.wavelengths.sample_hero(u.wavelength);
+        CameraPath { px, py, lambdas, lambda_weights, state: PathState::new(ray, &lambdas) }
+    }
+
+    /// Adds a finished camera sample to the film.
+    #[inline]
+    pub(crate) fn finish(&self, path: &CameraPath, film: &mut dyn Splat) {
+        // The film holds radiance relative to the lights' total power (see `image_scale`).
+        let inv_power = 1.0 / self.scene.lights.power();
+        let radiance = &path.state.radiance;
+        let values: [f64; HERO] =
+            std::array::from_fn(|j| radiance[j] * path.lambda_weights[j] * inv_power);
+        film.splat_spectral(path.px, path.py, &path.lambdas, &values);
+    }
+
     /// The radiance estimate of one camera ray at the path's wavelengths, added to the film.
     fn sample_pixel(
         &self,
@@ -219,16 +306,9 @@ impl<'a> PathTracer<'a> {
         film: &mut dyn Splat,
         stats: &mut TraceStats,
     ) {
-        let u = CameraSamples::draw(&self.layout, rng);
-        let camera_ray = self.scene.camera.generate_ray(px, py, u.film, u.lens);
-        let ray = Ray { origin: camera_ray.origin, direction: camera_ray.direction };
-        let (lambdas, mut lambda_weights) = self.settings.wavelengths.sample_hero(u.wavelength);
-        let radiance = self.radiance(ray, &lambdas, &mut lambda_weights, rng, stats);
-        // The film holds radiance relative to the lights' total power (see `image_scale`).
-        let inv_power = 1.0 / self.scene.lights.power();
-        let values: [f64; HERO] =
-            std::array::from_fn(|j| radiance[j] * lambda_weights[j] * inv_power);
-        film.splat_spectral(px, py, &lambdas, &values);
+        let mut path = self.start(px, py, rng);
+        path.state = self.trace(path.state, &mut path.lambda_weights, rng, stats);
+        self.finish(&path, film);
     }
 
     /// Radiance arriving along `ray` at each of the path's wavelengths (spectral, W m^-2 sr^-1
@@ -242,59 +322,170 @@ impl<'a> PathTracer<'a> {
         rng: &mut dyn rand::Rng,
         stats: &mut TraceStats,
     ) -> [f64; HERO] {
-        let scene = self.scene;
-        let mut p = PathState::new(ray, lambdas);
-        while let Some(hit) = scene.world.intersect(&p.ray, f64::INFINITY) {
-            stats.hits += 1;
-            let wo = -p.ray.direction;
-            if let Some((light, le)) = scene.emitted(&hit, wo) {
-                let weight = if p.specular {
-                    1.0
-                } else {
-                    power_heuristic(p.prev_pdf, scene.emitter_pdf(p.prev_point, &hit))
-                };
-                p.add_emission(scene, light, le, weight);
-            }
-            if p.last_bounce {
-                break;
-            }
-            let Some(material) = scene.materials.get(hit.primitive as usize) else { break };
-            let u = VertexSamples::draw(&self.layout, rng);
-            let guide = self.excitation.get(hit.primitive as usize).and_then(Option::as_ref);
-            let direction = Direction::Adjoint(guide);
-            let Some(lobe) = choose_lobe(
-                material.as_ref(),
-                direction,
-                &mut p.transport,
-                &mut p.beta,
-                u.fluorescence,
-                stats,
-            ) else {
+        self.trace(PathState::new(ray, lambdas), lambda_weights, rng, stats).radiance
+    }
+
+    /// The scalar kernel: follows one path to its end, one vertex at a time, through the same
+    /// steps the batched kernel runs over many paths ([`Self::arrive`],
+    /// [`Self::connection`] and [`Self::connect`], [`Self::go_on`]).
+    fn trace(
+        &self,
+        mut p: PathState,
+        lambda_weights: &mut [f64; HERO],
+        rng: &mut dyn rand::Rng,
+        stats: &mut TraceStats,
+    ) -> PathState {
+        while let Some(hit) = self.scene.world.intersect(&p.ray, f64::INFINITY) {
+            let Some(vertex) = self.arrive(&mut p, &hit, lambda_weights, rng, stats) else {
                 break;
             };
-            let material = lobe.material();
-            if material.is_dispersive() && !p.collapsed {
-                p.collapse(lambda_weights);
-            }
-            if !material.is_specular() {
-                let at = Shading { hit: &hit, wo, material };
-                self.next_event(&mut p, &at, u.light, stats);
-                if !self.effects.continue_after_diffuse {
-                    // No light can come back to a non-specular surface by interreflection:
-                    // only an emitter seen by the BSDF-sampled ray remains (for MIS), and
-                    // without emitting surfaces not even that.
-                    p.last_bounce = true;
-                    if !scene.surfaces_emit() {
-                        break;
+            if vertex.next_event {
+                let at = Shading { hit: &hit, wo: -p.ray.direction, material: vertex.material };
+                self.for_each_light(vertex.light, |light| {
+                    if let Some(c) = self.connection(&p, &at, light)
+                        && c.shadow.visible(self.scene)
+                    {
+                        self.connect(&mut p, &at, &c, stats);
                     }
-                }
+                });
             }
-            let go = ScatterSamples::draw(rng, p.depth >= self.settings.rr_depth);
-            if !self.bounce(&mut p, &hit, material, &go, stats) {
+            if !self.go_on(&mut p, &hit, vertex, rng, stats) {
                 break;
             }
         }
-        p.radiance
+        p
+    }
+
+    /// A path reaches `hit`: the emission found there (weighted by MIS), then the vertex's
+    /// uniforms and its lobe (the fluorescence choice; a dispersive lobe collapses the
+    /// wavelengths). `None` when the path ends here.
+    #[inline]
+    pub(crate) fn arrive(
+        &self,
+        p: &mut PathState,
+        hit: &Hit,
+        lambda_weights: &mut [f64; HERO],
+        rng: &mut dyn rand::Rng,
+        stats: &mut TraceStats,
+    ) -> Option<Vertex<'a>> {
+        let scene = self.scene;
+        stats.hits += 1;
+        if let Some((light, le)) = scene.emitted(hit, -p.ray.direction) {
+            let weight = if p.specular {
+                1.0
+            } else {
+                power_heuristic(p.prev_pdf, scene.emitter_pdf(p.prev_point, hit))
+            };
+            p.add_emission(scene, light, le, weight);
+        }
+        if p.last_bounce {
+            return None;
+        }
+        let material = scene.materials.get(hit.primitive as usize)?;
+        let u = VertexSamples::draw(&self.layout, rng);
+        let guide = self.excitation.get(hit.primitive as usize).and_then(Option::as_ref);
+        let lobe = choose_lobe(
+            material.as_ref(),
+            Direction::Adjoint(guide),
+            &mut p.transport,
+            &mut p.beta,
+            u.fluorescence,
+            stats,
+        )?;
+        let material = lobe.material();
+        if material.is_dispersive() && !p.collapsed {
+            p.collapse(lambda_weights);
+        }
+        Some(Vertex { material, light: u.light, next_event: !material.is_specular() })
+    }
+
+    /// Calls `f` with every light next-event estimation samples at a vertex whose light
+    /// uniforms are `u`: every delta-position light (points, spots) once, with probability 1 and
+    /// the centre of the unit square, and one area light chosen by the scene's light sampler.
+    #[inline]
+    pub(crate) fn for_each_light(&self, u: [f64; 2], mut f: impl FnMut(LightChoice)) {
+        for &id in self.scene.delta_lights() {
+            f(LightChoice { id, pmf: 1.0, u: [0.5, 0.5] });
+        }
+        if let Some(chosen) = self.scene.area_lights().sample(u[0]) {
+            f(LightChoice { id: chosen.id, pmf: chosen.pmf, u: [chosen.u, u[1]] });
+        }
+    }
+
+    /// Next-event estimation's light sample `light` seen from the vertex `at`, weighted by the
+    /// power heuristic against BSDF sampling (fully for a delta light), with the shadow ray that
+    /// decides it; `None` when it gives no light whatever the shadow ray finds.
+    #[inline]
+    pub(crate) fn connection(
+        &self,
+        p: &PathState,
+        at: &Shading<'_>,
+        light: LightChoice,
+    ) -> Option<Connection> {
+        let Shading { hit, wo, material } = *at;
+        let LightChoice { id, pmf, u } = light;
+        let sample = sample_light(self.scene, id, hit.point, u)?;
+        let wi = -sample.direction;
+        let n = hit.shading_normal;
+        let cos = wi.dot(n).abs();
+        if !(cos > 0.0 && pmf > 0.0) {
+            return None;
+        }
+        let weight = if sample.delta {
+            1.0
+        } else {
+            power_heuristic(pmf * sample.pdf, material.pdf(wo, wi, n, p.transport[0]))
+        };
+        if !(weight > 0.0) {
+            return None;
+        }
+        let g = sample.intensity * cos / (sample.distance * sample.distance * pmf) * weight;
+        let shadow = ShadowRay::between(End::Surface(hit), End::Light(id, sample.position));
+        Some(Connection { id, wi, g, shadow })
+    }
+
+    /// Adds an unoccluded connection's light to the path's radiance.
+    #[inline]
+    pub(crate) fn connect(
+        &self,
+        p: &mut PathState,
+        at: &Shading<'_>,
+        c: &Connection,
+        stats: &mut TraceStats,
+    ) {
+        stats.splats += 1;
+        let Some(spd) = p.light_values(self.scene, c.id) else { return };
+        let mut f = [0.0; HERO];
+        let n = at.hit.shading_normal;
+        at.material.eval_bundle(c.wi, at.wo, n, &p.transport, Transport::Radiance, &mut f);
+        for (j, f) in f.into_iter().enumerate() {
+            if p.beta[j] != 0.0 && f > 0.0 {
+                p.radiance[j] += p.beta[j] * f * c.g * spd[j];
+            }
+        }
+    }
+
+    /// After next-event estimation at `vertex`: whether the path goes on (without
+    /// interreflection, only the emission the BSDF-sampled ray hits is still wanted, and without
+    /// emitting surfaces not even that), then the vertex's scatter uniforms, the BSDF sample and
+    /// Russian roulette. `false` when the path ends here.
+    #[inline]
+    pub(crate) fn go_on(
+        &self,
+        p: &mut PathState,
+        hit: &Hit,
+        vertex: Vertex<'_>,
+        rng: &mut dyn rand::Rng,
+        stats: &mut TraceStats,
+    ) -> bool {
+        if vertex.next_event && !self.effects.continue_after_diffuse {
+            p.last_bounce = true;
+            if !self.scene.surfaces_emit() {
+                return false;
+            }
+        }
+        let go = ScatterSamples::draw(rng, p.depth >= self.settings.rr_depth);
+        self.bounce(p, hit, vertex.material, &go, stats)
     }
 
     /// The BSDF sample and Russian roulette at a vertex (after its next-event estimation);
@@ -340,59 +531,6 @@ impl<'a> PathTracer<'a> {
         }
         p.ray = hit.spawn_ray(scattered.direction);
         true
-    }
-
-    /// Next-event estimation at a non-specular vertex `at`: every delta-position light
-    /// (points, spots) once, and one area light chosen by the scene's light sampler, weighted by
-    /// the power heuristic against BSDF sampling; added to the path's radiance.
-    fn next_event(&self, p: &mut PathState, at: &Shading<'_>, u: [f64; 2], stats: &mut TraceStats) {
-        for &id in self.scene.delta_lights() {
-            self.connect_light(p, at, (id, 1.0), [0.5, 0.5], stats);
-        }
-        if let Some(chosen) = self.scene.area_lights().sample(u[0]) {
-            self.connect_light(p, at, (chosen.id, chosen.pmf), [chosen.u, u[1]], stats);
-        }
-    }
-
-    /// One light sample of light `id` (chosen with probability `pmf`) seen from the vertex `at`,
-    /// weighted by the power heuristic against BSDF sampling (fully for a delta light), added
-    /// to the path's radiance.
-    fn connect_light(
-        &self,
-        p: &mut PathState,
-        at: &Shading<'_>,
-        (id, pmf): (LightId, f64),
-        u: [f64; 2],
-        stats: &mut TraceStats,
-    ) {
-        let Shading { hit, wo, material } = *at;
-        let scene = self.scene;
-        let Some(sample) = sample_light(scene, id, hit.point, u) else { return };
-        let wi = -sample.direction;
-        let n = hit.shading_normal;
-        let cos = wi.dot(n).abs();
-        if !(cos > 0.0 && pmf > 0.0) {
-            return;
-        }
-        let weight = if sample.delta {
-            1.0
-        } else {
-            power_heuristic(pmf * sample.pdf, material.pdf(wo, wi, n, p.transport[0]))
-        };
-        if !(weight > 0.0) || !unoccluded(scene, End::Surface(hit), End::Light(id, sample.position))
-        {
-            return;
-        }
-        stats.splats += 1;
-        let Some(spd) = p.light_values(scene, id) else { return };
-        let g = sample.intensity * cos / (sample.distance * sample.distance * pmf) * weight;
-        let mut f = [0.0; HERO];
-        material.eval_bundle(wi, wo, n, &p.transport, Transport::Radiance, &mut f);
-        for (j, f) in f.into_iter().enumerate() {
-            if p.beta[j] != 0.0 && f > 0.0 {
-                p.radiance[j] += p.beta[j] * f * g * spd[j];
-            }
-        }
     }
 
     /// Point and spot lights seen directly: a camera ray never hits a point, but the pixel a
@@ -441,6 +579,29 @@ impl PassEstimator for PathTracer<'_> {
 
     fn start_pass(&self, rng: &mut ChunkSampler, film: &mut dyn Splat, stats: &mut TraceStats) {
         self.splat_delta_lights(rng, film, stats);
+    }
+
+    fn render_items(&self, work: ChunkWork, film: &mut dyn Splat) -> TraceStats {
+        let scene = self.scene;
+        let items = self.items();
+        let passes = super::pass::pass_items(work.chunk, work.items, items);
+        match self.settings.kernel {
+            Kernel::Batched => {
+                let width = u64::from(scene.camera.width());
+                let source =
+                    PassSource { kind: scene.sampler(), seed: work.seed, chunk: work.chunk, width };
+                let mut stats = TraceStats::default();
+                render_pass(self, source, passes, film, &mut stats);
+                stats
+            }
+            Kernel::Scalar => {
+                super::pass::run_pass(work.chunk, work.items, items, |item, stats| {
+                    let mut rng =
+                        ChunkSampler::for_path(scene.sampler(), work.seed, work.chunk, item);
+                    self.sample(item, &mut (), &mut rng, film, stats);
+                })
+            }
+        }
     }
 
     fn sample(
