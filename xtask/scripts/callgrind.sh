@@ -36,6 +36,8 @@ ONLY=${ONLY:-}
 [[ -x $BIN ]] || { echo "error: $BIN is not an executable" >&2; exit 2; }
 
 # scene file (relative to $SCENES) | integrator | effort option | N (2N is also run) | items per unit of N
+# An integrator written `path:batched` renders with `--kernel batched` (the path tracer's batched
+# kernel; plain `path` is the default scalar kernel).
 # Light tracer: N beams, a multiple of the 16,384-beam chunk, so 2N is exactly twice the chunks.
 # Camera integrators: N samples per pixel; items = N x width x height of the quarter scene.
 CASES=(
@@ -43,7 +45,9 @@ CASES=(
     "cornell.json              light --beams 81920  1"
     "caustic_ring.json         light --beams 262144 1"
     "quarter/spot_torus.json   path  --spp   16     9600"
+    "quarter/spot_torus.json   path:batched --spp 16 9600"
     "quarter/cornell.json      path  --spp   12     10000"
+    "quarter/cornell.json      path:batched --spp 12 10000"
     "quarter/caustic_ring.json bdpt  --spp   24     9600"
     "quarter/cornell.json      bdpt  --spp   4      10000"
 )
@@ -69,10 +73,15 @@ done
 instructions() {
     local scene=$1 integrator=$2 option=$3 value=$4 expected=$5
     local out="$WORK/out" log="$WORK/valgrind.log" stdout="$WORK/stdout"
+    local kernel=()
+    if [[ $integrator == *:* ]]; then
+        kernel=(--kernel "${integrator#*:}")
+        integrator=${integrator%%:*}
+    fi
     rm -rf "$out"
     mkdir -p "$out"
     if ! $NICE "$VALGRIND" --tool=callgrind --callgrind-out-file=/dev/null \
-        "$BIN" render "$SCENES/$scene" --integrator "$integrator" "$option" "$value" \
+        "$BIN" render "$SCENES/$scene" --integrator "$integrator" "${kernel[@]}" "$option" "$value" \
         --threads 1 --seed 1 --quiet --out "$out" >"$stdout" 2>"$log"; then
         echo "error: the render failed: $scene $integrator $option $value" >&2
         cat "$log" "$stdout" >&2

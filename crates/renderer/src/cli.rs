@@ -50,8 +50,9 @@ enum Command {
         /// settings.integrator).
         #[arg(long, value_parser = parse_integrator)]
         integrator: Option<IntegratorChoice>,
-        /// The kernel of the path tracer's camera paths: batched (the default) or scalar, the
-        /// reference (overrides settings.kernel; the image is the same).
+        /// The kernel of the path tracer's camera paths: scalar (one path at a time, the
+        /// default) or batched (16 paths stage by stage); overrides settings.kernel; the image
+        /// is the same.
         #[arg(long, value_parser = parse_kernel)]
         kernel: Option<Kernel>,
         /// Render for this many seconds instead of a fixed number of beams (with

@@ -112,8 +112,8 @@ pub struct Settings {
     /// Render until the estimated relative RMSE of the image is at most this (e.g. `0.05`),
     /// instead of a fixed number of beams or samples; `time_seconds` caps it.
     pub target_error: Option<f64>,
-    /// Which kernel traces the path tracer's camera paths: `"batched"` (many paths stage by
-    /// stage, the default) or `"scalar"` (one path at a time, the reference); the image is the
+    /// Which kernel traces the path tracer's camera paths: `"scalar"` (one path at a time, the
+    /// reference and the default) or `"batched"` (many paths stage by stage); the image is the
     /// same, bit for bit.
     pub kernel: Kernel,
 }
@@ -136,7 +136,7 @@ impl Default for Settings {
             camera_wavelengths: CameraWavelengths::Visible,
             sampler: SamplerKind::Independent,
             target_error: None,
-            kernel: Kernel::Batched,
+            kernel: Kernel::Scalar,
         }
     }
 }

@@ -45,7 +45,11 @@ pub(crate) fn chunk_rng(seed: u64, chunk: u64) -> Pcg64 {
 /// path's own stream): unrelated to every chunk stream and to every other item's.
 pub(crate) fn path_rng(seed: u64, chunk: u64, item: u64) -> Pcg64 {
     let z = split_mix(split_mix(seed ^ 0x5851_F42D_4C95_7F2D) ^ chunk);
-    Pcg64::seed_from_u64(split_mix(z ^ item.wrapping_mul(0xD6E8_FEB8_6659_FD93)))
+    let hi = split_mix(z ^ item.wrapping_mul(0xD6E8_FEB8_6659_FD93));
+    let lo = split_mix(hi ^ item);
+    // The state from both halves; the stream (increment) from the item too, so that two paths
+    // never share a sequence at an offset.
+    Pcg64::new((u128::from(hi) << 64) | u128::from(lo), u128::from(split_mix(lo ^ z)))
 }
 
 /// SplitMix64's finaliser of `x` (after its increment).

@@ -80,7 +80,7 @@ impl Default for PathTracerSettings {
             max_depth: 64,
             rr_depth: 4,
             wavelengths: CameraWavelengths::Visible,
-            kernel: Kernel::Batched,
+            kernel: Kernel::Scalar,
         }
     }
 }
@@ -307,7 +307,7 @@ impl<'a> PathTracer<'a> {
         stats: &mut TraceStats,
     ) {
         let mut path = self.start(px, py, rng);
-        path.state = self.trace(path.state, &mut path.lambda_weights, rng, stats);
+        self.trace(&mut path.state, &mut path.lambda_weights, rng, stats);
         self.finish(&path, film);
     }
 
@@ -322,7 +322,9 @@ impl<'a> PathTracer<'a> {
         rng: &mut dyn rand::Rng,
         stats: &mut TraceStats,
     ) -> [f64; HERO] {
-        self.trace(PathState::new(ray, lambdas), lambda_weights, rng, stats).radiance
+        let mut p = PathState::new(ray, lambdas);
+        self.trace(&mut p, lambda_weights, rng, stats);
+        p.radiance
     }
 
     /// The scalar kernel: follows one path to its end, one vertex at a time, through the same
@@ -330,30 +332,29 @@ impl<'a> PathTracer<'a> {
     /// [`Self::connection`] and [`Self::connect`], [`Self::go_on`]).
     fn trace(
         &self,
-        mut p: PathState,
+        p: &mut PathState,
         lambda_weights: &mut [f64; HERO],
         rng: &mut dyn rand::Rng,
         stats: &mut TraceStats,
-    ) -> PathState {
+    ) {
         while let Some(hit) = self.scene.world.intersect(&p.ray, f64::INFINITY) {
-            let Some(vertex) = self.arrive(&mut p, &hit, lambda_weights, rng, stats) else {
+            let Some(vertex) = self.arrive(p, &hit, lambda_weights, rng, stats) else {
                 break;
             };
             if vertex.next_event {
                 let at = Shading { hit: &hit, wo: -p.ray.direction, material: vertex.material };
                 self.for_each_light(vertex.light, |light| {
-                    if let Some(c) = self.connection(&p, &at, light)
+                    if let Some(c) = self.connection(p, &at, light)
                         && c.shadow.visible(self.scene)
                     {
-                        self.connect(&mut p, &at, &c, stats);
+                        self.connect(p, &at, &c, stats);
                     }
                 });
             }
-            if !self.go_on(&mut p, &hit, vertex, rng, stats) {
+            if !self.go_on(p, &hit, vertex, rng, stats) {
                 break;
             }
         }
-        p
     }
 
     /// A path reaches `hit`: the emission found there (weighted by MIS), then the vertex's
