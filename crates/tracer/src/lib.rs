@@ -16,9 +16,11 @@
 //!
 //! The layout follows the jobs: `scene` (what is traced), `integrators` (one module per estimator,
 //! over `integrators/common`, the transport steps they share, and `integrators/pass`, the camera
-//! estimators' pass loop), `film` and `raster` (exact sums and their size rules), `estimate`
-//! (the error from the spread between chunks), `render` (threads, chunks, memory), `sampler` (the
-//! random streams), `effects` (what the scene needs).
+//! estimators' pass loop), `batch` (the path tracer's batched kernel: many paths moved through
+//! the same steps stage by stage, giving the scalar kernel's image bit for bit; [`Kernel`]),
+//! `film` (exact sums, their size rules and the error from the spread between chunks), `render`
+//! (threads, chunks, memory), `sampler` (the random streams: one per chunk, one per camera
+//! path), `effects` (what the scene needs).
 //!
 //! The key design decisions: the film adds contributions in exact fixed point ([`ExactSum`]), so
 //! an image is bit-identical whatever the thread count, chunk order or number of machines

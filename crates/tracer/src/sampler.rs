@@ -101,9 +101,9 @@ impl ChunkSampler {
     }
 
     /// The sampler of one camera path, item `item` of pass (chunk) `chunk` of a render with seed
-    /// `seed`, already started: its own independent stream ([`path_rng`]), or point `chunk` of
-    /// the item's Sobol sequence over it. It depends on nothing else, so a path gives the same
-    /// result whichever paths are traced before it or beside it.
+    /// `seed`, already started: its own independent stream (`path_rng(seed, chunk, item)`), or
+    /// point `chunk` of the item's Sobol sequence over it. It depends on nothing else, so a path
+    /// gives the same result whichever paths are traced before it or beside it.
     pub fn for_path(kind: SamplerKind, seed: u64, chunk: u64, item: u64) -> Self {
         let rng = path_rng(seed, chunk, item);
         match kind {

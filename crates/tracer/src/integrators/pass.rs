@@ -3,11 +3,11 @@
 //!
 //! Item `i` of pass `c` is `(i + pass_start(c)) mod items`: whole passes cover every item once,
 //! and the one-item chunks of the pre-render probe spread over the image. Each item starts its
-//! //! own path with a sampler of its own ([`ChunkSampler::for_path`]: the stream of `(seed, c, i)`;
+//! own path with a sampler of its own ([`ChunkSampler::for_path`]: the stream of `(seed, c, i)`;
 //! Sobol: point `c` of the item's own sequence), so its result does not depend on the items
-//! traced before it or beside it. A pass is never
-//! cut short, so every pixel has the same sample count and the image is their plain mean:
-//! `image = film x power x items / samples` ([`camera_image_scale`]).
+//! traced before it or beside it. A pass is never cut short, so every pixel has the same sample
+//! count and the image is their plain mean: `image = film x power x items / samples`
+//! ([`camera_image_scale`]).
 
 use crate::{ChunkSampler, ChunkWork, Integrator, LightTracerScene, Splat, TraceStats};
 

@@ -36,6 +36,15 @@
 //! pixel, never cut short, so every pixel has had the same number of samples and the image is
 //! the plain mean, bit-identical for any thread count or shard split.
 //!
+//! # Two kernels, one set of steps
+//! A sample is a sequence of steps: `start` (camera ray and wavelengths), then per vertex
+//! `arrive` (emission, the vertex's uniforms and lobe), `connection` and `connect` for each light
+//! next-event estimation samples (the shadow ray in between), `go_on` (BSDF sample, roulette),
+//! and `finish` (the splat). The scalar kernel (`trace`, the default, [`Kernel::Scalar`]) runs
+//! them for one path to its end; the batched kernel (`crate::batch`, [`Kernel::Batched`]) runs
+//! each for 16 paths before the next. Every camera path draws from its own sampler, so both give
+//! the same film.
+//!
 //! # What it cannot see
 //! Lights that have no `sample_towards` (lasers, parallel skies, lights that only implement the
 //! seed's beam generator) are never reached by a camera path: their light is missing from a
@@ -85,8 +94,8 @@ impl Default for PathTracerSettings {
     }
 }
 
-/// The path tracer as an [`crate::Integrator`]; a work item is one camera sample, a chunk one pass over
-/// the image.
+/// The path tracer as an [`crate::Integrator`]; a work item is one camera sample, a chunk one
+/// pass over the image.
 #[derive(Debug, Clone)]
 pub struct PathTracer<'a> {
     scene: &'a LightTracerScene<'a>,
