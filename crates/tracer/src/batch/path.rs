@@ -4,9 +4,9 @@
 use spectrace_geometry::Hit;
 
 use super::LANES;
-use crate::integrators::pass::{PassEstimator, pixel_of};
+use crate::integrators::pass::{PassEstimator, pass_items, pixel_of};
 use crate::integrators::path_tracer::{CameraPath, Connection, PathTracer, Shading, Vertex};
-use crate::{ChunkSampler, SamplerKind, Splat, TraceStats};
+use crate::{ChunkSampler, ChunkWork, Splat, TraceStats};
 
 /// The paths in flight, as a structure of arrays: one entry per lane in each.
 struct Lanes<'a> {
@@ -24,29 +24,15 @@ struct Lanes<'a> {
     queue: Vec<(usize, Connection)>,
 }
 
-/// Where a pass's samples come from: the render's sampler kind and seed, the pass (chunk) and
-/// the image's width.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct PassSource {
-    /// The render's sampler.
-    pub kind: SamplerKind,
-    /// The render's seed.
-    pub seed: u64,
-    /// The pass.
-    pub chunk: u64,
-    /// Pixels in a row.
-    pub width: u64,
-}
-
-/// Renders the camera samples of `items` (pixels of one pass) with the batched kernel into
-/// `film`; counts them in `stats.beams`.
+/// Renders the camera samples of pass `work.chunk` (`work.items` pixels) with the batched
+/// kernel into `film`; the returned `stats.beams` counts them.
 pub(crate) fn render_pass<'a>(
     tracer: &PathTracer<'a>,
-    source: PassSource,
-    mut items: impl Iterator<Item = u64>,
+    work: ChunkWork,
     film: &mut dyn Splat,
-    stats: &mut TraceStats,
-) {
+) -> TraceStats {
+    let mut stats = TraceStats::default();
+    let mut items = pass_items(work.chunk, work.items, tracer.items());
     let mut lanes = Lanes::<'a> {
         paths: Vec::with_capacity(LANES),
         rngs: Vec::with_capacity(LANES),
@@ -56,14 +42,14 @@ pub(crate) fn render_pass<'a>(
         queue: Vec::with_capacity(2 * LANES),
     };
     loop {
-        lanes.generate(tracer, source, &mut items, stats);
+        lanes.generate(tracer, work, &mut items, &mut stats);
         if lanes.paths.is_empty() {
-            return;
+            return stats;
         }
         lanes.intersect(tracer);
-        lanes.shade(tracer, stats);
-        lanes.shadow_and_connect(tracer, stats);
-        lanes.go_on_or_splat(tracer, film, stats);
+        lanes.shade(tracer, &mut stats);
+        lanes.shadow_and_connect(tracer, &mut stats);
+        lanes.go_on_or_splat(tracer, film, &mut stats);
     }
 }
 
@@ -72,14 +58,16 @@ impl<'a> Lanes<'a> {
     fn generate(
         &mut self,
         tracer: &PathTracer<'a>,
-        source: PassSource,
+        work: ChunkWork,
         items: &mut impl Iterator<Item = u64>,
         stats: &mut TraceStats,
     ) {
+        let kind = tracer.scene().sampler();
+        let width = u64::from(tracer.scene().camera.width());
         while self.paths.len() < LANES {
             let Some(item) = items.next() else { break };
-            let (px, py) = pixel_of(item, source.width);
-            let mut rng = ChunkSampler::for_path(source.kind, source.seed, source.chunk, item);
+            let (px, py) = pixel_of(item, width);
+            let mut rng = ChunkSampler::for_path(kind, work.seed, work.chunk, item);
             self.paths.push(tracer.start(px, py, &mut rng));
             self.rngs.push(rng);
             stats.beams += 1;

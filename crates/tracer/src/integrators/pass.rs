@@ -50,12 +50,7 @@ pub(crate) trait PassEstimator: Send + Sync {
     /// `stats.beams`): by default the scalar kernel, [`Self::sample`] for one item after the
     /// other, each with its own sampler.
     fn render_items(&self, work: ChunkWork, film: &mut dyn Splat) -> TraceStats {
-        let mut scratch = self.scratch();
-        let kind = self.scene().sampler();
-        run_pass(work.chunk, work.items, self.items(), |item, stats| {
-            let mut rng = ChunkSampler::for_path(kind, work.seed, work.chunk, item);
-            self.sample(item, &mut scratch, &mut rng, film, stats);
-        })
+        scalar_items(self, work, film)
     }
 
     /// One sample of item `item`, drawing from `rng`, the path's own sampler.
@@ -121,6 +116,21 @@ pub(crate) fn pixel_of(item: u64, width: u64) -> (u32, u32) {
 /// samples done (its film holds estimates relative to the lights' power, one per item sample).
 pub(crate) fn camera_image_scale(power: f64, items: u64, samples_done: u64) -> f64 {
     if samples_done == 0 { 0.0 } else { power * items as f64 / samples_done as f64 }
+}
+
+/// The scalar kernel of a pass: [`PassEstimator::sample`] for one item after the other, each
+/// with its own sampler ([`ChunkSampler::for_path`]); counts them in `stats.beams`.
+pub(crate) fn scalar_items<E: PassEstimator + ?Sized>(
+    estimator: &E,
+    work: ChunkWork,
+    film: &mut dyn Splat,
+) -> TraceStats {
+    let mut scratch = estimator.scratch();
+    let kind = estimator.scene().sampler();
+    run_pass(work.chunk, work.items, estimator.items(), |item, stats| {
+        let mut rng = ChunkSampler::for_path(kind, work.seed, work.chunk, item);
+        estimator.sample(item, &mut scratch, &mut rng, film, stats);
+    })
 }
 
 /// The items of a chunk: `samples` items of pass `chunk` over `items` items, in order.

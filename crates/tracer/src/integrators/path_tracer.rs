@@ -61,8 +61,8 @@ use super::common::{
     choose_lobe, connect_light_to_camera, power_heuristic, relative_throughput, roulette,
     sample_light,
 };
-use super::pass::{PassEstimator, pixel_of};
-use crate::batch::path::{PassSource, render_pass};
+use super::pass::{PassEstimator, pixel_of, scalar_items};
+use crate::batch::path::render_pass;
 use crate::light_sampler::LightSampler;
 use crate::{
     CameraWavelengths, ChunkSampler, ChunkWork, Effects, HERO, Kernel, LightTracerScene, Splat,
@@ -592,25 +592,9 @@ impl PassEstimator for PathTracer<'_> {
     }
 
     fn render_items(&self, work: ChunkWork, film: &mut dyn Splat) -> TraceStats {
-        let scene = self.scene;
-        let items = self.items();
-        let passes = super::pass::pass_items(work.chunk, work.items, items);
         match self.settings.kernel {
-            Kernel::Batched => {
-                let width = u64::from(scene.camera.width());
-                let source =
-                    PassSource { kind: scene.sampler(), seed: work.seed, chunk: work.chunk, width };
-                let mut stats = TraceStats::default();
-                render_pass(self, source, passes, film, &mut stats);
-                stats
-            }
-            Kernel::Scalar => {
-                super::pass::run_pass(work.chunk, work.items, items, |item, stats| {
-                    let mut rng =
-                        ChunkSampler::for_path(scene.sampler(), work.seed, work.chunk, item);
-                    self.sample(item, &mut (), &mut rng, film, stats);
-                })
-            }
+            Kernel::Batched => render_pass(self, work, film),
+            Kernel::Scalar => scalar_items(self, work, film),
         }
     }
 
