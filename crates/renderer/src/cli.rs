@@ -23,6 +23,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use spectrace_tracer::{EffectsMode, IntegratorChoice, Kernel};
 
+use crate::say::{say, tell};
 use crate::{RenderOptions, merge_parts, render_file};
 
 /// Spectrace: a spectral Monte Carlo renderer built around light sources as beam generators.
@@ -224,10 +225,10 @@ fn millions(rate: f64) -> String {
 /// paths (light, path, bdpt and auto, and which one auto picks), and what the effects analysis
 /// saves the light tracer (auto against off).
 fn bench(scenes: &[PathBuf], beams: u64, threads: usize) -> ExitCode {
-    println!(
+    say!(
         "| scene | pixels | auto picks | paths/s, light | paths/s, path | paths/s, bdpt | paths/s, auto | light: beams/s with effects off | light: spectral samples on film per s, effects auto / off |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|");
+    say!("|---|---|---|---|---|---|---|---|---|");
     for path in scenes {
         let row = crate::Scene::load(path)
             .map_err(|e| crate::RenderError::from(e).to_string())
@@ -246,7 +247,7 @@ fn bench(scenes: &[PathBuf], beams: u64, threads: usize) -> ExitCode {
                     i.timings.iter().map(|t| millions(t.paths_per_second())).collect();
                 let effects_gain = r.auto_spectral_samples_per_second
                     / r.off_spectral_samples_per_second.max(1e-300);
-                println!(
+                say!(
                     "| `{name}` | {}x{} | {} | {} | {} | {effects_gain:.2}x |",
                     i.width,
                     i.height,
@@ -256,7 +257,7 @@ fn bench(scenes: &[PathBuf], beams: u64, threads: usize) -> ExitCode {
                 );
             }
             Err(e) => {
-                eprintln!("error: {e}");
+                tell!("error: {e}");
                 return ExitCode::from(2);
             }
         }
@@ -301,11 +302,12 @@ fn estimate_command(
     };
     match run() {
         Ok(md) => {
-            print!("{md}");
+            // As `say!`: a closed stdout loses the report, not the exit code.
+            let _ = std::io::Write::write_all(&mut std::io::stdout().lock(), md.as_bytes());
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            tell!("error: {e}");
             ExitCode::from(2)
         }
     }
@@ -390,9 +392,9 @@ where
     match result {
         Ok(report) => {
             for w in &report.warnings {
-                eprintln!("warning: {w}");
+                tell!("warning: {w}");
             }
-            println!(
+            say!(
                 "{} beams in {:.2} s ({:.3e} beams/s), {} rejected contributions; wrote {}",
                 report.beams,
                 report.wall_seconds,
@@ -401,12 +403,12 @@ where
                 report.outputs.join(", ")
             );
             if let Some(e) = &report.error_estimate {
-                println!("{}", e.summary());
+                say!("{}", e.summary());
             }
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            tell!("error: {e}");
             ExitCode::from(2)
         }
     }

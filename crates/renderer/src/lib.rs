@@ -43,6 +43,7 @@ mod probe;
 mod progress;
 mod report;
 mod run;
+mod say;
 mod scene;
 mod sensor_output;
 mod sensors;

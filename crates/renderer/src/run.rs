@@ -13,6 +13,7 @@ use crate::integrators::{kernel_of, with_kernel};
 use crate::plan::scene_normalisation;
 use crate::progress::render_with_progress;
 use crate::report::report;
+use crate::say::tell;
 use crate::sensors::render_sensors;
 use crate::shard::write_part;
 use crate::warnings::{black_image_warning, render_warnings};
@@ -53,12 +54,12 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
     let (plan, estimate_warning) = fit_estimate(scene, plan)?;
     let effects = decide_effects(scene, options.effects);
     if options.verbose {
-        eprintln!("{}", effects.summary());
-        eprintln!("integrator: {reason}");
+        tell!("{}", effects.summary());
+        tell!("integrator: {reason}");
     }
     let kernel = options.kernel.unwrap_or(scene.settings.kernel);
     if options.verbose && choice == IntegratorChoice::Path {
-        eprintln!("kernel: {}", kernel.name());
+        tell!("kernel: {}", kernel.name());
     }
     with_kernel(scene, choice, effects, plan.shard.is_none(), kernel, |tracer| {
         let setup = Setup { choice, reason: &reason, effects, plan, name: &name, kernel };
@@ -183,7 +184,7 @@ fn probe_noting(
 ) -> Result<ProbeOutcome, RenderError> {
     let probed = probe_with(scene, plan, tracer)?;
     if verbose && !probed.lit {
-        eprintln!(
+        tell!(
             "note: the pre-render probe ran out of time after {} paths without seeing light reach \
              the camera; rendering anyway",
             probed.beams
@@ -273,7 +274,7 @@ fn write_render(
     for r in &sensors {
         written.files.extend(r.files.iter().cloned());
         if options.verbose {
-            eprintln!("{}", sensor_summary(r));
+            tell!("{}", sensor_summary(r));
         }
     }
     let mut report = finished.report(output, written);

@@ -35,3 +35,28 @@ fn a_missing_scene_is_named() {
     assert_eq!(code, 2);
     assert!(err.contains("no-such-scene.json"), "{err}");
 }
+
+/// A closed stdout and stderr (`spectrace render scene.json | head -1` closes stdout after a
+/// line) lose the text, not the render: before, `println!` panicked with "failed printing to
+/// stdout" and the exit code was 101.
+#[test]
+fn closed_output_streams_do_not_panic() {
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/fading_spot.json");
+    let dir = std::env::temp_dir().join(format!("spectrace-closed-pipe-{}", std::process::id()));
+    let closed = || {
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        writer
+    };
+    let out = Command::new(env!("CARGO_BIN_EXE_spectrace"))
+        .args(["render", scene, "--beams", "20000", "--threads", "1", "--out"])
+        .arg(&dir)
+        .stdout(closed())
+        .stderr(closed())
+        .status()
+        .unwrap();
+    let written = dir.join("fading_spot.exr").is_file();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(out.code(), Some(0), "{out}");
+    assert!(written, "the image was not written");
+}
