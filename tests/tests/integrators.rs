@@ -19,7 +19,9 @@
 //! | `cornell_box` | box open at the front, area light under its ceiling (seen), 16x16 | none | all | all | all | path | off | 12 | 3 | 5% |
 //! | `five_lights` | `coloured_spot` plus two point, a rectangle and a disk light | none | all | all | all | path | auto | 12 | 4 | 5% |
 //! | `glass_under_area_light` | glass and diffuse spheres on a floor under an area light, 32x32 | none | not through glass | all | all | path | auto | 12 | 4 | 5% |
-//! | `glass_caustic` | glass sphere under the fading spot: a caustic on the floor, 16x16 | none | not through glass | no point-light caustic | all | bdpt | off | 12 | 3 | 5% |
+//! | `glass_caustic` | glass sphere under the fading spot: a caustic on the floor, 16x16 | none | not through glass | no delta-light caustic | all | bdpt | off | 12 | 3 | 5% |
+//! | `sunlit_sphere` | a sky's parallel light on a diffuse sphere and floor, 16x16 | none | all | all | all | path | auto | 12 | 4 | 5% |
+//! | `sunlit_glass` | glass sphere on the floor under the sky: the sun's caustic, 16x16 | none | not through glass | no delta-light caustic | all | bdpt | auto | 12 | 4 | 5% |
 //!
 //! What each cell checks ([`check_row`]):
 //! - **all** (the estimator sees every pixel): the closed form where the row has one (every 8x8
@@ -31,9 +33,9 @@
 //!   the pinhole from non-specular vertices only, so a pixel that sees nothing but the glass is
 //!   black: asserted exactly 0 in every render; it must agree with the others on the pixels that
 //!   do not see the glass at all;
-//! - **no point-light caustic** ([`Sight::NoPointLightCaustic`]): camera paths reach a point or
-//!   spot light only by next-event estimation, which the glass blocks, so the light it focuses
-//!   is missing: asserted darker than BDPT on the pixels that do not see the glass (by more than
+//! - **no delta-light caustic** ([`Sight::NoDeltaLightCaustic`]): camera paths reach a point,
+//!   spot or parallel light (a sky) only by next-event estimation, which the glass blocks, so the
+//!   light it focuses is missing: asserted darker than BDPT on the pixels that do not see the glass (by more than
 //!   3 standard errors of each), and compared with nothing else;
 //! - **auto picks**: the renderer's own choice (`choose_integrator`) is that estimator, and it
 //!   sees the whole image.
@@ -148,9 +150,9 @@ enum Sight {
     /// Nothing through the row's glass (the light tracer: it joins light paths to the pinhole
     /// from non-specular vertices only, and a join through glass is blocked).
     NotThroughGlass,
-    /// No caustic of a point or spot light (camera paths reach such lights only by next-event
-    /// estimation, which the glass blocks).
-    NoPointLightCaustic,
+    /// No caustic of a point, spot or parallel light (camera paths reach such lights only by
+    /// next-event estimation, which the glass blocks).
+    NoDeltaLightCaustic,
 }
 
 /// One cell of the matrix: the work per seed (beams for the light tracer, camera samples for
@@ -344,7 +346,7 @@ fn check_row(row: &Row) -> Renders {
                     }
                 }
             }
-            Sight::NoPointLightCaustic => {
+            Sight::NoDeltaLightCaustic => {
                 // Darker than BDPT where the glass is not seen: the caustic is missing.
                 assert_eq!(row.cells[2].sight, Sight::All);
                 let (m, se) = region_stats(&r.images[i], &r.clear).unwrap();
@@ -397,7 +399,7 @@ fn check_row(row: &Row) -> Renders {
             let region = |sight: Sight| match sight {
                 Sight::All => Some(vec![true; w * h]),
                 Sight::NotThroughGlass => Some(r.clear.clone()),
-                Sight::NoPointLightCaustic => None,
+                Sight::NoDeltaLightCaustic => None,
             };
             let (Some(a), Some(b)) = (region(row.cells[i].sight), region(row.cells[j].sight))
             else {
@@ -704,7 +706,7 @@ fn glass_caustic() -> Row {
         closed_form: None,
         cells: [
             Cell { effort: 80_000, sight: Sight::NotThroughGlass },
-            Cell { effort: 16 * 16 * 10, sight: Sight::NoPointLightCaustic },
+            Cell { effort: 16 * 16 * 10, sight: Sight::NoDeltaLightCaustic },
             all(16 * 16 * 10),
         ],
         glass: Some(1),
@@ -712,6 +714,76 @@ fn glass_caustic() -> Row {
         sharp: 0.05,
         mean_z: 3.0,
     }
+}
+
+/// A sky's parallel light (the sun) on a diffuse sphere and a floor; `glass` makes the sphere
+/// glass, which focuses the sun into a caustic on the floor in front of it (the sun shines from
+/// behind the sphere towards the camera, so the caustic is in view).
+fn sunlit_json(glass: bool) -> String {
+    let sphere = if glass {
+        r#"{"type": "Dielectric", "ior": 1.5}"#
+    } else {
+        r#"{"type": "Diffuse", "reflectance": {"nm": [400, 550, 700], "values": [0.2, 0.6, 0.3]}}"#
+    };
+    format!(
+        r#"{{
+  "camera": {{"position": [0, 1.5, 1.9], "look_at": [0, 0.2, 0], "fov": 50, "width": 16, "height": 16}},
+  "objects": [
+    {{"shape": {{"type": "Rectangle", "corner": [-2, 0, 2], "edge_u": [4, 0, 0], "edge_v": [0, 0, -4]}},
+     "material": {{"type": "Diffuse", "reflectance": 0.7}}}},
+    {{"shape": {{"type": "Sphere", "center": [0.1, 0.35, 0], "radius": 0.35}}, "material": {sphere}}}
+  ],
+  "lights": [{{"type": "Sky", "corner": [-4, 3, -6], "edge_u": [8, 0, 0], "edge_v": [0, 0, 8],
+              "direction": [0.3, -1, 0.8], "power": 50, "spd": {{"type": "CieIlluminant", "name": "D65"}}}}]
+}}"#
+    )
+}
+
+/// Next-event estimation of a sky: every estimator sees the whole image and they agree.
+fn sunlit_sphere() -> Row {
+    Row {
+        name: "sunlit_sphere",
+        scene: scene(&sunlit_json(false)),
+        auto: IntegratorChoice::Path,
+        effects: EffectsMode::Auto,
+        closed_form: None,
+        cells: [all(80_000), all(16 * 16 * 8), all(16 * 16 * 8)],
+        glass: None,
+        seeds: 12,
+        sharp: 0.05,
+        mean_z: 4.0,
+    }
+}
+
+/// The sky through glass: BDPT joins its next-event estimation of the sun with light paths,
+/// which find the caustic.
+fn sunlit_glass() -> Row {
+    Row {
+        name: "sunlit_glass",
+        scene: scene(&sunlit_json(true)),
+        auto: IntegratorChoice::Bdpt,
+        effects: EffectsMode::Auto,
+        closed_form: None,
+        cells: [
+            Cell { effort: 80_000, sight: Sight::NotThroughGlass },
+            Cell { effort: 16 * 16 * 8, sight: Sight::NoDeltaLightCaustic },
+            all(16 * 16 * 8),
+        ],
+        glass: Some(1),
+        seeds: 12,
+        sharp: 0.05,
+        mean_z: 4.0,
+    }
+}
+
+#[test]
+fn matrix_sunlit_sphere() {
+    check_row(&sunlit_sphere());
+}
+
+#[test]
+fn matrix_sunlit_glass() {
+    check_row(&sunlit_glass());
 }
 
 #[test]

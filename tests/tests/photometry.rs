@@ -379,6 +379,17 @@ fn the_path_tracer_sampling_points_on_a_sensor_gives_the_same_closed_forms() {
     let (scene, want) = integrating_sphere(&dir);
     let (got, errors, average_error) = measure_path(&scene, 20_000);
     assert_sphere(&got, &errors, average_error, want);
+    // Sunlight: a 4 m x 4 m sky 2 m up, slanted beams whose shadow covers the sensor, reached
+    // by next-event estimation (the one beam through each point): E = efficacy x power / area
+    // on every cell (the slant's cosine cancels between the sky and the sensor).
+    let sky = plane_scene(
+        r#"{"type": "Sky", "corner": [-2, 2, -2], "edge_u": [4, 0, 0], "edge_v": [0, 0, 4],
+            "direction": [0.3, -1, 0.2], "power": 20, "spd": {"type": "CieIlluminant", "name": "D65"}}"#,
+        &dir,
+    );
+    let lux = luminous_efficacy(&CieIlluminant::new("D65").unwrap()) * 20.0 / 16.0;
+    let (got, errors, average_error) = measure_path(&sky, 4000);
+    assert_cells_agree("path, sky", &got, &errors, &[lux; 64], average_error);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -433,7 +444,15 @@ fn sensors_beside_a_camera_integrator_use_light_paths_when_a_point_cannot_sample
             "direction": [0, -1, 0], "power": 1, "spd": {"type": "CieIlluminant", "name": "D65"}}"#,
         &dir,
     );
-    assert_eq!(sensor_integrator(&sky), SensorIntegrator::Light);
+    // A sky gives a point the one beam through it (next-event estimation reaches it); a laser
+    // of zero width is a line no point can sample.
+    assert_eq!(sensor_integrator(&sky), SensorIntegrator::Path);
+    let thin_laser = plane_scene(
+        r#"{"type": "Laser", "position": [0, 1, 0], "direction": [0, -1, 0], "power": 1,
+            "spd": {"type": "CieIlluminant", "name": "D65"}}"#,
+        &dir,
+    );
+    assert_eq!(sensor_integrator(&thin_laser), SensorIntegrator::Light);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

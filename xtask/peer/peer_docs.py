@@ -241,6 +241,20 @@ def kept_geometry_section(path):
     return found.group(0) if found else ""
 
 
+def glass_text(scene):
+    """The path tracers on the pixels that see the glass sphere (the reference cannot judge them):
+    the mean Y of each one's last image there, and Spectrace's over Mitsuba's."""
+    means = {(e["renderer"], e["integrator"]): e["glass_mean"] for e in scene["results"] if "glass_mean" in e}
+    ours, theirs = means.get(("spectrace", "path")), means.get(("mitsuba", "path"))
+    if ours is None or theirs is None or not theirs > 0:
+        return ""
+    others = ", ".join(f"{label({'renderer': r, 'integrator': i})} {v:.3e}" for (r, i), v in sorted(means.items()))
+    return (
+        f"On the pixels that see the glass sphere (no reference there): Spectrace path / Mitsuba path = "
+        f"**{ours / theirs:.4f}** (mean Y of each one's last image; issue 23's target: within 2%). All: {others}.\n"
+    )
+
+
 def write(report, root, method_path=None):
     docs = os.path.join(root, "docs")
     with open(os.path.join(docs, "peer.svg"), "w") as f:
@@ -272,6 +286,7 @@ def write(report, root, method_path=None):
                     f"{sig(p['seconds'])} s: {100 * p['rmse']:.2f}%, mean {p['mean_ratio']:.4f} of the reference{extra}"
                 )
         parts.append("Ladders:\n\n" + "\n".join(pts) + "\n")
+        parts.append(glass_text(scene))
     throughput = None
     if report.get("throughput"):
         import throughput_docs as throughput  # imported here: it needs Mitsuba, geometry.py does not

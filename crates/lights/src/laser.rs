@@ -31,7 +31,8 @@ pub(crate) const SAME_DIRECTION: f64 = 1e-9;
 use crate::geometry::{finite_point, non_negative, unit_direction};
 use crate::source::{power_from_keys, uniform};
 use crate::{
-    Beam, EmissionSample, LightError, LightFlags, LightSource, SpdLight, WavelengthSampling,
+    Beam, EmissionSample, LightError, LightFlags, LightSample, LightSource, SpdLight,
+    WavelengthSampling,
 };
 
 /// A laser: parallel beams from a point (or a disk of `beam_radius`) along one direction.
@@ -127,6 +128,13 @@ impl Laser {
         }
     }
 
+    /// Irradiance inside a beam of finite radius on a surface facing it (W/m^2), `power / (pi
+    /// beam_radius^2)`; 0 for a beam of radius 0 (a delta) or one whose area is not a positive
+    /// finite number.
+    pub fn irradiance(&self) -> f64 {
+        if self.beam_radius > 0.0 { self.emission.power() * self.pdf_position() } else { 0.0 }
+    }
+
     /// Area density of the beam origins (m^-2): 1 (a delta) for a beam of radius 0, else
     /// `1 / (pi beam_radius^2)`, or 0 when that area is not a positive finite number (a radius
     /// so small that it underflows, or so large that it overflows).
@@ -155,6 +163,34 @@ impl LightSource for Laser {
     crate::delegate_to_spd_light!(emission);
     fn flags(&self) -> Option<LightFlags> {
         Some(LightFlags { delta_position: self.beam_radius == 0.0, delta_direction: true })
+    }
+    /// For a beam of finite radius, the one beam through `receiver`: it starts on the beam's
+    /// disk, on the line through the receiver against the direction, and gives the receiver the
+    /// beam's [`irradiance`](Laser::irradiance) times the cosine there. `intensity` is that
+    /// irradiance times the squared distance, `pdf` 1, `delta` true. `None` outside the beam,
+    /// upstream of the laser, for a beam of radius 0 (a line no point can sample: only light
+    /// paths find it), or when the squared distance is not a finite positive number.
+    fn sample_towards(&self, receiver: DVec3, _u: [f64; 2]) -> Option<LightSample> {
+        let irradiance = self.irradiance();
+        let distance = (receiver - self.position).dot(self.direction);
+        let position = receiver - self.direction * distance;
+        let squared = distance * distance;
+        let intensity = irradiance * squared;
+        let inside = (position - self.position).length() <= self.beam_radius;
+        let usable = distance > 0.0 && squared.is_normal() && intensity.is_finite();
+        (irradiance > 0.0 && inside && usable).then_some(LightSample {
+            position,
+            direction: self.direction,
+            distance,
+            intensity,
+            pdf: 1.0,
+            delta: true,
+        })
+    }
+    /// The direction for a beam of finite radius (the disk its beams start from faces it),
+    /// `None` for a beam of radius 0 (a point).
+    fn normal_at(&self, _position: DVec3) -> Option<DVec3> {
+        (self.beam_radius > 0.0).then_some(self.direction)
     }
     /// The direction is always the laser's, with `pdf_direction` 1 standing for the delta; the
     /// origin as [`next_beam`](LightSource::next_beam) draws it (from `u[0]`, `u[1]`). The normal

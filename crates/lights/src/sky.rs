@@ -29,7 +29,8 @@ use spectrace_spectrum::SpectralPowerDistribution;
 use crate::geometry::{finite_point, safe_length, unit_direction};
 use crate::source::{power_from_keys, uniform};
 use crate::{
-    Beam, EmissionSample, LightError, LightFlags, LightSource, SpdLight, WavelengthSampling,
+    Beam, EmissionSample, LightError, LightFlags, LightSample, LightSource, SpdLight,
+    WavelengthSampling,
 };
 use spectrace_sampling::clamp_uniform;
 
@@ -46,6 +47,11 @@ pub struct Sky {
     normal: DVec3,
     /// The rectangle's area (m^2).
     area: f64,
+    /// Dual vectors of the edges in the rectangle's plane: a point `p` of the plane is
+    /// `corner + s edge_u + t edge_v` with `s = (p - corner) . dual_u`, `t = (p - corner) . dual_v`.
+    dual_u: DVec3,
+    /// See `dual_u`.
+    dual_v: DVec3,
 }
 
 /// Scene-file form of [`Sky`].
@@ -161,7 +167,10 @@ impl Sky {
         }
         let emission = SpdLight::new(L, spd, power, wavelength_sampling)?;
         let normal = if direction.dot(normal) > 0.0 { normal } else { -normal };
-        Ok(Self { emission, corner, edge_u, edge_v, direction, normal, area })
+        // edge_u . (edge_v x normal) = normal . (edge_u x edge_v) = +-area, never 0 here.
+        let dual_u = edge_v.cross(normal) / edge_u.dot(edge_v.cross(normal));
+        let dual_v = normal.cross(edge_u) / edge_v.dot(normal.cross(edge_u));
+        Ok(Self { emission, corner, edge_u, edge_v, direction, normal, area, dual_u, dual_v })
     }
 
     /// Where `(s, t)` in the unit square lands on the rectangle.
@@ -172,6 +181,12 @@ impl Sky {
     /// The rectangle's area (m^2).
     pub fn area(&self) -> f64 {
         self.area
+    }
+
+    /// Irradiance on a surface facing the beams (W/m^2): the power spread over the rectangle's
+    /// area projected across the direction, `power / (area cos)`.
+    pub fn irradiance(&self) -> f64 {
+        self.emission.power() / (self.area * self.direction.dot(self.normal))
     }
 }
 
@@ -199,6 +214,37 @@ impl LightSource for Sky {
             pdf_position: 1.0 / self.area,
             pdf_direction: 1.0,
         })
+    }
+    /// The one beam that passes through `receiver`: it starts where the line through the
+    /// receiver against the sky's direction crosses the rectangle, and gives the receiver the
+    /// sky's [`irradiance`](Sky::irradiance) times the cosine there, as the beams do on average.
+    /// `intensity` is that irradiance times the squared distance (so that `intensity cos /
+    /// distance^2` is the irradiance, as for every light), `pdf` 1 and `delta` true (no camera
+    /// ray can hit a delta direction). `None` when no beam passes through the receiver: it is
+    /// beside the rectangle's shadow, upstream of it, on it, or so far that the squared
+    /// distance is not a finite positive number.
+    fn sample_towards(&self, receiver: DVec3, _u: [f64; 2]) -> Option<LightSample> {
+        let distance = (receiver - self.corner).dot(self.normal) / self.direction.dot(self.normal);
+        let position = receiver - self.direction * distance;
+        let offset = position - self.corner;
+        let (s, t) = (offset.dot(self.dual_u), offset.dot(self.dual_v));
+        let squared = distance * distance;
+        let intensity = self.irradiance() * squared;
+        let inside = (0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&t);
+        let usable = distance > 0.0 && squared.is_normal() && intensity.is_finite();
+        (inside && usable).then_some(LightSample {
+            position,
+            direction: self.direction,
+            distance,
+            intensity,
+            pdf: 1.0,
+            delta: true,
+        })
+    }
+    /// The rectangle's normal on the side the beams leave, at every point (BDPT turns the
+    /// density of a beam's origin into the density of the point it lights with it).
+    fn normal_at(&self, _position: DVec3) -> Option<DVec3> {
+        Some(self.normal)
     }
     /// `(1 / area, 1)` along the sky's direction (1 standing for the delta: the caller learns
     /// that it is one from [`flags`](LightSource::flags)), `(1 / area, 0)` along any other.

@@ -117,7 +117,11 @@ pub trait LightSource: Send + Sync + Debug {
     /// Samples the light as seen from `receiver` (for connecting a surface point to the light):
     /// a point on the light, the direction from it towards the receiver, the radiant intensity
     /// that way, and the density of the choice. `None` (the default) when the light cannot be
-    /// sampled this way (parallel beams, or a light that implements only the seed's methods).
+    /// sampled this way (a light that implements only the seed's methods, a laser of zero
+    /// width) or sends no light to the receiver. Lights with a delta direction (skies, lasers
+    /// of finite width) return the one beam through the receiver, as a delta sample: renderers
+    /// count such a light as reachable from camera paths when it returns a sample for a point
+    /// on one of its own beams (see [`sample_emission`](Self::sample_emission)).
     fn sample_towards(&self, receiver: DVec3, u: [f64; 2]) -> Option<LightSample> {
         let _ = (receiver, u);
         None
@@ -254,7 +258,8 @@ pub struct LightSample {
     /// Density of having chosen this sample, in solid angle at the receiver (for multiple
     /// importance sampling); 1 for a delta position.
     pub pdf: f64,
-    /// `true` if the sample is a delta (point and spot lights).
+    /// `true` if the sample is a delta (point and spot lights, and the parallel beams of skies
+    /// and lasers): no path hits it by itself, so it takes no multiple importance sampling.
     pub delta: bool,
 }
 

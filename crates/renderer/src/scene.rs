@@ -384,11 +384,11 @@ impl Scene {
         crate::tracer_scene(self).features(&self.non_convex)
     }
 
-    /// Whether a point can sample every light (no laser, sky or beam-only light): what the path
-    /// tracer needs, from the camera or from a sensor.
+    /// Whether a point can sample every light (no laser of zero width, no beam-only light): what
+    /// the path tracer needs, from the camera or from a sensor.
     pub(crate) fn lights_sampled_from_points(&self) -> bool {
         let f = self.features();
-        f.beam_only_lights == 0 && f.delta_direction_lights == 0
+        f.beam_only_lights == 0 && f.unreachable_lights == 0
     }
 
     /// The tracer settings.

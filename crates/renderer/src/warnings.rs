@@ -18,8 +18,9 @@ pub(crate) fn render_warnings(
         && !scene.lights_sampled_from_points()
     {
         warnings.push(
-            "settings.sensor_integrator \"path\": lasers, skies and beam-only lights cannot be \
-             sampled from a point, so the sensors miss their light; use \"light\" or \"auto\""
+            "settings.sensor_integrator \"path\": lasers of zero width and beam-only lights \
+             cannot be sampled from a point, so the sensors miss their light; use \"light\" or \
+             \"auto\""
                 .to_owned(),
         );
     }
@@ -56,7 +57,7 @@ pub(crate) fn integrator_warnings(scene: &Scene, choice: IntegratorChoice) -> Ve
     }
     if !scene.lights_sampled_from_points() {
         warnings.push(
-            "the path tracer cannot reach lasers, skies or lights that only generate beams: \
+            "the path tracer cannot reach lasers of zero width or lights that only generate beams: \
              their light is missing from this image (use --integrator light or auto)"
                 .to_owned(),
         );
@@ -68,10 +69,11 @@ pub(crate) fn integrator_warnings(scene: &Scene, choice: IntegratorChoice) -> Ve
                 .to_owned(),
         );
     }
-    if features.delta_position_lights > 0 && features.specular {
+    if features.delta_position_lights + features.delta_direction_lights > 0 && features.specular {
         warnings.push(
-            "the path tracer cannot see caustics of point or spot lights (their light through \
-             mirrors and glass onto other surfaces is missing; use --integrator light or auto)"
+            "the path tracer cannot see caustics of point, spot, sky or laser lights (their light \
+             through mirrors and glass onto other surfaces is missing; use --integrator light or \
+             auto)"
                 .to_owned(),
         );
     }

@@ -44,9 +44,17 @@ pub struct SceneFeatures {
     /// by next-event estimation, so they cannot light a caustic for a camera path.
     #[serde(default)]
     pub delta_position_lights: usize,
-    /// Lights with a delta direction (lasers, skies): camera paths never reach them.
+    /// Lights with a delta direction (lasers, skies): camera paths reach them only by
+    /// next-event estimation, and only those that can be sampled towards a point (not
+    /// [`unreachable_lights`](Self::unreachable_lights)), so they cannot light a caustic for a
+    /// camera path.
     #[serde(default)]
     pub delta_direction_lights: usize,
+    /// Lights with a delta direction that cannot be sampled towards a point (a laser of zero
+    /// width: a line no camera path meets), counted among `delta_direction_lights` too: only
+    /// light paths find their light.
+    #[serde(default)]
+    pub unreachable_lights: usize,
     /// Lights with an area (area lights, glowing objects).
     #[serde(default)]
     pub area_lights: usize,
@@ -99,13 +107,13 @@ impl IntegratorChoice {
     /// The rule (measured: see the accuracy report):
     /// - **light** when a light only generates beams (a plugin without `sample_towards` or
     ///   emission densities): no other estimator can use it;
-    /// - **path** when every light can be reached from the camera: no laser or sky (delta
-    ///   direction), no spectral lines, and no point or spot light shining on mirrors or glass
-    ///   (its caustics);
+    /// - **path** when every light can be reached from the camera: no laser of zero width, no
+    ///   spectral lines, and no point, spot, sky or laser shining on mirrors or glass (its
+    ///   caustics);
     /// - otherwise **bdpt** when the scene has mirrors or glass (the light tracer would show
     ///   them black: light paths cannot reach a pinhole through a specular surface, and BDPT's
     ///   camera paths can),
-    /// - and **light** for the rest (lasers, skies or lines on diffuse scenes): the light
+    /// - and **light** for the rest (thin lasers or lines on diffuse scenes): the light
     ///   tracer is BDPT's light-side strategies alone, at a fraction of the cost.
     pub fn decide(self, features: &SceneFeatures) -> (IntegratorChoice, String) {
         if self != Self::Auto {
@@ -120,13 +128,16 @@ impl IntegratorChoice {
                     .to_owned(),
             );
         }
-        let unreachable = if f.delta_direction_lights > 0 {
-            Some("a laser or sky (parallel beams) is never reached by camera paths")
+        let unreachable = if f.unreachable_lights > 0 {
+            Some(
+                "a laser of zero width (a line no point can sample) is never reached by camera paths",
+            )
         } else if f.line_spectra {
             Some("a light has spectral lines, which camera paths cannot sample")
-        } else if f.delta_position_lights > 0 && f.specular {
+        } else if f.delta_position_lights + f.delta_direction_lights > 0 && f.specular {
             Some(
-                "a point or spot light shines on mirrors or glass, whose caustics only light paths find",
+                "a point, spot, sky or laser shines on mirrors or glass, whose caustics only light \
+                 paths find",
             )
         } else {
             None
@@ -237,9 +248,14 @@ mod tests {
         let spot = SceneFeatures { delta_position_lights: 1, ..area };
         assert_eq!(pick(spot), IntegratorChoice::Path);
         assert_eq!(pick(SceneFeatures { specular: true, ..spot }), IntegratorChoice::Bdpt);
+        // A sky (or a laser of finite width) is reached by next-event estimation, but its
+        // caustics are not; a laser of zero width is not reached at all.
         let sky = SceneFeatures { delta_direction_lights: 1, ..area };
-        assert_eq!(pick(sky), IntegratorChoice::Light);
+        assert_eq!(pick(sky), IntegratorChoice::Path);
         assert_eq!(pick(SceneFeatures { specular: true, ..sky }), IntegratorChoice::Bdpt);
+        let thin = SceneFeatures { unreachable_lights: 1, ..sky };
+        assert_eq!(pick(thin), IntegratorChoice::Light);
+        assert_eq!(pick(SceneFeatures { specular: true, ..thin }), IntegratorChoice::Bdpt);
         let lines = SceneFeatures { line_spectra: true, ..area };
         assert_eq!(pick(lines), IntegratorChoice::Light);
         let plugin = SceneFeatures { beam_only_lights: 1, specular: true, ..area };

@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use glam::DVec3;
 use spectrace_geometry::{Hit, Ray, World};
-use spectrace_lights::{LightId, LightSet};
+use spectrace_lights::{LightId, LightSet, LightSource};
 use spectrace_materials::Material;
 use spectrace_spectrum::SpectralPowerDistribution;
 
@@ -103,7 +103,13 @@ impl<'a> LightTracerScene<'a> {
             .lights()
             .iter()
             .enumerate()
-            .filter(|(_, l)| l.flags().is_some_and(|f| f.delta_position && !f.delta_direction))
+            .filter(|(_, l)| {
+                l.flags().is_some_and(|f| match (f.delta_position, f.delta_direction) {
+                    (true, false) => true,
+                    (_, true) => sampled_towards_its_beams(l.as_ref()),
+                    (false, false) => false,
+                })
+            })
             .map(|(i, _)| LightId(i as u32))
             .collect();
         Self {
@@ -157,8 +163,10 @@ impl<'a> LightTracerScene<'a> {
         &self.all_lights
     }
 
-    /// The lights with a delta position (points, spots, measured luminaires): next-event
-    /// estimation samples each of them at every vertex.
+    /// The delta lights that a point can sample: those with a delta position (points, spots,
+    /// measured luminaires) and the parallel lights whose one beam through a point it can find
+    /// (skies, lasers of finite width; [`sampled_towards_its_beams`]). Next-event estimation
+    /// samples each of them at every vertex.
     pub fn delta_lights(&self) -> &[LightId] {
         &self.delta_lights
     }
@@ -268,7 +276,9 @@ impl<'a> LightTracerScene<'a> {
         }
     }
 
-    /// What the scene contains, for the effects analysis.
+    /// What the scene contains, for the effects analysis. A light with a delta direction counts
+    /// as reachable from camera paths when it can be sampled towards a point on one of its own
+    /// beams ([`sampled_towards_its_beams`]).
     pub fn features(&self, shapes_non_convex: &[bool]) -> SceneFeatures {
         let mut f = SceneFeatures {
             light_spectra_vary: self.lights.lights().iter().any(|l| !l.uniform_spectrum()),
@@ -277,7 +287,10 @@ impl<'a> LightTracerScene<'a> {
         for light in self.lights.lights() {
             match light.flags() {
                 None => f.beam_only_lights += 1,
-                Some(flags) if flags.delta_direction => f.delta_direction_lights += 1,
+                Some(flags) if flags.delta_direction => {
+                    f.delta_direction_lights += 1;
+                    f.unreachable_lights += usize::from(!sampled_towards_its_beams(light.as_ref()));
+                }
                 Some(flags) if flags.delta_position => f.delta_position_lights += 1,
                 Some(_) => f.area_lights += 1,
             }
@@ -305,4 +318,16 @@ impl<'a> LightTracerScene<'a> {
         }
         f
     }
+}
+
+/// Whether `light` gives a next-event sample ([`LightSource::sample_towards`]) to a point that
+/// one of its own beams passes through: the middle emission ray
+/// ([`LightSource::sample_emission`] of uniforms 1/2), a distance of `1 + |origin|` along it
+/// (far enough to leave the origin in floating point). False for lights that draw no emission
+/// ray or return no sample there (a laser of zero width, a plugin that only generates beams).
+pub(crate) fn sampled_towards_its_beams(light: &dyn LightSource) -> bool {
+    light.sample_emission([0.5; 4]).is_some_and(|e| {
+        let receiver = e.position + e.direction * (1.0 + e.position.length());
+        light.sample_towards(receiver, [0.5; 2]).is_some()
+    })
 }

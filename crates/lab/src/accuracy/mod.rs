@@ -709,8 +709,8 @@ fn load(text: &str, path: &Path, max_width: Option<u32>) -> Result<Scene, String
 /// `features`, when the features alone say so (`auto_picks`: what `auto` renders with): a
 /// piecewise-constant SPD is another spectrum; the light tracer shows mirrors and glass that the
 /// camera sees black (flagged wherever the scene has specular surfaces, seen or not); the path
-/// tracer misses lasers, skies, beam-only lights, spectral lines and the caustics of point and
-/// spot lights. `None` when no bias is known (the report also flags a mean brightness off by
+/// tracer misses thin lasers, beam-only lights, spectral lines and the caustics of point, spot and
+/// parallel lights. `None` when no bias is known (the report also flags a mean brightness off by
 /// more than 2%, and errors that level off).
 pub fn known_bias(
     configuration: Configuration,
@@ -729,11 +729,12 @@ pub fn known_bias(
             Some("the light tracer shows mirrors and glass seen by the camera black")
         }
         IntegratorChoice::Path
-            if features.beam_only_lights + features.delta_direction_lights > 0
+            if features.beam_only_lights + features.unreachable_lights > 0
                 || features.line_spectra
-                || (features.delta_position_lights > 0 && features.specular) =>
+                || (features.delta_position_lights + features.delta_direction_lights > 0
+                    && features.specular) =>
         {
-            Some("the path tracer misses lasers, skies, spectral lines or point-light caustics")
+            Some("the path tracer misses thin lasers, spectral lines or caustics of delta lights")
         }
         _ => None,
     }

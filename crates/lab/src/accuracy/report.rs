@@ -341,7 +341,7 @@ pub(super) fn summary_markdown(md: &mut String, report: &AccuracyReport) {
          over that time. A configuration converges unless a bias is known from the scene (a \
          piecewise-constant SPD is another spectrum; the light tracer shows mirrors and glass \
          seen by the camera black, flagged wherever the scene has specular surfaces; the path \
-         tracer misses lasers, skies, lines and point-light caustics) or its mean brightness is \
+         tracer misses thin lasers, lines and caustics of delta lights) or its mean brightness is \
          more than 2% off the reference's; a biased configuration that gets there sooner is \
          named after it (its image is wrong, the error target is just coarse). Times are \
          interpolated between sweep points (`<=` when the first point is already below the \

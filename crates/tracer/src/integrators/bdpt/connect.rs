@@ -175,7 +175,7 @@ impl Bdpt<'_> {
         let ng = light_normal(source, sample.position);
         let kind = VertexKind::Light(chosen.id);
         let mut vertex = Vertex::at(kind, sample.position, ng, 0.0, wl.lambda, NO_SAMPLES);
-        vertex.delta = end.flags.delta_direction;
+        vertex.delta = end.first_vertex_delta();
         vertex.pdf_fwd = end.pmf * pdf_pos;
         Some(Joined { light: Some(vertex), ..Joined::at_pixel(value, wl, end) })
     }

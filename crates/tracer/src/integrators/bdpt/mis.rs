@@ -117,7 +117,7 @@ pub(super) fn build_mis_path(
     }
     if let Some(q) = qs.as_ref() {
         mis[s - 1].from_camera = bdpt.pdf(&pt, pt_minus.as_ref(), q, None);
-        mis[s - 1].delta = if s == 1 { end.flags.delta_direction } else { false };
+        mis[s - 1].delta = if s == 1 { end.first_vertex_delta() } else { false };
         if let Some(qm) = qs_minus.as_ref() {
             mis[s - 2].from_camera = bdpt.pdf(q, Some(&pt), qm, None);
         }

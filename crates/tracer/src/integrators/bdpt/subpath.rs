@@ -89,7 +89,7 @@ impl Bdpt<'_> {
         let ng = light_normal(source, beam.origin);
         let mut start =
             Vertex::at(VertexKind::Light(light.id), beam.origin, ng, beta, wl.lambda, u.lens);
-        start.delta = light.flags.delta_direction;
+        start.delta = light.first_vertex_delta();
         start.pdf_fwd = if camera_strategies { light.pmf * pdf_pos } else { 1.0 };
         buffers.light.push(start);
         let ray = Ray { origin: beam.origin, direction: beam.direction };
@@ -99,6 +99,11 @@ impl Bdpt<'_> {
             Walk { transport: Transport::Importance, reemit: true, max: self.max_vertices().1 };
         let start = WalkStart { ray, first, beta, pdf_dir };
         self.random_walk(start, walk, &mut buffers.light, rng, stats);
+        if light.parallel_sampled() && camera_strategies && buffers.light.len() >= 2 {
+            // The first hit of a parallel beam has a planar density, not a solid-angle one.
+            let (origin, first) = (buffers.light[0], buffers.light[1]);
+            buffers.light[1].pdf_fwd = self.parallel_area_pdf(light.id, &origin, &first);
+        }
     }
 
     /// Follows `start.ray` (whose first hit is `start.first`) through the scene, appending a

@@ -90,12 +90,29 @@ pub(super) struct LightEnd {
     pub id: LightId,
     pub flags: LightFlags,
     pub pmf: f64,
+    /// Whether a point can sample it ([`spectrace_lights::LightSource::sample_towards`] gives
+    /// a sample on its own beams): next-event estimation (`s = 1`) reaches it.
+    pub sampled_towards: bool,
 }
 
 impl LightEnd {
     /// Whether a camera path can never hit it (strategy `s = 0` impossible).
     pub(super) fn is_delta(&self, on_surface: bool) -> bool {
         self.flags.delta_position || self.flags.delta_direction || !on_surface
+    }
+
+    /// Whether no connection can end at its vertex: a delta direction that no point samples (a
+    /// laser of zero width), so strategies with `s = 1` are impossible. A sky's or a wide
+    /// laser's vertex is reached by next-event estimation along the one beam through the
+    /// receiver.
+    pub(super) fn first_vertex_delta(&self) -> bool {
+        self.flags.delta_direction && !self.sampled_towards
+    }
+
+    /// Whether it sends parallel beams that next-event estimation reaches: the density with
+    /// which it lights a vertex is then planar ([`Bdpt::parallel_area_pdf`]).
+    pub(super) fn parallel_sampled(&self) -> bool {
+        self.flags.delta_direction && self.sampled_towards
     }
 }
 
@@ -110,15 +127,31 @@ pub(super) struct Wavelength {
 impl Bdpt<'_> {
     /// The light `id` as a path end for wavelength `wl`.
     pub(super) fn light_end(&self, id: LightId, wl: &Wavelength) -> Option<LightEnd> {
-        let light = self.scene.lights.light(id)?;
-        let flags =
-            light.flags().unwrap_or(LightFlags { delta_position: true, delta_direction: true });
+        self.scene.lights.light(id)?;
+        let flags = self.light_end_flags(id);
         let pmf = if wl.density > 0.0 {
             self.scene.all_lights().pmf_given(id, wl.lambda, wl.density)
         } else {
             0.0
         };
-        Some(LightEnd { id, flags, pmf })
+        let sampled_towards = self.sampled_towards.get(id.0 as usize).copied().unwrap_or(false);
+        Some(LightEnd { id, flags, pmf, sampled_towards })
+    }
+
+    /// Area density at `next` of the parallel beams of light `id` (a delta direction: a sky, a
+    /// wide laser) from its vertex `light`: the density of the beam origins over the light's
+    /// surface, carried along the beams onto `next`, `pdf_position |cos next| / |cos light|`
+    /// (the cosines of the surfaces' normals with the beams; 1 at a vertex without a normal).
+    /// Next-event estimation (`s = 1`) picks the light's vertex as a function of `next`, and a
+    /// light subpath picks `next` as a function of its origin: both carry the same delta, so
+    /// this density is what the two strategies' weights compare.
+    pub(super) fn parallel_area_pdf(&self, id: LightId, light: &Vertex, next: &Vertex) -> f64 {
+        let d = (next.point - light.point).normalize_or_zero();
+        let (pdf_position, _) = self.light_pdfs(id, light.point, d);
+        let cos_light = light.ng.dot(d).abs();
+        let cos_next = if next.ng == DVec3::ZERO { 1.0 } else { next.ng.dot(d).abs() };
+        let p = pdf_position * cos_next / cos_light;
+        if cos_light > 0.0 && p.is_finite() { p } else { 0.0 }
     }
 
     /// Solid-angle density of a camera ray leaving the lens at `origin` (the pinhole for a
@@ -155,7 +188,12 @@ impl Bdpt<'_> {
     ) -> f64 {
         let solid = match v.kind {
             VertexKind::Camera => self.camera_pdf(v.point, next.point),
-            VertexKind::Light(id) => self.light_pdfs(id, v.point, next.point - v.point).1,
+            VertexKind::Light(id) => {
+                if self.light_end_flags(id).delta_direction {
+                    return self.parallel_area_pdf(id, v, next);
+                }
+                self.light_pdfs(id, v.point, next.point - v.point).1
+            }
             VertexKind::Surface(hit) => {
                 if let Some(id) = light.filter(|_| prev.is_none()) {
                     self.light_pdfs(id, v.point, next.point - v.point).1
@@ -188,6 +226,15 @@ impl Bdpt<'_> {
         let wi = (from - v.point).normalize();
         let wo = (to - v.point).normalize();
         material.eval_with(wi, wo, hit.shading_normal, v.lambda, transport)
+    }
+
+    /// A light's flags, or deltas in position and direction when it does not say.
+    pub(super) fn light_end_flags(&self, id: LightId) -> LightFlags {
+        self.scene
+            .lights
+            .light(id)
+            .and_then(|l| l.flags())
+            .unwrap_or(LightFlags { delta_position: true, delta_direction: true })
     }
 
     /// A light's `(position, direction)` emission densities from `point` along `direction`
