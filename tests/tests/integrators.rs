@@ -53,7 +53,8 @@ use crate::variance::pixel_noise;
 use spectrace_geometry::Ray;
 use spectrace_lights::LightSource;
 use spectrace_renderer::{
-    InMemoryRender, Scene, choose_integrator, decide_effects, normalisation, tracer_scene,
+    InMemoryRender, Scene, choose_integrator, decide_effects, normalisation, plan_with,
+    tracer_scene,
 };
 use spectrace_spectrum::{Uniform, Xyz};
 use spectrace_tracer::{
@@ -1095,7 +1096,7 @@ fn each_bdpt_strategy_alone_converges_to_the_same_image() {
     // the light), s = 1 (next-event estimation) and s = 2 (the light path's plane vertex joined to
     // the camera, t = 1). Unweighted, each alone must give the image MIS combines. Tolerance:
     // 5 combined standard errors of the image means over 8 seeds, and each sharp (5%).
-    use spectrace_renderer::{RenderOptions, decide_effects, plan_with, tracer_scene};
+    use spectrace_renderer::{RenderOptions, decide_effects, tracer_scene};
     use spectrace_tracer::{Bdpt, BdptSettings, render};
     let json = r#"{
       "camera": {"position": [0, 1.2, 2.2], "look_at": [0, 0, 0], "fov": 45, "width": 24, "height": 24},
@@ -1138,4 +1139,61 @@ fn each_bdpt_strategy_alone_converges_to_the_same_image() {
         );
         assert!(se < 0.05 * m, "strategy {strategy:?}: standard error {se} of {m}");
     }
+}
+
+/// `auto` by measurement (`spectrace_renderer::measured`): which renders measure, which
+/// estimators compete, and that the pick is the fastest predicted one.
+#[test]
+fn auto_measures_the_estimators_that_see_everything_when_the_render_is_open_ended() {
+    use IntegratorChoice::{Bdpt, Light, Path};
+    use spectrace_renderer::RenderOptions;
+    use spectrace_renderer::measured::{
+        PILOT_SECONDS, PILOT_SHARE, choose, complete_estimators, measure_choice, pilot_budget,
+    };
+    let diffuse = scene(POINT_OVER_PLANE);
+    let glass = scene(GLASS_UNDER_AREA_LIGHT);
+    let caustic = scene(&caustic_json(true));
+    // Who sees every pixel: all three on a diffuse scene, not the light tracer through glass,
+    // only BDPT where a spot's caustic is seen.
+    assert_eq!(complete_estimators(&diffuse), [Light, Path, Bdpt]);
+    assert_eq!(complete_estimators(&glass), [Path, Bdpt]);
+    assert_eq!(complete_estimators(&caustic), [Bdpt]);
+    // When it measures: an open-ended render asked for auto, not sharded.
+    let timed = RenderOptions { time: Some(4.0), ..RenderOptions::default() };
+    let plan = |o: &RenderOptions| plan_with(&diffuse, o, Path).unwrap();
+    assert_eq!(pilot_budget(&diffuse, &timed, &plan(&timed)), Some(PILOT_SHARE * 4.0));
+    let target = RenderOptions { target_error: Some(0.1), ..RenderOptions::default() };
+    assert_eq!(pilot_budget(&diffuse, &target, &plan(&target)), Some(PILOT_SECONDS));
+    for (what, o) in [
+        ("a fixed count", RenderOptions { spp: Some(4), ..timed.clone() }),
+        ("a fixed count", RenderOptions { beams: Some(1000), ..timed.clone() }),
+        ("an explicit estimator", RenderOptions { integrator: Some(Path), ..timed.clone() }),
+        ("a shard", RenderOptions { shard: Some((0, 2)), ..timed.clone() }),
+        ("no time or target", RenderOptions::default()),
+    ] {
+        assert_eq!(pilot_budget(&diffuse, &o, &plan(&o)), None, "{what}");
+    }
+    // The fastest prediction wins; without any, the analysis' pick stands.
+    let fallback = (Path, "path: every light can be reached from the camera".to_owned());
+    let picked =
+        choose(vec![(Light, Some(2.0)), (Path, Some(0.5)), (Bdpt, None)], 0.05, 0.1, &fallback);
+    assert_eq!(picked.choice, Path);
+    assert!(
+        picked.reason.contains("bdpt no estimate") && picked.reason.contains("5%"),
+        "{}",
+        picked.reason
+    );
+    let none = choose(vec![(Light, None), (Bdpt, None)], 0.05, 0.1, &fallback);
+    assert_eq!(none.choice, Path);
+    // A real pilot (0.05 s each): every candidate predicted, the pick the fastest of them; a
+    // scene with one complete estimator is not measured.
+    let short = RenderOptions { time: Some(3.0 / PILOT_SHARE * 0.05), threads: Some(1), ..timed };
+    let measured = measure_choice(&diffuse, &short, &plan(&short), &fallback).unwrap().unwrap();
+    let times: Vec<f64> = measured.predictions.iter().map(|p| p.1.unwrap()).collect();
+    assert_eq!(measured.predictions.iter().map(|p| p.0).collect::<Vec<_>>(), [Light, Path, Bdpt]);
+    let best = measured.predictions.iter().min_by(|a, b| a.1.unwrap().total_cmp(&b.1.unwrap()));
+    assert_eq!(Some(measured.choice), best.map(|b| b.0), "{times:?}");
+    assert!(measured.reason.starts_with(measured.choice.name()), "{}", measured.reason);
+    let caustic_plan = plan_with(&caustic, &short, Bdpt).unwrap();
+    assert_eq!(measure_choice(&caustic, &short, &caustic_plan, &fallback).unwrap(), None);
 }

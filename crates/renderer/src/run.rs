@@ -9,6 +9,7 @@ use spectrace_tracer::{
 };
 
 use crate::integrators::{kernel_of, with_kernel};
+use crate::measured::measure_choice;
 
 use crate::plan::scene_normalisation;
 use crate::progress::render_with_progress;
@@ -39,8 +40,8 @@ pub fn render_file(path: &Path, options: &RenderOptions) -> Result<RenderReport,
 /// # Errors
 /// As [`render_file`].
 pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderReport, RenderError> {
-    let (choice, reason) = choose_integrator(scene, options.integrator);
-    let plan = plan_with(scene, options, choice)?;
+    let fallback = choose_integrator(scene, options.integrator);
+    let plan = plan_with(scene, options, fallback.0)?;
     let name = scene.output_name();
     check_sensor_names(scene, &name)?;
     planned_outputs(
@@ -51,6 +52,15 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
         &scene.inputs,
         planned_sensor_outputs(scene, &options.out_dir),
     )?;
+    let (choice, reason, plan) = match measure_choice(scene, options, &plan, &fallback)? {
+        Some(m) => {
+            // The pilots' time comes out of the budget.
+            let mut plan = plan_with(scene, options, m.choice)?;
+            plan.time_budget = plan.time_budget.map(|t| (t - m.pilot_seconds).max(1e-3));
+            (m.choice, m.reason, plan)
+        }
+        None => (fallback.0, fallback.1, plan),
+    };
     let (plan, estimate_warning) = fit_estimate(scene, plan)?;
     let effects = decide_effects(scene, options.effects);
     if options.verbose {

@@ -449,7 +449,7 @@ fn format_decimal(k: u64, e: i32) -> String {
 }
 
 /// A summary figure with about three significant digits.
-fn format_value(x: f64) -> String {
+pub(crate) fn format_value(x: f64) -> String {
     if x == 0.0 {
         return "0".to_owned();
     }
