@@ -1175,15 +1175,19 @@ fn auto_measures_the_estimators_that_see_everything_when_the_render_is_open_ende
     }
     // The fastest prediction wins; without any, the analysis' pick stands.
     let fallback = (Path, "path: every light can be reached from the camera".to_owned());
-    let picked =
-        choose(vec![(Light, Some(2.0)), (Path, Some(0.5)), (Bdpt, None)], 0.05, 0.1, &fallback);
+    let picked = choose(
+        vec![(Light, Some(2.0)), (Path, Some(0.5)), (Bdpt, None)],
+        0.05,
+        (0.1, Some((64, 48))),
+        &fallback,
+    );
     assert_eq!(picked.choice, Path);
     assert!(
         picked.reason.contains("bdpt no estimate") && picked.reason.contains("5%"),
         "{}",
         picked.reason
     );
-    let none = choose(vec![(Light, None), (Bdpt, None)], 0.05, 0.1, &fallback);
+    let none = choose(vec![(Light, None), (Bdpt, None)], 0.05, (0.1, None), &fallback);
     assert_eq!(none.choice, Path);
     // A real pilot (0.05 s each): every candidate predicted, the pick the fastest of them; a
     // scene with one complete estimator is not measured.
@@ -1196,4 +1200,11 @@ fn auto_measures_the_estimators_that_see_everything_when_the_render_is_open_ende
     assert!(measured.reason.starts_with(measured.choice.name()), "{}", measured.reason);
     let caustic_plan = plan_with(&caustic, &short, Bdpt).unwrap();
     assert_eq!(measure_choice(&caustic, &short, &caustic_plan, &fallback).unwrap(), None);
+    // A large image is piloted at most 128 x 128 pixels, the same view and aspect.
+    let large = scene(
+        &POINT_OVER_PLANE.replace(r#""width": 32, "height": 32"#, r#""width": 400, "height": 200"#),
+    );
+    let large_plan = plan_with(&large, &short, Path).unwrap();
+    let measured = measure_choice(&large, &short, &large_plan, &fallback).unwrap().unwrap();
+    assert!(measured.reason.contains("at 181x90 pixels"), "{}", measured.reason);
 }

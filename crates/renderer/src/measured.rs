@@ -13,9 +13,14 @@
 //! # What it costs
 //! The pilots together take [`PILOT_SHARE`] of a `--time` budget (which the render then has that
 //! much less of), or [`PILOT_SECONDS`] when only a target error bounds the render; the time is
-//! split evenly between the candidates. Each pilot renders at least one chunk per thread (for a
-//! camera estimator a chunk is a pass over the image), so on a large image, or a budget of a
-//! fraction of a second, the pilots take longer than their share. The prediction ranks the candidates by their
+//! split evenly between the candidates. Each pilot renders at least one chunk per thread, and a
+//! camera estimator's chunk is a pass over the image, so the pilots render the scene with its
+//! camera scaled down to at most [`PILOT_PIXELS`] pixels (same view and aspect; the scene is
+//! loaded again from its canonical JSON, which the pilots' time includes). Every estimator's
+//! time to a given per-pixel error grows in proportion to the pixels (a camera pass costs its
+//! pixels, and a light tracer needs beams in proportion to them), so the predicted times are
+//! scaled by the ratio of pixels and their ranking is the pilot's. On a budget of a fraction of
+//! a second the pilots can still take longer than their share. The prediction ranks the candidates by their
 //! predicted time to the render's target error (5% when only a time is given; the ranking is the
 //! same for every target when errors fall as `1 / sqrt(time)`).
 //!
@@ -40,6 +45,9 @@ pub const PILOT_SHARE: f64 = 0.05;
 
 /// Seconds the pilots may take together when only a target error bounds the render.
 pub const PILOT_SECONDS: f64 = 2.0;
+
+/// Most pixels of the image the pilots render.
+pub const PILOT_PIXELS: u64 = 128 * 128;
 
 /// The target error the pilots predict for when the render has none (only a time budget).
 const DEFAULT_TARGET: f64 = 0.05;
@@ -105,26 +113,58 @@ pub fn measure_choice(
         fixed_rounds: None,
     };
     let start = Instant::now();
-    let report = estimate(scene, &estimate_options)?;
+    let small = pilot_scene(scene)?;
+    let (pilot, scale) = match &small {
+        Some(s) => (s, pixels(scene) as f64 / pixels(s) as f64),
+        None => (scene, 1.0),
+    };
+    let report = estimate(pilot, &estimate_options)?;
     let pilot_seconds = start.elapsed().as_secs_f64();
     let predictions: Vec<(IntegratorChoice, Option<f64>)> = candidates
         .iter()
         .map(|&c| {
             let p = report.predictions.iter().find(|p| p.integrator == c.name());
-            (c, p.and_then(|p| p.predicted_seconds))
+            (c, p.and_then(|p| p.predicted_seconds).map(|t| t * scale))
         })
         .collect();
-    Ok(Some(choose(predictions, target, pilot_seconds, fallback)))
+    let size = small.as_ref().map(|s| (s.camera.width(), s.camera.height()));
+    Ok(Some(choose(predictions, target, (pilot_seconds, size), fallback)))
+}
+
+/// Pixels of the scene's image.
+fn pixels(scene: &Scene) -> u64 {
+    u64::from(scene.camera.width()) * u64::from(scene.camera.height())
+}
+
+/// The scene with its camera scaled down to at most [`PILOT_PIXELS`] pixels (each side at least
+/// 1, the aspect kept), loaded again from its canonical JSON; `None` when it is that small
+/// already.
+///
+/// # Errors
+/// [`RenderError::Scene`] if the scene no longer loads (a file it names changed meanwhile).
+fn pilot_scene(scene: &Scene) -> Result<Option<Scene>, RenderError> {
+    let (w, h) = (scene.camera.width(), scene.camera.height());
+    if pixels(scene) <= PILOT_PIXELS {
+        return Ok(None);
+    }
+    let shrink = (PILOT_PIXELS as f64 / pixels(scene) as f64).sqrt();
+    let side = |n: u32| ((f64::from(n) * shrink).floor() as u32).max(1);
+    let mut value: serde_json::Value = serde_json::from_str(&scene.canonical_json)
+        .map_err(|e| RenderError::Options(format!("the scene's canonical JSON: {e}")))?;
+    value["camera"]["width"] = side(w).into();
+    value["camera"]["height"] = side(h).into();
+    Ok(Some(Scene::from_json(&value.to_string(), &scene.path)?))
 }
 
 /// The fastest of `predictions` (the static rule's choice when none could be predicted), with
-/// its reason.
+/// its reason; `pilot` is the pilots' time and, when they rendered a smaller image, its size.
 pub fn choose(
     predictions: Vec<(IntegratorChoice, Option<f64>)>,
     target: f64,
-    pilot_seconds: f64,
+    pilot: (f64, Option<(u32, u32)>),
     fallback: &(IntegratorChoice, String),
 ) -> MeasuredChoice {
+    let (pilot_seconds, size) = pilot;
     let fastest = predictions
         .iter()
         .filter_map(|&(c, t)| t.filter(|t| t.is_finite()).map(|t| (c, t)))
@@ -141,8 +181,11 @@ pub fn choose(
         None => (fallback.0, "no pilot gave an estimate, so the analysis decides"),
     };
     let percent = (100_000.0 * target).round() / 1000.0;
+    let at = size.map_or(String::new(), |(w, h)| {
+        format!(" at {w}x{h} pixels (times scaled to the full image)")
+    });
     let reason = format!(
-        "{}: {verdict} to {percent}% relative error by a {pilot_seconds:.2} s pilot of every \
+        "{}: {verdict} to {percent}% relative error by a {pilot_seconds:.2} s pilot{at} of every \
          estimator that sees the whole image ({}); the analysis alone picks {}",
         choice.name(),
         listed.join(", "),

@@ -133,7 +133,8 @@ pub struct InMemoryRender {
 }
 
 /// Renders a scene with overrides without writing anything (no probe, no progress bar): for
-/// tests, benchmarks and the accuracy report.
+/// tests, benchmarks and the accuracy report. `auto` is the effects analysis' rule here, never
+/// measured ([`crate::measured`] is [`render_scene`]'s), so the estimator is reproducible.
 ///
 /// # Errors
 /// [`RenderError::Options`] for invalid options or a film that cannot be made.
