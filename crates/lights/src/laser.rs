@@ -24,6 +24,29 @@ use spectrace_spectrum::SpectralPowerDistribution;
 
 use spectrace_sampling::{Frame, sample_uniform_disk_concentric};
 
+/// The next-event sample of a parallel beam that starts at `position` on the light and reaches
+/// the receiver `distance` along `direction`, carrying `irradiance` (W/m^2 across the beam):
+/// `intensity = irradiance distance^2`, so that `intensity cos / distance^2` is the irradiance;
+/// `pdf` 1, a delta. `None` upstream (`distance <= 0`) or when the squared distance or the
+/// intensity is not a finite positive number.
+pub(crate) fn beam_through(
+    position: DVec3,
+    direction: DVec3,
+    distance: f64,
+    irradiance: f64,
+) -> Option<LightSample> {
+    let squared = distance * distance;
+    let intensity = irradiance * squared;
+    (distance > 0.0 && squared.is_normal() && intensity.is_finite()).then_some(LightSample {
+        position,
+        direction,
+        distance,
+        intensity,
+        pdf: 1.0,
+        delta: true,
+    })
+}
+
 /// How far (in `1 - cos` of the angle between them) a direction may be from a laser's or a sky's
 /// and still count as its direction in `pdf_emission`: about 4.5e-5 rad.
 pub(crate) const SAME_DIRECTION: f64 = 1e-9;
@@ -174,18 +197,10 @@ impl LightSource for Laser {
         let irradiance = self.irradiance();
         let distance = (receiver - self.position).dot(self.direction);
         let position = receiver - self.direction * distance;
-        let squared = distance * distance;
-        let intensity = irradiance * squared;
         let inside = (position - self.position).length() <= self.beam_radius;
-        let usable = distance > 0.0 && squared.is_normal() && intensity.is_finite();
-        (irradiance > 0.0 && inside && usable).then_some(LightSample {
-            position,
-            direction: self.direction,
-            distance,
-            intensity,
-            pdf: 1.0,
-            delta: true,
-        })
+        (irradiance > 0.0 && inside)
+            .then(|| beam_through(position, self.direction, distance, irradiance))
+            .flatten()
     }
     /// The direction for a beam of finite radius (the disk its beams start from faces it),
     /// `None` for a beam of radius 0 (a point).

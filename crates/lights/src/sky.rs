@@ -27,6 +27,7 @@ use serde::{Deserialize, Serialize};
 use spectrace_spectrum::SpectralPowerDistribution;
 
 use crate::geometry::{finite_point, safe_length, unit_direction};
+use crate::laser::beam_through;
 use crate::source::{power_from_keys, uniform};
 use crate::{
     Beam, EmissionSample, LightError, LightFlags, LightSample, LightSource, SpdLight,
@@ -228,18 +229,10 @@ impl LightSource for Sky {
         let position = receiver - self.direction * distance;
         let offset = position - self.corner;
         let (s, t) = (offset.dot(self.dual_u), offset.dot(self.dual_v));
-        let squared = distance * distance;
-        let intensity = self.irradiance() * squared;
         let inside = (0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&t);
-        let usable = distance > 0.0 && squared.is_normal() && intensity.is_finite();
-        (inside && usable).then_some(LightSample {
-            position,
-            direction: self.direction,
-            distance,
-            intensity,
-            pdf: 1.0,
-            delta: true,
-        })
+        inside
+            .then(|| beam_through(position, self.direction, distance, self.irradiance()))
+            .flatten()
     }
     /// The rectangle's normal on the side the beams leave, at every point (BDPT turns the
     /// density of a beam's origin into the density of the point it lights with it).
