@@ -1208,3 +1208,40 @@ fn auto_measures_the_estimators_that_see_everything_when_the_render_is_open_ende
     let measured = measure_choice(&large, &short, &large_plan, &fallback).unwrap().unwrap();
     assert!(measured.reason.contains("at 181x90 pixels"), "{}", measured.reason);
 }
+
+/// When the scaled-down pilot cannot load the scene again (here its OBJ mesh was removed after
+/// loading), the render still runs, with the analysis' pick and a warning saying why.
+#[test]
+fn a_failed_pilot_falls_back_to_the_rule_with_a_warning() {
+    use spectrace_renderer::{RenderOptions, render_scene};
+    let dir = crate::rendering::temp_dir("pilot-fallback");
+    std::fs::write(
+        dir.join("quad.obj"),
+        "v -3 0 3\nv 3 0 3\nv 3 0 -3\nv -3 0 -3\nf 1 2 3\nf 1 3 4\n",
+    )
+    .unwrap();
+    let json = POINT_OVER_PLANE
+        .replace(r#""width": 32, "height": 32"#, r#""width": 200, "height": 100"#)
+        .replace(
+            r#"{"type": "Rectangle", "corner": [-3, 0, 3], "edge_u": [6, 0, 0], "edge_v": [0, 0, -6]}"#,
+            r#"{"type": "Mesh", "obj": "quad.obj"}"#,
+        );
+    let scene = Scene::from_json(&json, &dir.join("scene.json")).unwrap();
+    std::fs::remove_file(dir.join("quad.obj")).unwrap();
+    let options = RenderOptions {
+        time: Some(0.5),
+        threads: Some(1),
+        out_dir: dir.join("out"),
+        ..RenderOptions::default()
+    };
+    let report = render_scene(&scene, &options).unwrap();
+    let (rule, _) = choose_integrator(&scene, None);
+    assert_eq!(report.integrator, rule.name());
+    assert!(
+        report.warnings.iter().any(|w| w.contains("auto's pilot failed")),
+        "{:?}",
+        report.warnings
+    );
+    assert!(report.beams > 0);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

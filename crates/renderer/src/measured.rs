@@ -38,7 +38,7 @@ use crate::integrators::ESTIMATORS;
 use crate::pilot::{EstimateOptions, estimate};
 use crate::sensor_output::format_value;
 use crate::warnings::integrator_warnings;
-use crate::{RenderError, RenderOptions, Scene};
+use crate::{LoadOptions, RenderError, RenderOptions, Scene};
 
 /// Share of a `--time` budget the pilots may take together.
 pub const PILOT_SHARE: f64 = 0.05;
@@ -91,7 +91,8 @@ pub fn pilot_budget(scene: &Scene, options: &RenderOptions, plan: &RenderPlan) -
 /// `None` otherwise. `fallback` is the static rule's choice and reason.
 ///
 /// # Errors
-/// As [`estimate`].
+/// As [`estimate`], or when the scene no longer loads for the scaled-down pilot (a file it names
+/// changed meanwhile). [`crate::render_scene`] then renders with the rule's pick and warns.
 pub fn measure_choice(
     scene: &Scene,
     options: &RenderOptions,
@@ -113,7 +114,7 @@ pub fn measure_choice(
         fixed_rounds: None,
     };
     let start = Instant::now();
-    let small = pilot_scene(scene)?;
+    let small = pilot_scene(scene, options)?;
     let (pilot, scale) = match &small {
         Some(s) => (s, pixels(scene) as f64 / pixels(s) as f64),
         None => (scene, 1.0),
@@ -137,12 +138,12 @@ fn pixels(scene: &Scene) -> u64 {
 }
 
 /// The scene with its camera scaled down to at most [`PILOT_PIXELS`] pixels (each side at least
-/// 1, the aspect kept), loaded again from its canonical JSON; `None` when it is that small
-/// already.
+/// 1, the aspect kept), loaded again from its canonical JSON with the render's load options
+/// (`--restrict-paths` holds for the reload too); `None` when it is that small already.
 ///
 /// # Errors
 /// [`RenderError::Scene`] if the scene no longer loads (a file it names changed meanwhile).
-fn pilot_scene(scene: &Scene) -> Result<Option<Scene>, RenderError> {
+fn pilot_scene(scene: &Scene, options: &RenderOptions) -> Result<Option<Scene>, RenderError> {
     let (w, h) = (scene.camera.width(), scene.camera.height());
     if pixels(scene) <= PILOT_PIXELS {
         return Ok(None);
@@ -153,7 +154,8 @@ fn pilot_scene(scene: &Scene) -> Result<Option<Scene>, RenderError> {
         .map_err(|e| RenderError::Options(format!("the scene's canonical JSON: {e}")))?;
     value["camera"]["width"] = side(w).into();
     value["camera"]["height"] = side(h).into();
-    Ok(Some(Scene::from_json(&value.to_string(), &scene.path)?))
+    let load = LoadOptions { restrict_paths: options.restrict_paths };
+    Ok(Some(Scene::from_json_with(&value.to_string(), &scene.path, load)?))
 }
 
 /// The fastest of `predictions` (the static rule's choice when none could be predicted), with

@@ -52,16 +52,22 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
         &scene.inputs,
         planned_sensor_outputs(scene, &options.out_dir),
     )?;
-    let (choice, reason, plan) = match measure_choice(scene, options, &plan, &fallback)? {
-        Some(m) => {
+    let mut warnings = Vec::new();
+    let (choice, reason, plan) = match measure_choice(scene, options, &plan, &fallback) {
+        Ok(Some(m)) => {
             // The pilots' time comes out of the budget.
             let mut plan = plan_with(scene, options, m.choice)?;
             plan.time_budget = plan.time_budget.map(|t| (t - m.pilot_seconds).max(1e-3));
             (m.choice, m.reason, plan)
         }
-        None => (fallback.0, fallback.1, plan),
+        Ok(None) => (fallback.0, fallback.1, plan),
+        Err(e) => {
+            warnings.push(format!("auto's pilot failed ({e}); the analysis' pick is used"));
+            (fallback.0, fallback.1, plan)
+        }
     };
     let (plan, estimate_warning) = fit_estimate(scene, plan)?;
+    warnings.extend(estimate_warning);
     let effects = decide_effects(scene, options.effects);
     if options.verbose {
         tell!("{}", effects.summary());
@@ -73,7 +79,7 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
     }
     with_kernel(scene, choice, effects, plan.shard.is_none(), kernel, |tracer| {
         let setup = Setup { choice, reason: &reason, effects, plan, name: &name, kernel };
-        render_with(scene, options, &setup, estimate_warning.into_iter().collect(), tracer)
+        render_with(scene, options, &setup, warnings, tracer)
     })
 }
 
