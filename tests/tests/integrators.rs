@@ -22,6 +22,7 @@
 //! | `glass_caustic` | glass sphere under the fading spot: a caustic on the floor, 16x16 | none | not through glass | no delta-light caustic | all | bdpt | off | 12 | 3 | 5% |
 //! | `sunlit_sphere` | a sky's parallel light on a diffuse sphere and floor, 16x16 | none | all | all | all | path | auto | 12 | 4 | 5% |
 //! | `sunlit_glass` | glass sphere on the floor under the sky: the sun's caustic, 16x16 | none | not through glass | no delta-light caustic | all | bdpt | auto | 12 | 4 | 5% |
+//! | `wide_laser` | a laser of 0.6 m radius slanting onto the diffuse sphere and floor, 16x16 | none | all | all | all | path | auto | 12 | 4 | 5% |
 //!
 //! What each cell checks ([`check_row`]):
 //! - **all** (the estimator sees every pixel): the closed form where the row has one (every 8x8
@@ -775,6 +776,34 @@ fn sunlit_glass() -> Row {
         sharp: 0.05,
         mean_z: 4.0,
     }
+}
+
+/// A laser of finite width instead of the sky: next-event estimation finds the one beam through
+/// a point inside the beam's cylinder (the disk's normal is the beam direction).
+fn wide_laser() -> Row {
+    let sky = r#"{"type": "Sky", "corner": [-4, 3, -6], "edge_u": [8, 0, 0], "edge_v": [0, 0, 8],
+              "direction": [0.3, -1, 0.8], "power": 50, "spd": {"type": "CieIlluminant", "name": "D65"}}"#;
+    let laser = r#"{"type": "Laser", "position": [-0.5, 2, -1.2], "direction": [0.3, -1, 0.6],
+              "beam_radius": 0.6, "power": 20, "spd": {"type": "CieIlluminant", "name": "D65"}}"#;
+    let json = sunlit_json(false);
+    assert!(json.contains(sky), "the sky of sunlit_json changed");
+    Row {
+        name: "wide_laser",
+        scene: scene(&json.replace(sky, laser)),
+        auto: IntegratorChoice::Path,
+        effects: EffectsMode::Auto,
+        closed_form: None,
+        cells: [all(80_000), all(16 * 16 * 8), all(16 * 16 * 8)],
+        glass: None,
+        seeds: 12,
+        sharp: 0.05,
+        mean_z: 4.0,
+    }
+}
+
+#[test]
+fn matrix_wide_laser() {
+    check_row(&wide_laser());
 }
 
 #[test]
