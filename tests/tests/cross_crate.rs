@@ -7,6 +7,7 @@ mod fuzz;
 mod hostile;
 mod integrators;
 mod kernels;
+mod measured_auto;
 mod photometry;
 mod rendering;
 mod rough_materials;

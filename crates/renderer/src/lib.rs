@@ -28,7 +28,8 @@
 //! ([`render_scene`] in named steps), `progress`, `write` and `output` (the files and their
 //! encoding), `report` (the sidecar), `sensors` and `sensor_output`, `part` and `shard` (part
 //! files and [`merge_parts`]), `bench`, [`pilot`], [`measured`] (`auto` chosen by a pilot of
-//! each complete estimator), [`cli`], and `files` (bounded reads, atomic writes). Everything public is re-exported here, at the crate's root.
+//! each complete estimator), [`cli`], and `files` (bounded reads, atomic writes). Everything
+//! public is re-exported here, at the crate's root.
 
 mod bench;
 pub mod cli;

@@ -20,9 +20,9 @@
 //! time to a given per-pixel error grows in proportion to the pixels (a camera pass costs its
 //! pixels, and a light tracer needs beams in proportion to them), so the predicted times are
 //! scaled by the ratio of pixels and their ranking is the pilot's. On a budget of a fraction of
-//! a second the pilots can still take longer than their share. The prediction ranks the candidates by their
-//! predicted time to the render's target error (5% when only a time is given; the ranking is the
-//! same for every target when errors fall as `1 / sqrt(time)`).
+//! a second the pilots can still take longer than their share. The prediction ranks the
+//! candidates by their predicted time to the render's target error (5% when only a time is
+//! given; the ranking is the same for every target when errors fall as `1 / sqrt(time)`).
 //!
 //! # Reproducibility
 //! The choice depends on the machine's speed at the time, so two runs may choose differently

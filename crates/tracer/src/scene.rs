@@ -50,9 +50,13 @@ pub struct LightTracerScene<'a> {
     area_lights: PowerLightSampler,
     /// Every light, by power: the choice of a light vertex given a wavelength (BDPT).
     all_lights: PowerLightSampler,
-    /// The lights with a delta position and a spread of directions (points, spots): sampled
-    /// one by one, never chosen, since no ray can hit them.
+    /// The delta lights a point can sample: a delta position and a spread of directions (points,
+    /// spots), or parallel beams (`parallel_sampled`); sampled one by one, never chosen, since
+    /// no ray can hit them.
     delta_lights: Vec<LightId>,
+    /// Per light (by id): whether it sends parallel beams (a delta direction) that a point can
+    /// sample ([`sampled_towards_its_beams`]): skies and lasers of finite width.
+    parallel_sampled: Vec<bool>,
 }
 
 /// Light leaving a shape's surface: which light of the set it belongs to, so that camera paths
@@ -99,16 +103,21 @@ impl<'a> LightTracerScene<'a> {
         let area_lights = PowerLightSampler::new(lights, |l| {
             l.flags().is_some_and(|f| !f.delta_position && !f.delta_direction)
         });
+        let parallel_sampled: Vec<bool> = lights
+            .lights()
+            .iter()
+            .map(|l| {
+                l.flags().is_some_and(|f| f.delta_direction)
+                    && sampled_towards_its_beams(l.as_ref())
+            })
+            .collect();
         let delta_lights = lights
             .lights()
             .iter()
+            .zip(&parallel_sampled)
             .enumerate()
-            .filter(|(_, l)| {
-                l.flags().is_some_and(|f| match (f.delta_position, f.delta_direction) {
-                    (true, false) => true,
-                    (_, true) => sampled_towards_its_beams(l.as_ref()),
-                    (false, false) => false,
-                })
+            .filter(|(_, (l, parallel))| {
+                **parallel || l.flags().is_some_and(|f| f.delta_position && !f.delta_direction)
             })
             .map(|(i, _)| LightId(i as u32))
             .collect();
@@ -128,6 +137,7 @@ impl<'a> LightTracerScene<'a> {
             area_lights,
             all_lights: PowerLightSampler::new(lights, |_| true),
             delta_lights,
+            parallel_sampled,
         }
     }
 
@@ -169,6 +179,12 @@ impl<'a> LightTracerScene<'a> {
     /// samples each of them at every vertex.
     pub fn delta_lights(&self) -> &[LightId] {
         &self.delta_lights
+    }
+
+    /// Whether light `id` sends parallel beams that a point can sample (a sky, a laser of
+    /// finite width): next-event estimation reaches it along the one beam through the point.
+    pub fn parallel_sampled(&self, id: LightId) -> bool {
+        self.parallel_sampled.get(id.0 as usize).copied().unwrap_or(false)
     }
 
     /// The scene's sensors (none if it has none).
@@ -284,12 +300,12 @@ impl<'a> LightTracerScene<'a> {
             light_spectra_vary: self.lights.lights().iter().any(|l| !l.uniform_spectrum()),
             ..SceneFeatures::default()
         };
-        for light in self.lights.lights() {
+        for (i, light) in self.lights.lights().iter().enumerate() {
             match light.flags() {
                 None => f.beam_only_lights += 1,
                 Some(flags) if flags.delta_direction => {
                     f.delta_direction_lights += 1;
-                    f.unreachable_lights += usize::from(!sampled_towards_its_beams(light.as_ref()));
+                    f.unreachable_lights += usize::from(!self.parallel_sampled(LightId(i as u32)));
                 }
                 Some(flags) if flags.delta_position => f.delta_position_lights += 1,
                 Some(_) => f.area_lights += 1,
@@ -325,7 +341,7 @@ impl<'a> LightTracerScene<'a> {
 /// ([`LightSource::sample_emission`] of uniforms 1/2), a distance of `1 + |origin|` along it
 /// (far enough to leave the origin in floating point). False for lights that draw no emission
 /// ray or return no sample there (a laser of zero width, a plugin that only generates beams).
-pub(crate) fn sampled_towards_its_beams(light: &dyn LightSource) -> bool {
+fn sampled_towards_its_beams(light: &dyn LightSource) -> bool {
     light.sample_emission([0.5; 4]).is_some_and(|e| {
         let receiver = e.position + e.direction * (1.0 + e.position.length());
         light.sample_towards(receiver, [0.5; 2]).is_some()

@@ -145,9 +145,6 @@ pub struct Bdpt<'a> {
     camera_layout: SampleLayout,
     /// The uniforms of light-subpath vertices (re-emission, a lens point for `t = 1`).
     light_layout: SampleLayout,
-    /// Per light (by id): whether a point can sample it, so that next-event estimation reaches
-    /// it ([`crate::scene::sampled_towards_its_beams`]).
-    sampled_towards: Vec<bool>,
 }
 
 /// A strategy: `s` vertices of the light subpath `light` joined to `t` of the camera
@@ -171,13 +168,7 @@ impl<'a> Bdpt<'a> {
             SampleLayout::camera_paths(scene, false, !scene.all_lights().is_empty());
         let light_layout = SampleLayout::light_paths(scene);
         let set_spd = LightSource::spd(scene.lights);
-        let sampled_towards = scene
-            .lights
-            .lights()
-            .iter()
-            .map(|l| crate::scene::sampled_towards_its_beams(l.as_ref()))
-            .collect();
-        Self { scene, settings, effects, set_spd, camera_layout, light_layout, sampled_towards }
+        Self { scene, settings, effects, set_spd, camera_layout, light_layout }
     }
 
     /// Its settings.

@@ -99,7 +99,7 @@ impl Bdpt<'_> {
             Walk { transport: Transport::Importance, reemit: true, max: self.max_vertices().1 };
         let start = WalkStart { ray, first, beta, pdf_dir };
         self.random_walk(start, walk, &mut buffers.light, rng, stats);
-        if light.parallel_sampled() && camera_strategies && buffers.light.len() >= 2 {
+        if light.parallel_sampled && camera_strategies && buffers.light.len() >= 2 {
             // The first hit of a parallel beam has a planar density, not a solid-angle one.
             let (origin, first) = (buffers.light[0], buffers.light[1]);
             buffers.light[1].pdf_fwd = self.parallel_area_pdf(light.id, &origin, &first);

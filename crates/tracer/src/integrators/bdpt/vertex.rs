@@ -90,9 +90,10 @@ pub(super) struct LightEnd {
     pub id: LightId,
     pub flags: LightFlags,
     pub pmf: f64,
-    /// Whether a point can sample it ([`spectrace_lights::LightSource::sample_towards`] gives
-    /// a sample on its own beams): next-event estimation (`s = 1`) reaches it.
-    pub sampled_towards: bool,
+    /// Whether it sends parallel beams that a point can sample
+    /// ([`crate::LightTracerScene::parallel_sampled`]): next-event estimation (`s = 1`) reaches
+    /// it.
+    pub parallel_sampled: bool,
 }
 
 impl LightEnd {
@@ -106,13 +107,7 @@ impl LightEnd {
     /// laser's vertex is reached by next-event estimation along the one beam through the
     /// receiver.
     pub(super) fn first_vertex_delta(&self) -> bool {
-        self.flags.delta_direction && !self.sampled_towards
-    }
-
-    /// Whether it sends parallel beams that next-event estimation reaches: the density with
-    /// which it lights a vertex is then planar ([`Bdpt::parallel_area_pdf`]).
-    pub(super) fn parallel_sampled(&self) -> bool {
-        self.flags.delta_direction && self.sampled_towards
+        self.flags.delta_direction && !self.parallel_sampled
     }
 }
 
@@ -127,15 +122,16 @@ pub(super) struct Wavelength {
 impl Bdpt<'_> {
     /// The light `id` as a path end for wavelength `wl`.
     pub(super) fn light_end(&self, id: LightId, wl: &Wavelength) -> Option<LightEnd> {
-        self.scene.lights.light(id)?;
-        let flags = self.light_end_flags(id);
+        let light = self.scene.lights.light(id)?;
+        let flags =
+            light.flags().unwrap_or(LightFlags { delta_position: true, delta_direction: true });
         let pmf = if wl.density > 0.0 {
             self.scene.all_lights().pmf_given(id, wl.lambda, wl.density)
         } else {
             0.0
         };
-        let sampled_towards = self.sampled_towards.get(id.0 as usize).copied().unwrap_or(false);
-        Some(LightEnd { id, flags, pmf, sampled_towards })
+        let parallel_sampled = self.scene.parallel_sampled(id);
+        Some(LightEnd { id, flags, pmf, parallel_sampled })
     }
 
     /// Area density at `next` of the parallel beams of light `id` (a delta direction: a sky, a
@@ -189,7 +185,7 @@ impl Bdpt<'_> {
         let solid = match v.kind {
             VertexKind::Camera => self.camera_pdf(v.point, next.point),
             VertexKind::Light(id) => {
-                if self.light_end_flags(id).delta_direction {
+                if self.scene.parallel_sampled(id) {
                     return self.parallel_area_pdf(id, v, next);
                 }
                 self.light_pdfs(id, v.point, next.point - v.point).1
@@ -226,15 +222,6 @@ impl Bdpt<'_> {
         let wi = (from - v.point).normalize();
         let wo = (to - v.point).normalize();
         material.eval_with(wi, wo, hit.shading_normal, v.lambda, transport)
-    }
-
-    /// A light's flags, or deltas in position and direction when it does not say.
-    pub(super) fn light_end_flags(&self, id: LightId) -> LightFlags {
-        self.scene
-            .lights
-            .light(id)
-            .and_then(|l| l.flags())
-            .unwrap_or(LightFlags { delta_position: true, delta_direction: true })
     }
 
     /// A light's `(position, direction)` emission densities from `point` along `direction`
