@@ -11,7 +11,7 @@ use spectrace_renderer::{
     PartialFilm, RenderOptions, Scene, merge_parts, render_in_memory, render_scene,
 };
 use spectrace_spectrum::Xyz;
-use spectrace_tracer::{IntegratorChoice, MIN_BATCHES};
+use spectrace_tracer::{IntegratorChoice, MIN_BATCHES, SamplerKind};
 
 /// A shipped scene at `width x height` pixels.
 pub(crate) fn small(name: &str, width: u32, height: u32) -> Scene {
@@ -78,7 +78,9 @@ fn the_estimate_is_within_20_percent_of_the_true_error_on_shipped_scenes() {
         ("prism.json", IntegratorChoice::Bdpt),
         ("spot_torus.json", IntegratorChoice::Light),
     ] {
-        let s = small(name, 48, 32);
+        let mut s = small(name, 48, 32);
+        // Independent passes: the estimate's promise (Sobol's is an upper bound, below).
+        s.settings.sampler = SamplerKind::Independent;
         // 32 samples per pixel, or 32 chunks of beams.
         let effort = if integrator == IntegratorChoice::Light { 32 << 14 } else { 32 * 48 * 32 };
         let (truth, estimated) = truth_and_estimate(&s, integrator, effort, 8);
@@ -87,6 +89,28 @@ fn the_estimate_is_within_20_percent_of_the_true_error_on_shipped_scenes() {
             (estimated / truth - 1.0).abs() < 0.2,
             "{name}: estimated {estimated}, true {truth}"
         );
+    }
+}
+
+/// Under Sobol points (the camera estimators' default for fixed efforts and time budgets) a
+/// pixel's passes are one stratified sequence, not independent batches: the estimate measures
+/// the independent sampler's error, an upper bound of the true one. Same renders as above.
+/// Measured estimated / true: 1.92 (Cornell box, path; its independent renders: 0.1293 true
+/// error, 0.0695 under Sobol) and 1.68 (sky, BDPT). Asserted above 1.2: the estimate bounds the
+/// error from above with a margin larger than its own noise (the 20% allowed above), which
+/// only holds if Sobol's true error is well below the independent sampler's.
+#[test]
+fn under_sobol_points_the_estimate_is_an_upper_bound() {
+    for (name, integrator) in
+        [("cornell.json", IntegratorChoice::Path), ("sky.json", IntegratorChoice::Bdpt)]
+    {
+        let mut s = small(name, 48, 32);
+        s.settings.sampler = SamplerKind::Auto;
+        let (truth, estimated) = truth_and_estimate(&s, integrator, 32 * 48 * 32, 8);
+        eprintln!(
+            "{name} ({integrator:?}, sobol): true error {truth:.4}, estimated {estimated:.4}"
+        );
+        assert!(estimated / truth > 1.2, "{name}: estimated {estimated}, true {truth}");
     }
 }
 

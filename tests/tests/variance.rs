@@ -187,7 +187,10 @@ fn sobol_has_less_pixel_noise_than_independent_sampling() {
     let sobol = scene(
         &POINT_OVER_PLANE.replace(r#""lights""#, r#""settings": {"sampler": "sobol"}, "lights""#),
     );
-    let independent = scene(POINT_OVER_PLANE);
+    let independent = scene(
+        &POINT_OVER_PLANE
+            .replace(r#""lights""#, r#""settings": {"sampler": "independent"}, "lights""#),
+    );
     for (integrator, effort, bound) in
         [(IntegratorChoice::Path, 32 * 32 * 16, 0.5), (IntegratorChoice::Light, 200_000, 0.65)]
     {
@@ -264,6 +267,47 @@ fn sobol_renders_are_bit_identical_across_threads_and_merge_shards_exactly() {
             assert!(a == b, "{name}: the merged {ext} differs from the one-machine render");
         }
     }
+}
+
+#[test]
+fn the_default_sampler_is_sobol_for_camera_estimators_unless_a_target_stops_the_render() {
+    // `settings.sampler` unset is "auto": the sidecar names the sampler used. Sobol for the
+    // path tracer and BDPT at a fixed effort; independent for the light tracer, and for a
+    // camera estimator rendering to a target error (its estimate must be the error itself).
+    let dir = std::env::temp_dir().join(format!("spectrace-auto-sampler-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let s = scene(POINT_OVER_PLANE);
+    let cases = [
+        (IntegratorChoice::Path, None, "sobol"),
+        (IntegratorChoice::Bdpt, None, "sobol"),
+        (IntegratorChoice::Light, None, "independent"),
+        (IntegratorChoice::Path, Some(0.5), "independent"),
+    ];
+    for (k, (integrator, target_error, expected)) in cases.into_iter().enumerate() {
+        let camera = integrator != IntegratorChoice::Light;
+        let options = RenderOptions {
+            spp: (camera && target_error.is_none()).then_some(2),
+            beams: (!camera).then_some(20_000),
+            target_error,
+            time: target_error.map(|_| 30.0),
+            integrator: Some(integrator),
+            out_dir: dir.join(k.to_string()),
+            threads: Some(1),
+            verbose: false,
+            ..RenderOptions::default()
+        };
+        let report = render_scene(&s, &options).unwrap();
+        assert_eq!(report.sampler, expected, "{integrator:?}, target {target_error:?}");
+        let sidecar = std::fs::read_dir(dir.join(k.to_string()))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| p.extension().is_some_and(|e| e == "json"))
+            .unwrap();
+        let sidecar: Value =
+            serde_json::from_str(&std::fs::read_to_string(sidecar).unwrap()).unwrap();
+        assert_eq!(sidecar["sampler"], expected);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

@@ -35,7 +35,7 @@ enum Command {
         max_width: Option<u32>,
         /// The configurations to sweep, comma-separated (default: all): baseline (or light),
         /// equal_wavelengths, piecewise_constant_spd, effects_off, path, bdpt, auto,
-        /// observer_wavelengths, sobol, path_sobol, path_uniform_wavelengths.
+        /// observer_wavelengths, sobol, path_sobol, bdpt_sobol, path_uniform_wavelengths.
         #[arg(long, value_delimiter = ',', value_parser = parse_configuration)]
         configurations: Vec<Configuration>,
         /// Where accuracy.md and accuracy.svg go.

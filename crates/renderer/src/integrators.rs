@@ -7,7 +7,7 @@
 
 use spectrace_tracer::{
     Effects, INTEGRATORS, Integrator, IntegratorChoice, IntegratorSettings, Kernel,
-    LightTracerScene, build_integrator, registered,
+    LightTracerScene, SamplerKind, build_integrator, registered,
 };
 
 use crate::Scene;
@@ -78,25 +78,66 @@ pub fn with_integrator_filling<R>(
     sensors: bool,
     f: impl FnOnce(&dyn Integrator) -> R,
 ) -> R {
-    with_kernel(scene, choice, effects, sensors, scene.settings.kernel, f)
+    with_kernel(scene, choice, effects, sensors, (scene.settings.kernel, false), f)
 }
 
-/// As [`with_integrator_filling`], with the path tracer's camera paths traced by `kernel`.
+/// As [`with_integrator_filling`], with the path tracer's camera paths traced by `kernel`, and
+/// `settings.sampler` resolved knowing whether the error estimate decides the stop
+/// ([`sampler_of`]).
 pub(crate) fn with_kernel<R>(
     scene: &Scene,
     choice: IntegratorChoice,
     effects: Effects,
     sensors: bool,
-    kernel: Kernel,
+    (kernel, error_decides): (Kernel, bool),
     f: impl FnOnce(&dyn Integrator) -> R,
 ) -> R {
     let none = spectrace_tracer::SensorSet::default();
-    let tracer_scene =
-        if sensors { tracer_scene(scene) } else { tracer_scene(scene).with_sensors(&none) };
+    let sampler = sampler_of(scene.settings.sampler, choice, error_decides);
+    let tracer_scene = tracer_scene(scene).with_sampler(sampler);
+    let tracer_scene = if sensors { tracer_scene } else { tracer_scene.with_sensors(&none) };
     let mut settings = integrator_settings(scene);
     settings.path.kernel = kernel;
     let integrator = build_integrator(choice, &tracer_scene, &settings, effects);
     f(integrator.as_ref())
+}
+
+/// The sampler `choice` draws from: `settings.sampler` as set, or for `auto` Sobol points for
+/// the camera estimators unless the render's error estimate decides when it stops
+/// (`error_decides`: a target error, or a pilot measuring error against time), and independent
+/// uniforms otherwise. Only independent passes are independent batches: under Sobol the
+/// estimate is the independent sampler's error, an upper bound, so a render that stops on it
+/// would gain nothing from Sobol points and would report an error it does not have.
+pub(crate) fn sampler_of(
+    setting: SamplerKind,
+    choice: IntegratorChoice,
+    error_decides: bool,
+) -> SamplerKind {
+    setting.resolve(is_camera_integrator(choice) && !error_decides)
+}
+
+/// The sampler line of a verbose render: the sampler `choice` draws from, and why.
+pub(crate) fn sampler_text(
+    setting: SamplerKind,
+    choice: IntegratorChoice,
+    error_decides: bool,
+) -> String {
+    let used = sampler_of(setting, choice, error_decides);
+    let why = match (setting, used) {
+        (SamplerKind::Auto, SamplerKind::Sobol) => {
+            "auto: a pixel's passes are the points of one Owen-scrambled Sobol sequence; the \
+             error estimate is an upper bound"
+        }
+        (SamplerKind::Auto, _) if !is_camera_integrator(choice) => {
+            "auto: the light tracer's beams stay independent"
+        }
+        (SamplerKind::Auto, _) => {
+            "auto: a target error stops this render, and only independent passes estimate the \
+             error itself rather than an upper bound"
+        }
+        _ => "settings.sampler",
+    };
+    format!("{} ({why})", used.name())
 }
 
 /// The kernel that traces `choice`'s paths given the path tracer's `kernel` setting: only the

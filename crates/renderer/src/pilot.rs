@@ -21,11 +21,10 @@ use serde::{Deserialize, Serialize};
 use spectrace_lights::LightSource;
 use spectrace_tracer::{IntegratorChoice, MIN_BATCHES, Progress, RenderPlan, render_observed};
 
-use crate::integrators::ESTIMATORS;
+use crate::integrators::{ESTIMATORS, with_kernel};
 use crate::warnings::integrator_warnings;
 use crate::{
     RenderError, RenderOptions, Scene, choose_integrator, decide_effects, duration, plan_with,
-    with_integrator,
 };
 
 /// Fewest chunks a live estimate of the pilot needs to enter the slope fit.
@@ -177,7 +176,10 @@ fn pilot(
     let threads = first.threads.max(1) as u64;
     let first = RenderPlan { beams: first.chunk_beams.saturating_mul(threads), ..first };
     let run = |plan: &RenderPlan, observe: &(dyn Fn(&Progress) + Sync)| {
-        let out = with_integrator(scene, choice, effects, |tracer| {
+        // The error estimate decides here: independent passes for `auto`'s sampler, whose
+        // spread is the error itself (see `sampler_of`).
+        let build = (scene.settings.kernel, true);
+        let out = with_kernel(scene, choice, effects, true, build, |tracer| {
             render_observed(tracer, plan, observe)
         })
         .map_err(|e| RenderError::Options(e.to_string()));

@@ -31,7 +31,8 @@ pub struct RenderReport {
     /// Why that estimator: asked for, or the effects analysis' reason.
     #[serde(default)]
     pub integrator_reason: String,
-    /// Where the random numbers came from (`settings.sampler`): `"independent"` or `"sobol"`.
+    /// Where the random numbers came from: `"independent"` or `"sobol"` (`settings.sampler`
+    /// resolved for the estimator; `auto` gives Sobol to the path tracer and BDPT).
     #[serde(default = "independent_sampler")]
     pub sampler: String,
     /// The kernel that traced the paths (`settings.kernel`, `--kernel`): `"batched"` or

@@ -8,7 +8,7 @@ use spectrace_tracer::{
     Effects, Integrator, IntegratorChoice, Kernel, MemoryLimit, RenderOutput, RenderPlan, render,
 };
 
-use crate::integrators::{kernel_of, with_kernel};
+use crate::integrators::{kernel_of, sampler_of, sampler_text, with_kernel};
 use crate::measured::measure_choice;
 
 use crate::plan::scene_normalisation;
@@ -77,7 +77,11 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
     if options.verbose && choice == IntegratorChoice::Path {
         tell!("kernel: {}", kernel.name());
     }
-    with_kernel(scene, choice, effects, plan.shard.is_none(), kernel, |tracer| {
+    let error_decides = plan.target_error.is_some();
+    if options.verbose {
+        tell!("sampler: {}", sampler_text(scene.settings.sampler, choice, error_decides));
+    }
+    with_kernel(scene, choice, effects, plan.shard.is_none(), (kernel, error_decides), |tracer| {
         let setup = Setup { choice, reason: &reason, effects, plan, name: &name, kernel };
         render_with(scene, options, &setup, warnings, tracer)
     })
@@ -152,8 +156,9 @@ pub fn render_in_memory(
     let plan = plan_with(scene, options, choice)?;
     let effects = decide_effects(scene, options.effects);
     let kernel = options.kernel.unwrap_or(scene.settings.kernel);
+    let build = (kernel, plan.target_error.is_some());
     let output =
-        with_kernel(scene, choice, effects, true, kernel, |tracer| render(tracer, &plan, &|_| {}))
+        with_kernel(scene, choice, effects, true, build, |tracer| render(tracer, &plan, &|_| {}))
             .map_err(|e| RenderError::Options(e.to_string()))?;
     scene.lights.reset_count();
     let image = image(&output, scene_normalisation(scene, choice));
@@ -239,7 +244,9 @@ impl Finished<'_> {
             written,
         );
         r.integrator_reason = setup.reason.to_owned();
-        r.sampler = scene.settings.sampler.name().to_owned();
+        let error_decides = setup.plan.target_error.is_some();
+        r.sampler =
+            sampler_of(scene.settings.sampler, setup.choice, error_decides).name().to_owned();
         r.kernel = kernel_of(setup.choice, setup.kernel).name().to_owned();
         r
     }

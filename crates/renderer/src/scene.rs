@@ -134,7 +134,7 @@ impl Default for Settings {
             integrator: IntegratorChoice::Auto,
             spp: DEFAULT_SPP,
             camera_wavelengths: CameraWavelengths::Visible,
-            sampler: SamplerKind::Independent,
+            sampler: SamplerKind::Auto,
             target_error: None,
             kernel: Kernel::Scalar,
         }

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use spectrace_tracer::{Film, MemoryLimit, RenderOutput, RenderPlan, TraceStats};
 
+use crate::integrators::sampler_of;
 use crate::report::report;
 use crate::write::{planned_outputs, write_sidecar};
 use crate::{
@@ -190,7 +191,8 @@ fn write_merged(
     );
     report.beams_per_second =
         if total_seconds > 0.0 { merged.beams as f64 / total_seconds } else { 0.0 };
-    report.sampler = first.sampler.name().to_owned();
+    let error_decides = first.plan.target_error.is_some();
+    report.sampler = sampler_of(first.sampler, first.integrator, error_decides).name().to_owned();
     write_sidecar(out_dir, &first.name, &report)?;
     Ok(report)
 }

@@ -131,7 +131,7 @@ impl<'a> LightTracerScene<'a> {
             surfaces_emit: false,
             light_shapes: Vec::new(),
             object_shapes: materials.len(),
-            sampler: SamplerKind::Independent,
+            sampler: SamplerKind::Auto,
             sensors: None,
             sensors_only: false,
             area_lights,

@@ -97,9 +97,11 @@ pub fn apply(configuration: Configuration, scene: &mut Scene) -> Result<String, 
         scene.settings.camera_wavelengths = CameraWavelengths::Uniform;
         return Ok("settings.camera_wavelengths = uniform".to_owned());
     }
-    if configuration.sampler() == SamplerKind::Sobol {
-        scene.settings.sampler = SamplerKind::Sobol;
-        return Ok("settings.sampler = sobol".to_owned());
+    if let Some(sampler) = configuration.sampler() {
+        scene.settings.sampler = sampler;
+        if sampler == SamplerKind::Sobol {
+            return Ok("settings.sampler = sobol".to_owned());
+        }
     }
     if let Some(sampling) = configuration.wavelength_sampling() {
         return match set_wavelength_sampling(scene, sampling)? {

@@ -12,11 +12,11 @@
 //! | `equal_wavelengths` | every light draws its wavelengths uniformly with weights (`"wavelength_sampling": "equal_wavelengths"`) instead of by importance |
 //! | `piecewise_constant_spd` | every `Tabulated` SPD of the lights (and every tabulated `CieIlluminant`) becomes the seed's "choppy" `Binned` SPD: bins centred on the table's nodes, the same values |
 //! | `effects_off` | the effects analysis off (one wavelength per path, beams continue after diffuse hits) |
-//! | `path`, `bdpt` | the estimator: N paths are `ceil(N / pixels)` camera samples per pixel |
-//! | `auto` | the estimator `auto` picks ([`IntegratorChoice::decide`]) |
+//! | `path`, `bdpt` | the estimator, with independent sampling: N paths are `ceil(N / pixels)` camera samples per pixel |
+//! | `auto` | the estimator `auto` picks ([`IntegratorChoice::decide`]), with the default sampler |
 //! | `observer_wavelengths` | every light draws its wavelengths from SPD x observer sensitivity with weights (`"wavelength_sampling": "observer"`), light tracer |
 //! | `sobol` | Owen-scrambled Sobol points instead of independent uniforms (`settings.sampler: "sobol"`), light tracer |
-//! | `path_sobol` | the path tracer with `settings.sampler: "sobol"` (compare with `path`) |
+//! | `path_sobol`, `bdpt_sobol` | the path tracer and BDPT with `settings.sampler: "sobol"` (compare with `path` and `bdpt`, which sample independently) |
 //!
 //! Which knobs act on which estimator ([`KNOBS_BY_ESTIMATOR`], also in the report): the sampler
 //! and the SPD sampler act on all three (a piecewise-constant SPD is another spectrum, so every
@@ -26,7 +26,7 @@
 //! analysis sets the light tracer's wavelengths per path and whether its beams and the path
 //! tracer's paths continue after a diffuse hit, and BDPT ignores it. The sweep applies each
 //! non-estimator knob to the light tracer, where all of them act, and the sampler also to the
-//! path tracer.
+//! path tracer and BDPT.
 //!
 //! Code: this module runs the sweep; `knobs` sets configurations on the typed scene, `cache`
 //! keeps the references, `report` analyses and writes the Markdown, `plot` draws the SVG.
@@ -174,6 +174,8 @@ pub enum Configuration {
     Sobol,
     /// The Sobol sampler with the path tracer.
     PathSobol,
+    /// The Sobol sampler with bidirectional path tracing.
+    BdptSobol,
     /// The path tracer with camera wavelengths uniform over 360-830 nm instead of the visible
     /// density: the camera side's wavelength strategy.
     PathUniformWavelengths,
@@ -181,7 +183,7 @@ pub enum Configuration {
 
 impl Configuration {
     /// Every configuration, in report order.
-    pub const ALL: [Configuration; 11] = [
+    pub const ALL: [Configuration; 12] = [
         Configuration::Baseline,
         Configuration::EqualWavelengths,
         Configuration::PiecewiseConstantSpd,
@@ -192,6 +194,7 @@ impl Configuration {
         Configuration::ObserverWavelengths,
         Configuration::Sobol,
         Configuration::PathSobol,
+        Configuration::BdptSobol,
         Configuration::PathUniformWavelengths,
     ];
 
@@ -215,7 +218,7 @@ impl Configuration {
             Configuration::Path
             | Configuration::PathSobol
             | Configuration::PathUniformWavelengths => IntegratorChoice::Path,
-            Configuration::Bdpt => IntegratorChoice::Bdpt,
+            Configuration::Bdpt | Configuration::BdptSobol => IntegratorChoice::Bdpt,
             Configuration::Auto => IntegratorChoice::Auto,
             _ => IntegratorChoice::Light,
         }
@@ -242,6 +245,7 @@ impl Configuration {
             Configuration::ObserverWavelengths => "observer_wavelengths",
             Configuration::Sobol => "sobol",
             Configuration::PathSobol => "path_sobol",
+            Configuration::BdptSobol => "bdpt_sobol",
             Configuration::PathUniformWavelengths => "path_uniform_wavelengths",
         }
     }
@@ -267,14 +271,16 @@ impl Configuration {
             }
             Configuration::Path => {
                 "the path tracer (camera paths, next-event estimation, MIS) on the scene as \
-                 written; N paths are ceil(N / pixels) samples per pixel"
+                 written, with independent sampling; N paths are ceil(N / pixels) samples per \
+                 pixel"
             }
             Configuration::Bdpt => {
-                "bidirectional path tracing with MIS on the scene as written; N paths are \
-                 ceil(N / pixels) samples per pixel"
+                "bidirectional path tracing with MIS on the scene as written, with independent \
+                 sampling; N paths are ceil(N / pixels) samples per pixel"
             }
             Configuration::Auto => {
-                "the estimator `auto` picks (`IntegratorChoice::decide`), with its own seeds"
+                "the estimator `auto` picks (`IntegratorChoice::decide`) with the default \
+                 sampler, with its own seeds"
             }
             Configuration::ObserverWavelengths => {
                 "every light draws wavelengths in proportion to SPD x (xbar + ybar + zbar), \
@@ -289,6 +295,10 @@ impl Configuration {
                 "the path tracer with Owen-scrambled Sobol points (settings.sampler \"sobol\"); \
                  N paths are ceil(N / pixels) samples per pixel"
             }
+            Configuration::BdptSobol => {
+                "bidirectional path tracing with Owen-scrambled Sobol points (settings.sampler \
+                 \"sobol\"); N paths are ceil(N / pixels) samples per pixel"
+            }
             Configuration::PathUniformWavelengths => {
                 "the path tracer with camera wavelengths uniform over 360-830 nm \
                  (settings.camera_wavelengths \"uniform\") instead of the visible density: the \
@@ -297,11 +307,16 @@ impl Configuration {
         }
     }
 
-    /// The sampler the configuration sets (`settings.sampler`).
-    pub fn sampler(self) -> SamplerKind {
+    /// The sampler the configuration sets (`settings.sampler`; `None`: as written, which
+    /// `auto` resolves per estimator): Sobol for the `*sobol` configurations, independent
+    /// sampling for `path` and `bdpt`, their peers.
+    pub fn sampler(self) -> Option<SamplerKind> {
         match self {
-            Configuration::Sobol | Configuration::PathSobol => SamplerKind::Sobol,
-            _ => SamplerKind::Independent,
+            Configuration::Sobol | Configuration::PathSobol | Configuration::BdptSobol => {
+                Some(SamplerKind::Sobol)
+            }
+            Configuration::Path | Configuration::Bdpt => Some(SamplerKind::Independent),
+            _ => None,
         }
     }
 
@@ -420,7 +435,8 @@ pub struct AccuracyReport {
 }
 
 /// Which knobs act on which estimator, as the report states it (see the module documentation).
-pub const KNOBS_BY_ESTIMATOR: &str = "the sampler (`sobol`, `path_sobol`) and the SPD sampler \
+pub const KNOBS_BY_ESTIMATOR: &str = "the sampler (`sobol`, `path_sobol`, `bdpt_sobol`; `path` \
+     and `bdpt` sample independently, `auto` as by default) and the SPD sampler \
      (`piecewise_constant_spd`, another spectrum) act on every estimator; the lights' wavelength \
      strategy (`equal_wavelengths`, `observer_wavelengths`) acts on the light tracer and BDPT \
      (light subpaths start with a light's beam) but not on the path tracer, whose camera paths \
@@ -429,7 +445,7 @@ pub const KNOBS_BY_ESTIMATOR: &str = "the sampler (`sobol`, `path_sobol`) and th
      (`effects_off`) sets the light tracer's wavelengths per path and whether light-tracer beams \
      and path-tracer paths continue after a diffuse hit, and BDPT ignores it. The sweep applies \
      each of these knobs to the light tracer, where all of them act, and the sampler also to the \
-     path tracer";
+     path tracer and BDPT";
 
 /// The Monte Carlo expectation for the slope of log error against log time.
 pub const EXPECTED_SLOPE: f64 = -0.5;
@@ -581,8 +597,13 @@ fn run_scene(
                 options.reference_beams,
                 reference_integrator.name()
             );
+            // Independent sampling: its batches are independent, so the reference's own noise
+            // (see `reference_noise`) is measured by the same estimator's sweep.
+            let mut independent =
+                load(&text, path, options.max_width).map_err(|e| format!("accuracy: {e}"))?;
+            independent.settings.sampler = SamplerKind::Independent;
             let (image, seconds, _) = render_xyz(
-                &baseline,
+                &independent,
                 reference_integrator,
                 EffectsMode::Auto,
                 options.reference_beams,

@@ -106,8 +106,18 @@ pub(super) fn reach_text(result: Option<&ConfigurationResult>) -> String {
     }
 }
 
-/// Auto's time to [`ROUND_TARGET`] over the fastest of light, path and bdpt, and the text of the
-/// ratio column (`None` when the ratio cannot be measured).
+/// The estimators `auto` is measured against: light, path and bdpt, the camera estimators with
+/// either sampler.
+const AUTO_PEERS: [Configuration; 5] = [
+    Configuration::Baseline,
+    Configuration::Path,
+    Configuration::PathSobol,
+    Configuration::Bdpt,
+    Configuration::BdptSobol,
+];
+
+/// Auto's time to [`ROUND_TARGET`] over the fastest of light, path and bdpt (with either
+/// sampler), and the text of the ratio column (`None` when the ratio cannot be measured).
 pub(super) fn auto_ratio(scene: &SceneResult) -> (Option<f64>, String) {
     let reach = |c: Configuration| {
         scene
@@ -117,7 +127,7 @@ pub(super) fn auto_ratio(scene: &SceneResult) -> (Option<f64>, String) {
             .and_then(|r| measured_reach(r, ROUND_TARGET))
             .and_then(Reach::seconds)
     };
-    let fastest = [Configuration::Baseline, Configuration::Path, Configuration::Bdpt]
+    let fastest = AUTO_PEERS
         .into_iter()
         .filter_map(|c| reach(c).map(|t| (c, t)))
         .min_by(|a, b| a.1.total_cmp(&b.1));
@@ -130,18 +140,17 @@ pub(super) fn auto_ratio(scene: &SceneResult) -> (Option<f64>, String) {
             (Some(f64::INFINITY), format!("auto does not reach it; {} does", c.integrator_label()))
         }
         (_, None) => {
-            let converging: Vec<&str> =
-                [Configuration::Baseline, Configuration::Path, Configuration::Bdpt]
-                    .into_iter()
-                    .filter(|&c| {
-                        scene
-                            .configurations
-                            .iter()
-                            .find(|r| r.configuration == c)
-                            .is_some_and(|r| r.points.len() >= 3 && !levels_off(r))
-                    })
-                    .map(Configuration::integrator_label)
-                    .collect();
+            let converging: Vec<&str> = AUTO_PEERS
+                .into_iter()
+                .filter(|&c| {
+                    scene
+                        .configurations
+                        .iter()
+                        .find(|r| r.configuration == c)
+                        .is_some_and(|r| r.points.len() >= 3 && !levels_off(r))
+                })
+                .map(Configuration::integrator_label)
+                .collect();
             let text = if converging.is_empty() {
                 "none reaches it in the sweep".to_owned()
             } else {

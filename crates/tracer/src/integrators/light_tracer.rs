@@ -162,7 +162,7 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
     work: ChunkWork,
     film: &mut S,
 ) -> TraceStats {
-    let mut rng = ChunkSampler::new(scene.sampler(), work.seed, work.chunk);
+    let mut rng = ChunkSampler::new(scene.sampler().resolve(false), work.seed, work.chunk);
     let mut stats = TraceStats::default();
     let tracer = BeamTracer {
         scene,

@@ -75,7 +75,8 @@ impl<E: PassEstimator> Integrator for E {
 
     /// One pass (see the module docs). The deadline is not looked at: a pass is never cut.
     fn render_chunk(&self, work: ChunkWork, film: &mut dyn Splat) -> TraceStats {
-        let mut rng = ChunkSampler::new(self.scene().sampler(), work.seed, work.chunk);
+        let kind = self.scene().sampler().resolve(true);
+        let mut rng = ChunkSampler::new(kind, work.seed, work.chunk);
         let items = self.items();
         let mut before = TraceStats::default();
         if work.items >= items.max(1) {
