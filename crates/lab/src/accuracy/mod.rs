@@ -1213,6 +1213,10 @@ mod tests {
         assert!(text.contains("; sooner but biased: `baseline` 1.0"), "{text}");
         assert!(text.ends_with(" s (black mirrors)"), "{text}");
         assert_eq!(auto_vs_fastest_text(&scene, ROUND_TARGET), "1.00 (auto is the fastest)");
+        // ... nor auto's peer in the estimator table: the path tracer is, at 4 s.
+        let (ratio, text) = auto_ratio(&scene);
+        assert!(ratio.is_some_and(|r| (r - 0.5).abs() < 1e-9), "{ratio:?}");
+        assert_eq!(text, "0.50 (fastest: path)");
         // A brightness 2x off is a bias the report sees without knowing why.
         assert!(!converges(&scene, &scene.configurations[2]));
         assert!(converges(&scene, &scene.configurations[1]));

@@ -117,18 +117,17 @@ const AUTO_PEERS: [Configuration; 5] = [
 ];
 
 /// Auto's time to [`ROUND_TARGET`] over the fastest of light, path and bdpt (with either
-/// sampler), and the text of the ratio column (`None` when the ratio cannot be measured).
+/// sampler) among those that converge to the reference's image ([`converges`]: a light tracer
+/// that shows mirrors black is not a peer however soon it gets there), and the text of the ratio
+/// column (`None` when the ratio cannot be measured).
 pub(super) fn auto_ratio(scene: &SceneResult) -> (Option<f64>, String) {
+    let result = |c: Configuration| scene.configurations.iter().find(|r| r.configuration == c);
     let reach = |c: Configuration| {
-        scene
-            .configurations
-            .iter()
-            .find(|r| r.configuration == c)
-            .and_then(|r| measured_reach(r, ROUND_TARGET))
-            .and_then(Reach::seconds)
+        result(c).and_then(|r| measured_reach(r, ROUND_TARGET)).and_then(Reach::seconds)
     };
     let fastest = AUTO_PEERS
         .into_iter()
+        .filter(|&c| result(c).is_some_and(|r| converges(scene, r)))
         .filter_map(|c| reach(c).map(|t| (c, t)))
         .min_by(|a, b| a.1.total_cmp(&b.1));
     match (reach(Configuration::Auto), fastest) {
@@ -481,9 +480,12 @@ pub(super) fn integrators_markdown(md: &mut String, report: &AccuracyReport) {
          points; `<=` when the first point is already below it). An estimator that is biased on \
          a scene (the light tracer where the camera sees mirrors or glass, the path tracer where \
          lights are skies, lasers or lines) levels off: it is reported as not reaching the target, \
-         never extrapolated. The last column is auto's time over the fastest of light, path and \
-         bdpt, measured in the same run (auto renders with its own seeds, so a ratio near 1 is \
-         timing and noise); `auto` is a good pick when it is within {AUTO_FACTOR}x.\n",
+         never extrapolated. The columns light, path and bdpt sample independently. The last \
+         columns are auto's time (with the default sampler: Sobol points for path and bdpt) over \
+         the fastest of light, path, path_sobol, bdpt and bdpt_sobol among those that converge \
+         to the reference's image (a light tracer that shows mirrors black is not auto's peer), \
+         measured in the same run (auto renders with its own seeds, so a ratio near 1 is timing \
+         and noise); `auto` is a good pick when it is within {AUTO_FACTOR}x.\n",
         target = percent(ROUND_TARGET)
     );
     let _ = writeln!(
