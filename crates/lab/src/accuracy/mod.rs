@@ -876,7 +876,7 @@ mod tests {
         let mut ob = scene(TINY);
         assert_eq!(apply(Configuration::ObserverWavelengths, &mut ob).unwrap(), "1 light(s)");
         assert_eq!(light(&ob, 0)["wavelength_sampling"], "observer");
-        for c in [Configuration::Sobol, Configuration::PathSobol] {
+        for c in [Configuration::Sobol, Configuration::PathSobol, Configuration::BdptSobol] {
             let mut so = scene(TINY);
             assert_eq!(apply(c, &mut so).unwrap(), "settings.sampler = sobol");
             assert_eq!(so.settings.sampler, SamplerKind::Sobol);
@@ -884,6 +884,20 @@ mod tests {
         }
         assert_eq!(Configuration::PathSobol.integrator(), IntegratorChoice::Path);
         assert_eq!(Configuration::from_name("path_sobol"), Some(Configuration::PathSobol));
+        assert_eq!(Configuration::BdptSobol.integrator(), IntegratorChoice::Bdpt);
+        assert_eq!(Configuration::from_name("bdpt_sobol"), Some(Configuration::BdptSobol));
+        // `path` and `bdpt`, their peers, sample independently whatever the scene says; the
+        // other knobs leave the scene's sampler (`auto` by default) as written.
+        for (c, written, expected) in [
+            (Configuration::Path, SamplerKind::Sobol, SamplerKind::Independent),
+            (Configuration::Bdpt, SamplerKind::Sobol, SamplerKind::Independent),
+            (Configuration::Auto, SamplerKind::Auto, SamplerKind::Auto),
+        ] {
+            let mut so = scene(TINY);
+            so.settings.sampler = written;
+            assert_eq!(apply(c, &mut so).unwrap(), "");
+            assert_eq!(so.settings.sampler, expected, "{c:?}");
+        }
         let mut uw = scene(TINY);
         let c = Configuration::PathUniformWavelengths;
         assert_eq!(apply(c, &mut uw).unwrap(), "settings.camera_wavelengths = uniform");
