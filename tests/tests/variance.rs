@@ -316,6 +316,7 @@ fn a_bad_sampler_or_wavelength_sampling_names_the_field() {
         POINT_OVER_PLANE.replace(r#""lights""#, r#""settings": {"sampler": "halton"}, "lights""#);
     let e = Scene::from_json(&bad, Path::new("inline.json")).unwrap_err().to_string();
     assert!(e.contains("settings.sampler") && e.contains("halton"), "{e}");
+    assert!(e.contains("auto"), "the accepted names, `auto` among them: {e}");
     let bad = POINT_OVER_PLANE
         .replace(r#""power": 100,"#, r#""power": 100, "wavelength_sampling": "eye","#);
     let e = Scene::from_json(&bad, Path::new("inline.json")).unwrap_err().to_string();

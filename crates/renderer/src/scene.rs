@@ -105,8 +105,10 @@ pub struct Settings {
     /// How the path tracer's camera paths draw their wavelengths: `"visible"` (in proportion to
     /// the observer's sensitivity, the default) or `"uniform"` (360-830 nm).
     pub camera_wavelengths: CameraWavelengths,
-    /// Where every integrator's random numbers come from: `"independent"` (each chunk's own
-    /// stream, the default) or `"sobol"` (Owen-scrambled Sobol points, see
+    /// Where every integrator's random numbers come from: `"auto"` (the default: Sobol points
+    /// for the camera estimators unless a target error stops the render, independent streams
+    /// otherwise; see [`spectrace_tracer::SamplerKind::resolve`]), `"independent"` (each
+    /// chunk's own stream) or `"sobol"` (Owen-scrambled Sobol points, see
     /// [`spectrace_tracer::ChunkSampler`]).
     pub sampler: SamplerKind,
     /// Render until the estimated relative RMSE of the image is at most this (e.g. `0.05`),
