@@ -504,7 +504,11 @@ fn furnace() -> Row {
         auto: IntegratorChoice::Path,
         effects: EffectsMode::Auto,
         closed_form: Some((Box::new(move |_: &Scene, _: usize, _: usize| expected), 0.0)),
-        cells: [all(100_000), all(16 * 16 * 16), all(16 * 16 * 8)],
+        // BDPT at 32 samples per pixel: with hero wavelengths its colour noise is gone and what
+        // is left is right-skewed at 8 (48 seeds of block (1, 0): skewness 0.55, median 0.16% below
+        // the mean, the largest 2.8% above it), and 16 seeds of 8 were measured 6 standard
+        // errors below the truth; the t-test needs per-seed means closer to normal.
+        cells: [all(100_000), all(16 * 16 * 16), all(16 * 16 * 32)],
         glass: None,
         seeds: 16,
         sharp: 0.02,
@@ -927,7 +931,8 @@ fn every_estimator_writes_the_renderers_units() {
     }
     // BDPT's settings as scene files write them; unknown fields are refused.
     let s: BdptSettings = serde_json::from_str(r#"{"max_depth": 3, "rr_depth": 1}"#).unwrap();
-    assert_eq!(s, BdptSettings { max_depth: 3, rr_depth: 1, only_strategy: None });
+    assert_eq!(s, BdptSettings { max_depth: 3, rr_depth: 1, ..BdptSettings::default() });
+    assert_eq!(s.wavelengths, spectrace_tracer::BdptWavelengths::Hero);
     assert!(serde_json::from_str::<BdptSettings>(r#"{"max_depth": 3, "rr": 1}"#).is_err());
 }
 
@@ -1129,7 +1134,8 @@ fn each_bdpt_strategy_alone_converges_to_the_same_image() {
     let effects = decide_effects(&s, None);
     let ts = tracer_scene(&s);
     let run = |only: Option<(usize, usize)>, seed: u64| -> f64 {
-        let settings = BdptSettings { max_depth: 0, rr_depth: 4, only_strategy: only };
+        let settings =
+            BdptSettings { max_depth: 0, rr_depth: 4, only_strategy: only, ..Default::default() };
         let bdpt = Bdpt::new(&ts, settings, effects);
         let options = RenderOptions {
             spp: Some(32),

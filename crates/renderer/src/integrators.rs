@@ -6,8 +6,9 @@
 //! are said elsewhere.
 
 use spectrace_tracer::{
-    Effects, INTEGRATORS, Integrator, IntegratorChoice, IntegratorSettings, Kernel,
-    LightTracerScene, SamplerKind, build_integrator, registered,
+    Bdpt, BdptWavelengths, Effects, HERO, INTEGRATORS, Integrator, IntegratorChoice,
+    IntegratorSettings, Kernel, LightTracerScene, SamplerKind, SceneFeatures, build_integrator,
+    registered,
 };
 
 use crate::Scene;
@@ -114,6 +115,20 @@ pub(crate) fn sampler_of(
     error_decides: bool,
 ) -> SamplerKind {
     setting.resolve(is_camera_integrator(choice) && !error_decides)
+}
+
+/// How many wavelengths a BDPT sample carries in a scene with `features` under `setting`,
+/// and why: `"hero: ..."` or `"beam: ..."` (the verbose line and the sidecar's
+/// `bdpt_wavelengths`).
+pub(crate) fn bdpt_wavelengths_text(setting: BdptWavelengths, features: &SceneFeatures) -> String {
+    let beam = "beam: one wavelength per sample, the beam's";
+    match (setting, Bdpt::hero_possible(features)) {
+        (BdptWavelengths::Beam, _) => format!("{beam} (settings.bdpt_wavelengths)"),
+        (BdptWavelengths::Hero, Err(why)) => format!("{beam} ({why})"),
+        (BdptWavelengths::Hero, Ok(())) => format!(
+            "hero: {HERO} wavelengths per sample from the camera's density, shared by both              subpaths"
+        ),
+    }
 }
 
 /// The sampler line of a verbose render: the sampler `choice` draws from, and why.

@@ -39,6 +39,10 @@ pub struct RenderReport {
     /// `"scalar"` (the light tracer and BDPT are scalar).
     #[serde(default = "scalar_kernel")]
     pub kernel: String,
+    /// When BDPT rendered the image: how many wavelengths a sample carried and why
+    /// (`settings.bdpt_wavelengths`): `"hero: ..."` (four) or `"beam: ..."` (one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bdpt_wavelengths: Option<String>,
     /// Beams traced.
     pub beams: u64,
     /// Wall time (s).
@@ -224,6 +228,7 @@ pub(crate) fn report(
         integrator_reason: String::new(),
         sampler: independent_sampler(),
         kernel: scalar_kernel(),
+        bdpt_wavelengths: None,
         beams: output.beams,
         wall_seconds: wall,
         beams_per_second: if wall > 0.0 { output.beams as f64 / wall } else { 0.0 },

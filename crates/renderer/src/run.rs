@@ -8,7 +8,7 @@ use spectrace_tracer::{
     Effects, Integrator, IntegratorChoice, Kernel, MemoryLimit, RenderOutput, RenderPlan, render,
 };
 
-use crate::integrators::{kernel_of, sampler_of, sampler_text, with_kernel};
+use crate::integrators::{bdpt_wavelengths_text, kernel_of, sampler_of, sampler_text, with_kernel};
 use crate::measured::measure_choice;
 
 use crate::plan::scene_normalisation;
@@ -80,6 +80,10 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
     let error_decides = plan.target_error.is_some();
     if options.verbose {
         tell!("sampler: {}", sampler_text(scene.settings.sampler, choice, error_decides));
+        if choice == IntegratorChoice::Bdpt {
+            let text = bdpt_wavelengths_text(scene.settings.bdpt_wavelengths, &effects.features);
+            tell!("wavelengths: {text}");
+        }
     }
     with_kernel(scene, choice, effects, plan.shard.is_none(), (kernel, error_decides), |tracer| {
         let setup = Setup { choice, reason: &reason, effects, plan, name: &name, kernel };
@@ -248,6 +252,9 @@ impl Finished<'_> {
         r.sampler =
             sampler_of(scene.settings.sampler, setup.choice, error_decides).name().to_owned();
         r.kernel = kernel_of(setup.choice, setup.kernel).name().to_owned();
+        r.bdpt_wavelengths = (setup.choice == IntegratorChoice::Bdpt).then(|| {
+            bdpt_wavelengths_text(scene.settings.bdpt_wavelengths, &setup.effects.features)
+        });
         r
     }
 }

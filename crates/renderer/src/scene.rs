@@ -13,9 +13,9 @@ use spectrace_materials::Diffuse;
 use spectrace_materials::Material;
 use spectrace_spectrum::Reflectance;
 use spectrace_tracer::{
-    BdptSettings, CameraWavelengths, DEFAULT_CHUNK_BEAMS, EffectsMode, Emitter, IntegratorChoice,
-    Kernel, LightTracerSettings, MAX_DEPTH, ObjectEmission, ObjectLight, PathTracerSettings,
-    PinholeCamera, RenderPlan, SamplerKind, SceneFeatures,
+    BdptSettings, BdptWavelengths, CameraWavelengths, DEFAULT_CHUNK_BEAMS, EffectsMode, Emitter,
+    IntegratorChoice, Kernel, LightTracerSettings, MAX_DEPTH, ObjectEmission, ObjectLight,
+    PathTracerSettings, PinholeCamera, RenderPlan, SamplerKind, SceneFeatures,
 };
 use spectrace_tracer::{IrradianceSensor, SensorSet};
 
@@ -105,6 +105,11 @@ pub struct Settings {
     /// How the path tracer's camera paths draw their wavelengths: `"visible"` (in proportion to
     /// the observer's sensitivity, the default) or `"uniform"` (360-830 nm).
     pub camera_wavelengths: CameraWavelengths,
+    /// How many wavelengths a BDPT sample carries: `"hero"` (the default: four, drawn like
+    /// the path tracer's and shared by both subpaths, wherever nothing disperses or fluoresces
+    /// and no light has spectral lines; the beam's one elsewhere) or `"beam"` (always the
+    /// beam's one wavelength, drawn from the lights' spectrum).
+    pub bdpt_wavelengths: BdptWavelengths,
     /// Where every integrator's random numbers come from: `"auto"` (the default: Sobol points
     /// for the camera estimators unless a target error stops the render, independent streams
     /// otherwise; see [`spectrace_tracer::SamplerKind::resolve`]), `"independent"` (each
@@ -136,6 +141,7 @@ impl Default for Settings {
             integrator: IntegratorChoice::Auto,
             spp: DEFAULT_SPP,
             camera_wavelengths: CameraWavelengths::Visible,
+            bdpt_wavelengths: BdptWavelengths::Hero,
             sampler: SamplerKind::Auto,
             target_error: None,
             kernel: Kernel::Scalar,
@@ -415,6 +421,8 @@ impl Scene {
             max_depth: self.settings.max_depth,
             rr_depth: self.settings.rr_depth,
             only_strategy: None,
+            wavelengths: self.settings.bdpt_wavelengths,
+            camera_wavelengths: self.settings.camera_wavelengths,
         }
     }
 

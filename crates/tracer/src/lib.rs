@@ -66,7 +66,7 @@ pub use wavelengths::{CAMERA_LAMBDA_MAX, CAMERA_LAMBDA_MIN, CameraWavelengths, H
 
 // The estimators, their settings and their registry.
 pub use effects::{BUNDLE, Effects, EffectsMode, IntegratorChoice, SceneFeatures};
-pub use integrators::bdpt::{Bdpt, BdptSettings};
+pub use integrators::bdpt::{Bdpt, BdptSettings, BdptWavelengths};
 pub use integrators::light_tracer::{
     LightTracer, LightTracerSettings, MAX_DEPTH, image_scale, trace_chunk, trace_chunk_until,
 };

@@ -33,11 +33,13 @@ pub enum Configuration {
     /// The path tracer with camera wavelengths uniform over 360-830 nm instead of the visible
     /// density: the camera side's wavelength strategy.
     PathUniformWavelengths,
+    /// BDPT with the beam's one wavelength per sample instead of hero wavelengths.
+    BdptBeam,
 }
 
 impl Configuration {
     /// Every configuration, in report order.
-    pub const ALL: [Configuration; 12] = [
+    pub const ALL: [Configuration; 13] = [
         Configuration::Baseline,
         Configuration::EqualWavelengths,
         Configuration::PiecewiseConstantSpd,
@@ -50,6 +52,7 @@ impl Configuration {
         Configuration::PathSobol,
         Configuration::BdptSobol,
         Configuration::PathUniformWavelengths,
+        Configuration::BdptBeam,
     ];
 
     /// The estimator knob: the light tracer (`baseline`), `path`, `bdpt` and `auto`.
@@ -72,7 +75,9 @@ impl Configuration {
             Configuration::Path
             | Configuration::PathSobol
             | Configuration::PathUniformWavelengths => IntegratorChoice::Path,
-            Configuration::Bdpt | Configuration::BdptSobol => IntegratorChoice::Bdpt,
+            Configuration::Bdpt | Configuration::BdptSobol | Configuration::BdptBeam => {
+                IntegratorChoice::Bdpt
+            }
             Configuration::Auto => IntegratorChoice::Auto,
             _ => IntegratorChoice::Light,
         }
@@ -101,6 +106,7 @@ impl Configuration {
             Configuration::PathSobol => "path_sobol",
             Configuration::BdptSobol => "bdpt_sobol",
             Configuration::PathUniformWavelengths => "path_uniform_wavelengths",
+            Configuration::BdptBeam => "bdpt_beam",
         }
     }
 
@@ -158,6 +164,11 @@ impl Configuration {
                  (settings.camera_wavelengths \"uniform\") instead of the visible density: the \
                  camera side's wavelength strategy"
             }
+            Configuration::BdptBeam => {
+                "bidirectional path tracing with one wavelength per sample, the beam's \
+                 (settings.bdpt_wavelengths \"beam\") instead of four hero wavelengths, with \
+                 independent sampling: the peer of `bdpt` for BDPT's colour noise"
+            }
         }
     }
 
@@ -169,7 +180,9 @@ impl Configuration {
             Configuration::Sobol | Configuration::PathSobol | Configuration::BdptSobol => {
                 Some(SamplerKind::Sobol)
             }
-            Configuration::Path | Configuration::Bdpt => Some(SamplerKind::Independent),
+            Configuration::Path | Configuration::Bdpt | Configuration::BdptBeam => {
+                Some(SamplerKind::Independent)
+            }
             _ => None,
         }
     }

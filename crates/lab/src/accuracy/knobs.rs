@@ -2,7 +2,7 @@
 //! SPDs, the sampler.
 
 use super::*;
-use spectrace_tracer::CameraWavelengths;
+use spectrace_tracer::{Bdpt, BdptWavelengths, CameraWavelengths};
 
 /// Scales the camera down so the image is at most `max_width` pixels wide, keeping the aspect
 /// ratio (a new camera from the same [`CameraRepr`]). Returns whether it changed anything.
@@ -96,6 +96,15 @@ pub fn apply(configuration: Configuration, scene: &mut Scene) -> Result<String, 
         }
         scene.settings.camera_wavelengths = CameraWavelengths::Uniform;
         return Ok("settings.camera_wavelengths = uniform".to_owned());
+    }
+    if configuration == Configuration::BdptBeam {
+        let hero = scene.settings.bdpt_wavelengths == BdptWavelengths::Hero;
+        if !(hero && Bdpt::hero_possible(&scene.features()).is_ok()) {
+            return Err("BDPT already carries the beam's one wavelength in this scene".to_owned());
+        }
+        scene.settings.sampler = SamplerKind::Independent;
+        scene.settings.bdpt_wavelengths = BdptWavelengths::Beam;
+        return Ok("settings.bdpt_wavelengths = beam".to_owned());
     }
     if let Some(sampler) = configuration.sampler() {
         scene.settings.sampler = sampler;

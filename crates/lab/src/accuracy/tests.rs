@@ -80,6 +80,19 @@ fn the_knobs_are_set_on_the_typed_scene() {
     assert_eq!(uw.settings.camera_wavelengths, spectrace_tracer::CameraWavelengths::Uniform);
     assert_eq!(c.integrator(), IntegratorChoice::Path);
     assert!(apply(c, &mut uw).is_err(), "already uniform: nothing to compare");
+    // BDPT's one-wavelength peer: independent sampling, beam wavelengths; refused where BDPT
+    // carries one wavelength anyway.
+    let mut bw = scene(TINY);
+    bw.settings.sampler = SamplerKind::Sobol;
+    let c = Configuration::BdptBeam;
+    assert_eq!(apply(c, &mut bw).unwrap(), "settings.bdpt_wavelengths = beam");
+    assert_eq!(bw.settings.bdpt_wavelengths, spectrace_tracer::BdptWavelengths::Beam);
+    assert_eq!(bw.settings.sampler, SamplerKind::Independent);
+    assert_eq!(
+        (c.integrator(), Configuration::from_name("bdpt_beam")),
+        (IntegratorChoice::Bdpt, Some(c))
+    );
+    assert!(apply(c, &mut bw).is_err(), "already one wavelength: nothing to compare");
 
     let mut pc = scene(TINY);
     assert_eq!(apply(Configuration::PiecewiseConstantSpd, &mut pc).unwrap(), "1 light(s)");

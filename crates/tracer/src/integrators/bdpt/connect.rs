@@ -6,7 +6,9 @@ use spectrace_materials::Transport;
 
 use super::MisVertex;
 use super::mis::{Sampled, build_mis_path, mis_weight};
-use super::vertex::{LightEnd, NO_SAMPLES, Vertex, VertexKind, Wavelength, light_normal};
+use super::vertex::{
+    Lanes, LightEnd, NO_SAMPLES, Vertex, VertexKind, Wavelengths, light_normal, scaled, times,
+};
 use super::{Bdpt, Strategy};
 use crate::integrators::common::{
     End, connect_light_to_camera, connect_surface_to_camera, importance_cosine, sample_light,
@@ -14,13 +16,14 @@ use crate::integrators::common::{
 };
 use crate::light_sampler::LightSampler;
 
-/// What one strategy gives: the value (film units before the colour matching), and the pixel
-/// for a `t = 1` splat (`None`: the sample's own pixel).
+/// What one strategy gives: the value per wavelength (film units before the colour matching
+/// and the wavelengths' film weights), and the pixel for a `t = 1` splat (`None`: the sample's
+/// own pixel).
 pub(super) struct Contribution {
-    pub value: f64,
+    pub value: Lanes,
     pub raster: Option<(u32, u32)>,
-    /// The wavelength a `t = 1` splat is recorded at (the light subpath's, which differs from
-    /// the sample's beyond a re-emission).
+    /// With one wavelength, the one a `t = 1` splat is recorded at (the light subpath's, which
+    /// differs from the sample's beyond a re-emission).
     pub lambda: f64,
     /// The MIS weight applied (included in `value`).
     #[cfg_attr(not(test), allow(dead_code))]
@@ -32,7 +35,7 @@ pub(super) struct Contribution {
 
 /// A strategy's unweighted value and what its MIS weight needs.
 struct Joined {
-    value: f64,
+    value: Lanes,
     raster: Option<(u32, u32)>,
     lambda: f64,
     /// The light the path starts on.
@@ -44,8 +47,8 @@ struct Joined {
 
 impl Joined {
     /// A value at the sample's own pixel and wavelength, with no fresh vertex.
-    fn at_pixel(value: f64, wl: &Wavelength, end: LightEnd) -> Self {
-        Self { value, raster: None, lambda: wl.lambda, end, light: None, camera: None }
+    fn at_pixel(value: Lanes, wl: &Wavelengths, end: LightEnd) -> Self {
+        Self { value, raster: None, lambda: wl.lambda(), end, light: None, camera: None }
     }
 }
 
@@ -56,7 +59,7 @@ impl Bdpt<'_> {
         &self,
         strategy: Strategy<'_>,
         beam_light: &LightEnd,
-        wl: &Wavelength,
+        wl: &Wavelengths,
         camera_strategies: bool,
         mis: &mut Vec<MisVertex>,
     ) -> Option<Contribution> {
@@ -70,7 +73,7 @@ impl Bdpt<'_> {
             (1, _) => self.sample_light_vertex(strategy, wl)?,
             _ => self.join_surfaces(strategy, beam_light, wl)?,
         };
-        if !(joined.value > 0.0 && joined.value.is_finite()) {
+        if !useful(&joined.value[..wl.n]) {
             return None;
         }
         let fluoresced = s > 0 && light[s - 1].fluoresced;
@@ -84,7 +87,7 @@ impl Bdpt<'_> {
             (1.0, true)
         };
         Some(Contribution {
-            value: joined.value * weight,
+            value: scaled(joined.value, weight),
             raster: joined.raster,
             lambda: joined.lambda,
             weight,
@@ -93,14 +96,19 @@ impl Bdpt<'_> {
     }
 
     /// `s = 0`: the camera subpath hits an emitter.
-    fn hit_emitter(&self, st: Strategy<'_>, wl: &Wavelength) -> Option<Joined> {
+    fn hit_emitter(&self, st: Strategy<'_>, wl: &Wavelengths) -> Option<Joined> {
         let pt = &st.camera[st.t - 1];
         let VertexKind::Surface(hit) = pt.kind else { return None };
         let wo = (st.camera[st.t - 2].point - pt.point).normalize();
         let (id, le) = self.scene.emitted(&hit, wo)?;
         let spd = self.scene.light_spd(id)?;
         let end = self.light_end(id, wl)?;
-        Some(Joined::at_pixel(pt.beta * le * spd.value(wl.lambda) / wl.density, wl, end))
+        // One wavelength: the density it was drawn with divides; hero wavelengths: their film
+        // weights do.
+        let emitted: Lanes = std::array::from_fn(|j| {
+            if j < wl.n { le * spd.value(wl.lambdas[j]) / wl.density } else { 0.0 }
+        });
+        Some(Joined::at_pixel(times(pt.beta, emitted), wl, end))
     }
 
     /// `t = 1`: a light vertex seen by the camera, through a point of the lens sampled towards
@@ -109,7 +117,7 @@ impl Bdpt<'_> {
         &self,
         st: Strategy<'_>,
         beam_light: &LightEnd,
-        wl: &Wavelength,
+        wl: &Wavelengths,
     ) -> Option<Joined> {
         let qs = &st.light[st.s - 1];
         let (raster, lens, value, lambda) = match qs.kind {
@@ -118,22 +126,17 @@ impl Bdpt<'_> {
                     return None;
                 }
                 let (seen, density) = connect_light_to_camera(self.scene, id, qs.point, qs.u)?;
-                ((seen.x, seen.y), seen.lens, qs.beta * density, wl.lambda)
+                ((seen.x, seen.y), seen.lens, scaled(qs.beta, density), wl.lambda())
             }
             VertexKind::Surface(hit) => {
                 let material = self.lobe(qs, &hit)?;
                 let wi = (st.light[st.s - 2].point - qs.point).normalize();
-                let mut f = [0.0];
+                let mut f = [0.0; crate::HERO];
+                let lambdas = wl.at(qs);
                 let seen = connect_surface_to_camera(
-                    self.scene,
-                    &hit,
-                    material,
-                    wi,
-                    &[qs.lambda],
-                    qs.u,
-                    &mut f,
+                    self.scene, &hit, material, wi, lambdas, qs.u, &mut f,
                 )?;
-                ((seen.x, seen.y), seen.lens, qs.beta * f[0], qs.lambda)
+                ((seen.x, seen.y), seen.lens, times(qs.beta, f), qs.lambda)
             }
             VertexKind::Camera => return None,
         };
@@ -149,11 +152,15 @@ impl Bdpt<'_> {
 
     /// `s = 1`: next-event estimation, a light chosen given the wavelength by the scene's
     /// light sampler and a point on it, with the camera vertex's own light uniforms.
-    fn sample_light_vertex(&self, st: Strategy<'_>, wl: &Wavelength) -> Option<Joined> {
+    fn sample_light_vertex(&self, st: Strategy<'_>, wl: &Wavelengths) -> Option<Joined> {
         let scene = self.scene;
         let pt = &st.camera[st.t - 1];
         let VertexKind::Surface(hit) = pt.kind else { return None };
-        let chosen = scene.all_lights().sample_given(pt.u[0], wl.lambda)?;
+        let chosen = if wl.is_hero() {
+            LightSampler::sample(scene.all_lights(), pt.u[0])?
+        } else {
+            scene.all_lights().sample_given(pt.u[0], wl.lambda())?
+        };
         let end = self.light_end(chosen.id, wl)?;
         let sample = sample_light(scene, chosen.id, pt.point, [chosen.u, pt.u[1]])?;
         let pmf = scene.all_lights().pmf(chosen.id);
@@ -161,20 +168,31 @@ impl Bdpt<'_> {
             return None;
         }
         let wi = -sample.direction;
-        let f = self.bsdf(pt, sample.position, st.camera[st.t - 2].point, Transport::Radiance);
+        let to = st.camera[st.t - 2].point;
+        let f = self.bsdf(pt, wl, sample.position, to, Transport::Radiance);
         let cos = wi.dot(hit.shading_normal).abs();
         let visible =
             || unoccluded(scene, End::Surface(&hit), End::Light(chosen.id, sample.position));
-        if !(f > 0.0 && cos > 0.0 && visible()) {
+        if !(useful(&f[..wl.n]) && cos > 0.0 && visible()) {
             return None;
         }
-        let value =
-            pt.beta * f * cos * sample.intensity / (sample.distance * sample.distance * pmf);
+        let geometry = cos * sample.intensity / (sample.distance * sample.distance * pmf);
+        // One wavelength: the light was chosen given it, and its spectrum cancels the density
+        // the wavelength was drawn with. Hero wavelengths: chosen by power, times its spectrum.
+        let spectrum = if wl.is_hero() {
+            let spd = scene.light_spd(chosen.id)?;
+            wl.lambdas.map(|l| spd.value(l))
+        } else {
+            [1.0; crate::HERO]
+        };
+        let value = scaled(times(times(pt.beta, f), spectrum), geometry);
         let (pdf_pos, _) = self.light_pdfs(chosen.id, sample.position, sample.direction);
         let source = scene.lights.light(chosen.id)?;
         let ng = light_normal(source, sample.position);
         let kind = VertexKind::Light(chosen.id);
-        let mut vertex = Vertex::at(kind, sample.position, ng, 0.0, wl.lambda, NO_SAMPLES);
+        let lambda = wl.lambda();
+        let mut vertex =
+            Vertex::at(kind, sample.position, ng, [0.0; crate::HERO], lambda, NO_SAMPLES);
         vertex.delta = end.first_vertex_delta();
         vertex.pdf_fwd = end.pmf * pdf_pos;
         Some(Joined { light: Some(vertex), ..Joined::at_pixel(value, wl, end) })
@@ -185,7 +203,7 @@ impl Bdpt<'_> {
         &self,
         st: Strategy<'_>,
         beam_light: &LightEnd,
-        wl: &Wavelength,
+        wl: &Wavelengths,
     ) -> Option<Joined> {
         let (qs, pt) = (&st.light[st.s - 1], &st.camera[st.t - 1]);
         let (VertexKind::Surface(hq), VertexKind::Surface(hp)) = (qs.kind, pt.kind) else {
@@ -197,9 +215,10 @@ impl Bdpt<'_> {
             return None;
         }
         let q_prev = st.light[st.s - 2].point;
-        let f_light = self.bsdf(qs, q_prev, pt.point, Transport::Importance);
-        let f_camera = self.bsdf(pt, qs.point, st.camera[st.t - 2].point, Transport::Radiance);
-        if !(f_light > 0.0 && f_camera > 0.0) {
+        let f_light = self.bsdf(qs, wl, q_prev, pt.point, Transport::Importance);
+        let p_prev = st.camera[st.t - 2].point;
+        let f_camera = self.bsdf(pt, wl, qs.point, p_prev, Transport::Radiance);
+        if !(useful(&f_light[..wl.n]) && useful(&f_camera[..wl.n])) {
             return None;
         }
         let d = pt.point - qs.point;
@@ -214,7 +233,13 @@ impl Bdpt<'_> {
         if !unoccluded(self.scene, End::Surface(&hq), End::Surface(&hp)) {
             return None;
         }
-        let value = qs.beta * f_light * cos_q * cos_p / d2 * f_camera * pt.beta;
+        let light_side = scaled(times(qs.beta, f_light), cos_q * cos_p / d2);
+        let value = times(times(light_side, f_camera), pt.beta);
         Some(Joined::at_pixel(value, wl, *beam_light))
     }
+}
+
+/// Whether some lane of `values` is positive and none is infinite or NaN.
+pub(super) fn useful(values: &[f64]) -> bool {
+    values.iter().all(|v| v.is_finite()) && values.iter().any(|&v| v > 0.0)
 }

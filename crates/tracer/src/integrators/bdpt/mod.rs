@@ -1,12 +1,12 @@
-//! Bidirectional path tracing (Veach 1997, chapter 10; pbrt's `BDPTIntegrator`), one wavelength
-//! per sample.
+//! Bidirectional path tracing (Veach 1997, chapter 10; pbrt's `BDPTIntegrator`), with four hero
+//! wavelengths per sample where the scene allows it and one elsewhere.
 //!
 //! # Estimator
 //! A camera sample of pixel `p` pairs a *light subpath* with a *camera subpath* and combines every
 //! way of joining them, `(s, t)` with `s` light vertices and `t` camera vertices:
 //! - the light subpath starts with one beam of the light set ([`LightSource::next_beam`]): its
-//!   light `l` (chosen by power), origin, direction and wavelength `lambda` (drawn from the
-//!   light's SPD), then a random walk ([`Transport::Importance`]) with Russian roulette;
+//!   light `l` (chosen by power), origin, direction and (with one wavelength per sample)
+//!   wavelength `lambda` (drawn from the light's SPD), then a random walk ([`Transport::Importance`]) with Russian roulette;
 //! - the camera subpath is a ray through a uniform point of pixel `p` from the pinhole, or from a
 //!   uniform point of a thin lens ([`crate::PinholeCamera::generate_ray`]; a pinhole draws no
 //!   lens uniforms), then a random walk ([`Transport::Radiance`]);
@@ -23,7 +23,26 @@
 //! sampled with from either end.
 //!
 //! # Wavelengths and units
-//! The whole sample uses the beam's wavelength. Its density is the light set's marginal
+//! A sample carries either [`HERO`] wavelengths or one.
+//!
+//! **Hero wavelengths** ([`BdptWavelengths::Hero`], the default, wherever
+//! [`Bdpt::hero_possible`]): one uniform, drawn first, gives four stratified wavelengths from the
+//! camera's density `p` ([`CameraWavelengths::sample_hero`], as the path tracer's), shared by
+//! both subpaths. The light subpath starts from a beam of the light set (its light `l` chosen by
+//! power, `pmf(l) = Phi_l / Phi`; its origin and direction, which for a light with
+//! [`LightSource::uniform_spectrum`] do not depend on the beam's wavelength, whose own value
+//! and weight are not used), with throughput `Phi_l spd_l(lambda_j) / pmf(l) = Phi
+//! spd_l(lambda_j)` per wavelength. Next-event estimation chooses its light by power too and
+//! multiplies by its spectrum; a camera path that hits an emitter multiplies by the emitter's.
+//! So no density of any vertex depends on the wavelength, and one set of MIS weights serves all
+//! four; each wavelength's value is divided by `HERO p(lambda_j)` when it is splatted. A
+//! vertex's scattering is sampled by the hero (a bundle, [`spectrace_materials::Material::scatter_bundle`]),
+//! and the vertex's densities are evaluated at the hero. This needs a scene where nothing
+//! disperses or fluoresces (one path must serve every wavelength) and every light has a
+//! continuous spectrum, the same over all its beams.
+//!
+//! **One wavelength** (elsewhere, or [`BdptWavelengths::Beam`]): the beam's wavelength. Its
+//! density is the light set's marginal
 //! `p(lambda) = sum_l pmf(l) spd_l(lambda)`, the set's SPD. Given `lambda`, the beam's light was
 //! chosen with `pmf(l | lambda) = pmf(l) spd_l(lambda) / p(lambda)`, and next-event estimation
 //! (`s = 1`) chooses its light with the same conditional probability (the scene's light sampler,
@@ -37,11 +56,11 @@
 //!   `intensity / pmf(l)` (the spectra cancel).
 //!
 //! Lights whose beams use `equal_wavelengths` (beam `scale != 1`) draw `lambda` from another
-//! density: a sample whose beam has such a weight falls back to the light tracer's estimate
-//! (every `t = 1` strategy with full weight, no camera strategies). That is exact when every
-//! light of the set uses `equal_wavelengths` and only approximate for a mix. The same fallback
-//! applies when `p(lambda)` is not positive (a delta line of a line spectrum), which only light
-//! paths can reach.
+//! density: with one wavelength, a sample whose beam has such a weight falls back to the light
+//! tracer's estimate (every `t = 1` strategy with full weight, no camera strategies). That is
+//! exact when every light of the set uses `equal_wavelengths` and only approximate for a mix.
+//! The same fallback applies when `p(lambda)` is not positive (a delta line of a line
+//! spectrum), which only light paths can reach. Hero samples do not use the beam's weight.
 //!
 //! # Normalisation
 //! A chunk is one *pass*: one sample of every pixel, in pixel order ([`Bdpt::pass_samples`]
@@ -98,9 +117,12 @@ use spectrace_spectrum::SpectralPowerDistribution;
 
 use super::common::SampleLayout;
 use super::pass::{PassEstimator, pixel_of};
-use crate::{ChunkSampler, Effects, LightTracerScene, Splat, TraceStats};
+use crate::{
+    CameraWavelengths, ChunkSampler, Effects, HERO, LightTracerScene, SceneFeatures, Splat,
+    TraceStats,
+};
 use subpath::Buffers;
-use vertex::{Vertex, Wavelength};
+use vertex::{Lanes, Vertex, Wavelengths};
 
 mod connect;
 mod mis;
@@ -124,11 +146,46 @@ pub struct BdptSettings {
     /// give the same image where each can sample every path). Not a scene setting.
     #[serde(skip)]
     pub only_strategy: Option<(usize, usize)>,
+    /// How a sample chooses its wavelengths (`settings.bdpt_wavelengths`).
+    #[serde(default)]
+    pub wavelengths: BdptWavelengths,
+    /// The density hero wavelengths are drawn from (`settings.camera_wavelengths`).
+    #[serde(default)]
+    pub camera_wavelengths: CameraWavelengths,
 }
 
 impl Default for BdptSettings {
     fn default() -> Self {
-        Self { max_depth: 64, rr_depth: 4, only_strategy: None }
+        Self {
+            max_depth: 64,
+            rr_depth: 4,
+            only_strategy: None,
+            wavelengths: BdptWavelengths::default(),
+            camera_wavelengths: CameraWavelengths::default(),
+        }
+    }
+}
+
+/// How many wavelengths a BDPT sample carries (`settings.bdpt_wavelengths` in scene files).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BdptWavelengths {
+    /// [`HERO`] wavelengths from the camera's density, shared by both subpaths, where the
+    /// scene allows it ([`Bdpt::carries_hero`]); the beam's one wavelength elsewhere. The
+    /// default.
+    #[default]
+    Hero,
+    /// The beam's one wavelength, drawn from the lights' spectrum.
+    Beam,
+}
+
+impl BdptWavelengths {
+    /// The name used in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Hero => "hero",
+            Self::Beam => "beam",
+        }
     }
 }
 
@@ -145,6 +202,8 @@ pub struct Bdpt<'a> {
     camera_layout: SampleLayout,
     /// The uniforms of light-subpath vertices (re-emission, a lens point for `t = 1`).
     light_layout: SampleLayout,
+    /// Whether samples carry [`HERO`] wavelengths ([`Bdpt::carries_hero`]).
+    hero: bool,
 }
 
 /// A strategy: `s` vertices of the light subpath `light` joined to `t` of the camera
@@ -168,7 +227,36 @@ impl<'a> Bdpt<'a> {
             SampleLayout::camera_paths(scene, false, !scene.all_lights().is_empty());
         let light_layout = SampleLayout::light_paths(scene);
         let set_spd = LightSource::spd(scene.lights);
-        Self { scene, settings, effects, set_spd, camera_layout, light_layout }
+        let hero = settings.wavelengths == BdptWavelengths::Hero
+            && Self::hero_possible(&effects.features).is_ok();
+        Self { scene, settings, effects, set_spd, camera_layout, light_layout, hero }
+    }
+
+    /// Whether a scene with `features` lets BDPT samples carry hero wavelengths, or why not:
+    /// nothing disperses or fluoresces (both subpaths must follow one path for all
+    /// wavelengths, at the wavelengths the camera drew), and every light can say what it
+    /// emits at any wavelength (no spectral lines, one spectrum over its whole surface, flags
+    /// for its densities).
+    pub fn hero_possible(features: &SceneFeatures) -> Result<(), &'static str> {
+        let f = features;
+        if f.dispersive {
+            Err("a dispersive material sends each wavelength its own way")
+        } else if f.fluorescent {
+            Err("a fluorescent material changes wavelengths")
+        } else if f.line_spectra {
+            Err("a light has spectral lines, which drawn wavelengths cannot hit")
+        } else if f.light_spectra_vary {
+            Err("a light's colour varies over its beams")
+        } else if f.beam_only_lights > 0 {
+            Err("a light only generates beams")
+        } else {
+            Ok(())
+        }
+    }
+
+    /// Whether its samples carry [`HERO`] wavelengths (else the beam's one).
+    pub fn carries_hero(&self) -> bool {
+        self.hero
     }
 
     /// Its settings.
@@ -186,10 +274,24 @@ impl<'a> Bdpt<'a> {
         u64::from(self.scene.camera.width()) * u64::from(self.scene.camera.height())
     }
 
-    /// Whether a sample with `beam` at `wl` may use camera strategies: a beam of weight 1 at a
-    /// wavelength the lights' spectrum has a density for (see the module docs).
-    fn camera_strategies(beam: &spectrace_lights::Beam, wl: &Wavelength) -> bool {
-        beam.scale == 1.0 && wl.density > 0.0 && wl.density.is_finite()
+    /// Whether a sample with `beam` at `wl` may use camera strategies: always with hero
+    /// wavelengths; with one, a beam of weight 1 at a wavelength the lights' spectrum has a
+    /// density for (see the module docs).
+    fn camera_strategies(beam: &spectrace_lights::Beam, wl: &Wavelengths) -> bool {
+        wl.is_hero() || (beam.scale == 1.0 && wl.density > 0.0 && wl.density.is_finite())
+    }
+
+    /// The sample's wavelengths: [`HERO`](HERO) of them from the observer's density when
+    /// the render carries hero wavelengths (one uniform, drawn before the beam), else the
+    /// beam's own.
+    fn wavelengths(&self, beam_lambda: f64, hero_u: Option<f64>) -> Wavelengths {
+        match hero_u {
+            Some(u) => {
+                let (lambdas, weights) = self.settings.camera_wavelengths.sample_hero(u);
+                Wavelengths::hero(lambdas, weights)
+            }
+            None => Wavelengths::single(beam_lambda, self.set_spd.value(beam_lambda)),
+        }
     }
 
     /// Most vertices of a camera subpath (pinhole included) and of a light subpath.
@@ -211,8 +313,10 @@ impl<'a> Bdpt<'a> {
     ) {
         let scene = self.scene;
         let beam = LightSource::next_beam(scene.lights, rng);
-        let density = self.set_spd.value(beam.lambda);
-        let wl = Wavelength { lambda: beam.lambda, density };
+        // Drawn after the beam, so that the beam keeps the first Sobol dimensions, as in one-
+        // wavelength mode (drawn first, it cost sky's Sobol gain a third of its error ratio).
+        let hero_u = self.hero.then(|| spectrace_sampling::uniform(rng));
+        let wl = self.wavelengths(beam.lambda, hero_u);
         let camera_strategies = Self::camera_strategies(&beam, &wl);
         let Some(light) = self.light_end(beam.parent, &wl) else { return };
         self.light_subpath(&beam, &light, &wl, rng, buffers, stats);
@@ -220,14 +324,14 @@ impl<'a> Bdpt<'a> {
             self.camera_subpath(px, py, &wl, rng, buffers, stats);
         } else {
             buffers.camera.clear();
-            buffers.camera.push(Vertex::camera(scene.camera.position(), wl.lambda));
+            buffers.camera.push(Vertex::camera(scene.camera.position(), wl.lambda()));
         }
         // The film holds values relative to the lights' total power (see `image_scale`).
         let power = scene.lights.power();
         let inv_power = if power > 0.0 { 1.0 / power } else { 0.0 };
         let pixels = self.pass_samples().max(1) as f64;
         let max_len = self.settings.max_depth.min(crate::MAX_DEPTH) as usize + 3;
-        let mut radiance = 0.0;
+        let mut radiance: Lanes = [0.0; HERO];
         let Buffers { light: lv, camera: cv, mis } = buffers;
         let t_max = if camera_strategies { cv.len() } else { 1 };
         for t in 1..=t_max {
@@ -245,23 +349,31 @@ impl<'a> Bdpt<'a> {
                 };
                 if self.settings.only_strategy.is_some() {
                     // Unweighted: undo the MIS weight.
-                    c.value = if c.weight > 0.0 { c.value / c.weight } else { 0.0 };
+                    let undo = if c.weight > 0.0 { 1.0 / c.weight } else { 0.0 };
+                    c.value = vertex::scaled(c.value, undo);
                 }
-                if !(c.value > 0.0 && c.value.is_finite()) {
+                if !connect::useful(&c.value[..wl.n]) {
                     continue;
                 }
                 match c.raster {
                     Some((x, y)) => {
-                        let value = c.value * inv_power / pixels;
-                        if film.splat_spectral(x, y, &[c.lambda], &[value]) {
+                        let k = inv_power / pixels;
+                        let value = vertex::scaled(vertex::times(c.value, wl.weights), k);
+                        let lambdas = if wl.is_hero() { &wl.lambdas[..] } else { &[c.lambda][..] };
+                        if film.splat_spectral(x, y, lambdas, &value[..wl.n]) {
                             stats.splats += 1;
                         }
                     }
-                    None => radiance += c.value,
+                    None => {
+                        for (r, v) in radiance.iter_mut().zip(c.value) {
+                            *r += v;
+                        }
+                    }
                 }
             }
         }
-        film.splat_spectral(px, py, &[wl.lambda], &[radiance * inv_power]);
+        let value = vertex::scaled(vertex::times(radiance, wl.weights), inv_power);
+        film.splat_spectral(px, py, &wl.lambdas[..wl.n], &value[..wl.n]);
     }
 }
 

@@ -16,7 +16,6 @@ use spectrace_lights::{LightId, LightSource};
 
 use super::mis::mis_weight;
 use super::subpath::Buffers;
-use super::vertex::Wavelength;
 use super::*;
 use crate::{CameraRepr, EffectsMode, FovAxis, PinholeCamera};
 use crate::{Effects, Emitter, TraceStats};
@@ -198,8 +197,9 @@ fn check_sample(
     buffers: &mut Buffers,
 ) -> Vec<(usize, usize)> {
     let mut stats = TraceStats::default();
+    let hero_u = bdpt.hero.then(|| spectrace_sampling::uniform(rng));
     let beam = LightSource::next_beam(bdpt.scene.lights, rng);
-    let wl = Wavelength { lambda: beam.lambda, density: bdpt.set_spd.value(beam.lambda) };
+    let wl = bdpt.wavelengths(beam.lambda, hero_u);
     let end = bdpt.light_end(beam.parent, &wl).unwrap();
     bdpt.light_subpath(&beam, &end, &wl, rng, buffers, &mut stats);
     bdpt.camera_subpath(pixel.0, pixel.1, &wl, rng, buffers, &mut stats);

@@ -9,6 +9,10 @@ use spectrace_lights::{LightFlags, LightId, LightSource, LightSurface};
 use spectrace_materials::{Material, Transport, reemission_lobe};
 
 use super::Bdpt;
+use crate::HERO;
+
+/// A value per wavelength a sample carries: its first [`Wavelengths::n`] entries are used.
+pub(super) type Lanes = [f64; HERO];
 
 /// What a vertex is.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -28,15 +32,17 @@ pub(super) struct Vertex {
     pub point: DVec3,
     /// Geometric normal; zero for points not on a surface (pinhole, point lights).
     pub ng: DVec3,
-    /// Throughput from the subpath's start up to this vertex (not including its scattering).
-    pub beta: f64,
+    /// Throughput per wavelength from the subpath's start up to this vertex (not including its
+    /// scattering).
+    pub beta: Lanes,
     /// Scatters by a delta lobe (or, for a light, emits in a delta direction).
     pub delta: bool,
     /// Area density of this vertex sampled from its own subpath's side.
     pub pdf_fwd: f64,
     /// Area density of this vertex sampled from the other side.
     pub pdf_rev: f64,
-    /// The wavelength (nm) at which this vertex connects: the sample's own, or on a light
+    /// The wavelength (nm) at which this vertex's densities are evaluated and, with one
+    /// wavelength per sample, at which it connects: the sample's own (its hero), or on a light
     /// subpath beyond a fluorescent re-emission the re-emitted one.
     pub lambda: f64,
     /// This vertex re-emitted (scatters with [`reemission_lobe`] instead of its material).
@@ -51,7 +57,7 @@ pub(super) struct Vertex {
 impl Vertex {
     /// The camera's vertex at `point` (the pinhole or a lens point).
     pub(super) fn camera(point: DVec3, lambda: f64) -> Self {
-        Self::at(VertexKind::Camera, point, DVec3::ZERO, 1.0, lambda, NO_SAMPLES)
+        Self::at(VertexKind::Camera, point, DVec3::ZERO, [1.0; HERO], lambda, NO_SAMPLES)
     }
 
     /// A vertex of `kind` at `point` with normal `ng`, throughput `beta` and uniforms `u`.
@@ -59,7 +65,7 @@ impl Vertex {
         kind: VertexKind,
         point: DVec3,
         ng: DVec3,
-        beta: f64,
+        beta: Lanes,
         lambda: f64,
         u: [f64; 2],
     ) -> Self {
@@ -111,22 +117,80 @@ impl LightEnd {
     }
 }
 
-/// The wavelength of a sample and what depends on it.
+/// The wavelengths of a sample and what depends on them.
+///
+/// With one wavelength (`n = 1`, the beam's own, drawn from the light set's SPD) every value
+/// carries the density `1 / p(lambda)` inside it, as the light tracer's do. With [`HERO`]
+/// wavelengths (drawn from the observer's density, [`crate::CameraWavelengths::sample_hero`])
+/// values are per unit of wavelength density, and each lane's film weight
+/// `1 / (HERO p(lambda_j))` is applied when it is splatted.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Wavelength {
-    pub lambda: f64,
-    /// The light set's SPD at `lambda`: the density the wavelength was drawn with.
+pub(super) struct Wavelengths {
+    /// The wavelengths (nm), the hero first.
+    pub lambdas: Lanes,
+    /// Each wavelength's film weight (1 with one wavelength).
+    pub weights: Lanes,
+    /// How many are carried: 1 or [`HERO`].
+    pub n: usize,
+    /// With one wavelength, the light set's SPD at it (the density it was drawn with); 1 with
+    /// hero wavelengths.
     pub density: f64,
 }
 
+impl Wavelengths {
+    /// The one wavelength `lambda` of a beam, drawn with density `density`.
+    pub(super) fn single(lambda: f64, density: f64) -> Self {
+        let mut lambdas = [lambda; HERO];
+        lambdas[1..].fill(0.0);
+        let mut weights = [0.0; HERO];
+        weights[0] = 1.0;
+        Self { lambdas, weights, n: 1, density }
+    }
+
+    /// [`HERO`] wavelengths with their film weights.
+    pub(super) fn hero(lambdas: Lanes, weights: Lanes) -> Self {
+        Self { lambdas, weights, n: HERO, density: 1.0 }
+    }
+
+    /// Whether the sample carries hero wavelengths.
+    pub(super) fn is_hero(&self) -> bool {
+        self.n > 1
+    }
+
+    /// The hero (or only) wavelength.
+    pub(super) fn lambda(&self) -> f64 {
+        self.lambdas[0]
+    }
+
+    /// The wavelengths at which vertex `v` connects: the sample's, or with one wavelength the
+    /// vertex's own (a re-emitted one beyond a fluorescent surface).
+    pub(super) fn at<'w>(&'w self, v: &'w Vertex) -> &'w [f64] {
+        if self.is_hero() { &self.lambdas } else { std::slice::from_ref(&v.lambda) }
+    }
+}
+
+/// `a * k`, lane by lane.
+pub(super) fn scaled(a: Lanes, k: f64) -> Lanes {
+    a.map(|x| x * k)
+}
+
+/// `a * b`, lane by lane.
+pub(super) fn times(a: Lanes, b: Lanes) -> Lanes {
+    std::array::from_fn(|j| a[j] * b[j])
+}
+
 impl Bdpt<'_> {
-    /// The light `id` as a path end for wavelength `wl`.
-    pub(super) fn light_end(&self, id: LightId, wl: &Wavelength) -> Option<LightEnd> {
+    /// The light `id` as a path end for the sample's wavelengths `wl`: chosen given the one
+    /// wavelength, or by power alone for hero wavelengths.
+    pub(super) fn light_end(&self, id: LightId, wl: &Wavelengths) -> Option<LightEnd> {
         let light = self.scene.lights.light(id)?;
         let flags =
             light.flags().unwrap_or(LightFlags { delta_position: true, delta_direction: true });
-        let pmf = if wl.density > 0.0 {
-            self.scene.all_lights().pmf_given(id, wl.lambda, wl.density)
+        let lights = self.scene.all_lights();
+        let pmf = if wl.is_hero() {
+            crate::light_sampler::LightSampler::pmf(lights, id)
+        } else if wl.density > 0.0 {
+            lights.pmf_given(id, wl.lambda(), wl.density)
         } else {
             0.0
         };
@@ -215,13 +279,31 @@ impl Bdpt<'_> {
     }
 
     /// The BSDF at surface vertex `v` for light arriving from `from` and leaving towards `to`,
-    /// with `transport`'s adjoint; 0 for other vertices.
-    pub(super) fn bsdf(&self, v: &Vertex, from: DVec3, to: DVec3, transport: Transport) -> f64 {
-        let VertexKind::Surface(hit) = v.kind else { return 0.0 };
-        let Some(material) = self.lobe(v, &hit) else { return 0.0 };
+    /// with `transport`'s adjoint, at the wavelengths `wl` carries there
+    /// ([`Wavelengths::at`]); 0 for other vertices.
+    pub(super) fn bsdf(
+        &self,
+        v: &Vertex,
+        wl: &Wavelengths,
+        from: DVec3,
+        to: DVec3,
+        transport: Transport,
+    ) -> Lanes {
+        let mut f = [0.0; HERO];
+        let VertexKind::Surface(hit) = v.kind else { return f };
+        let Some(material) = self.lobe(v, &hit) else { return f };
         let wi = (from - v.point).normalize();
         let wo = (to - v.point).normalize();
-        material.eval_with(wi, wo, hit.shading_normal, v.lambda, transport)
+        let lambdas = wl.at(v);
+        material.eval_bundle(
+            wi,
+            wo,
+            hit.shading_normal,
+            lambdas,
+            transport,
+            &mut f[..lambdas.len()],
+        );
+        f
     }
 
     /// A light's `(position, direction)` emission densities from `point` along `direction`
