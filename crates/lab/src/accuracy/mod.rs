@@ -21,15 +21,17 @@
 //! Which knobs act on which estimator ([`KNOBS_BY_ESTIMATOR`], also in the report): the sampler
 //! and the SPD sampler act on all three (a piecewise-constant SPD is another spectrum, so every
 //! estimator converges to another image); the lights' wavelength strategy acts on the light
-//! tracer and BDPT (whose light subpaths start with a light's beam), not on the path tracer,
-//! whose camera paths draw their own wavelengths (`settings.camera_wavelengths`); the effects
+//! tracer and on one-wavelength BDPT (whose light subpaths start with a light's beam), not on
+//! the path tracer or hero-wavelength BDPT, whose camera paths draw their own wavelengths
+//! (`settings.camera_wavelengths`); the effects
 //! analysis sets the light tracer's wavelengths per path and whether its beams and the path
 //! tracer's paths continue after a diffuse hit, and BDPT ignores it. The sweep applies each
 //! non-estimator knob to the light tracer, where all of them act, and the sampler also to the
 //! path tracer and BDPT.
 //!
 //! Code: this module runs the sweep; `configuration` names the knobs, `knobs` sets them on the
-//! typed scene, `cache` keeps the references, `report` analyses and writes the Markdown, `plot`
+//! typed scene, `cache` keeps the references, `report` analyses and writes the Markdown, `gains`
+//! states each variance-reduction knob's variance over its peer's (pixel and colour), `plot`
 //! draws the SVG, and `tests` tests them.
 //!
 //! Each point records the wall time of the render alone and the relative RMSE of the XYZ image
@@ -58,6 +60,7 @@
 mod cache;
 mod check;
 mod configuration;
+mod gains;
 mod knobs;
 mod plot;
 mod report;
@@ -168,6 +171,10 @@ pub struct AccuracyPoint {
     /// far from 1 when light is missing or added.
     #[serde(default)]
     pub mean_ratio: f64,
+    /// The part of the relative RMSE that changes pixels' colours, not their brightness (see
+    /// [`colour_relative_rmse`]); 0 in reports written before it was measured.
+    #[serde(default)]
+    pub colour_rmse: f64,
 }
 
 /// The sweep of one configuration on one scene.
@@ -253,10 +260,13 @@ pub struct AccuracyReport {
 pub const KNOBS_BY_ESTIMATOR: &str = "the sampler (`sobol`, `path_sobol`, `bdpt_sobol`; `path` \
      and `bdpt` sample independently, `auto` as by default) and the SPD sampler \
      (`piecewise_constant_spd`, another spectrum) act on every estimator; the lights' wavelength \
-     strategy (`equal_wavelengths`, `observer_wavelengths`) acts on the light tracer and BDPT \
-     (light subpaths start with a light's beam) but not on the path tracer, whose camera paths \
-     draw their own wavelengths (`settings.camera_wavelengths`, swept as \
-     `path_uniform_wavelengths` against the visible density of `path`); the effects analysis \
+     strategy (`equal_wavelengths`, `observer_wavelengths`) acts on the light tracer, and on \
+     BDPT only with one wavelength per sample (`bdpt_beam`, and scenes that disperse, fluoresce \
+     or have line spectra, whose light subpaths start with a light's beam), not on the path \
+     tracer or hero-wavelength BDPT (`bdpt`), whose camera paths draw their own wavelengths \
+     (`settings.camera_wavelengths`, swept as `path_uniform_wavelengths` against the visible \
+     density of `path`); BDPT's wavelengths (`bdpt_beam` against `bdpt`) act on BDPT alone; \
+     the effects analysis \
      (`effects_off`) sets the light tracer's wavelengths per path and whether light-tracer beams \
      and path-tracer paths continue after a diffuse hit, and BDPT ignores it. The sweep applies \
      each of these knobs to the light tracer, where all of them act, and the sampler also to the \
@@ -467,13 +477,21 @@ fn run_scene(
                 render_xyz(scene, integrator, mode, nominal, seed, threads)?;
             let relative_rmse = relative_rmse(&xyz, &reference)?;
             let mean_ratio = mean_ratio(&xyz, &reference);
+            let colour_rmse = colour_relative_rmse(&xyz, &reference)?;
             eprintln!(
                 "accuracy: {name}: {:<22} {beams:>10} paths {seconds:>8.3} s  error {:.3}%  \
                  mean Y {mean_ratio:.3}x the reference",
                 p.configuration.name(),
                 relative_rmse * 100.0
             );
-            points[c].push(AccuracyPoint { beams, seed, seconds, relative_rmse, mean_ratio });
+            points[c].push(AccuracyPoint {
+                beams,
+                seed,
+                seconds,
+                relative_rmse,
+                mean_ratio,
+                colour_rmse,
+            });
         }
     }
     let configurations = prepared
@@ -607,6 +625,28 @@ pub fn relative_rmse(image: &[Xyz], reference: &[Xyz]) -> Result<f64, String> {
     }
     if !(norm > 0.0) {
         return Err("the reference image is black".to_owned());
+    }
+    Ok((diff / norm).sqrt())
+}
+
+/// The colour part of [`relative_rmse`]: each pixel's XYZ error minus its component along
+/// the reference pixel's XYZ direction (which only changes brightness), so
+/// `sqrt(sum |d - (d . r^) r^|^2 / sum |ref|^2)` with `d = xyz - ref` and `r^ = ref / |ref|`.
+/// Where the reference pixel is black it has no colour to keep and the whole error counts. The
+/// squares of the two parts add up to the square of [`relative_rmse`].
+///
+/// # Errors
+/// As [`relative_rmse`].
+pub fn colour_relative_rmse(image: &[Xyz], reference: &[Xyz]) -> Result<f64, String> {
+    relative_rmse(image, reference)?;
+    let (mut diff, mut norm) = (0.0, 0.0);
+    for (a, r) in image.iter().zip(reference) {
+        let d = [a.x - r.x, a.y - r.y, a.z - r.z];
+        let rr = r.x * r.x + r.y * r.y + r.z * r.z;
+        let along =
+            if rr > 0.0 { (d[0] * r.x + d[1] * r.y + d[2] * r.z).powi(2) / rr } else { 0.0 };
+        diff += (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] - along).max(0.0);
+        norm += rr;
     }
     Ok((diff / norm).sqrt())
 }

@@ -221,6 +221,7 @@ pub fn markdown(report: &AccuracyReport) -> String {
     if o.configurations.iter().any(|c| c.integrator() != IntegratorChoice::Light) {
         integrators_markdown(&mut md, report);
     }
+    super::gains::gains_markdown(&mut md, report);
     let _ = writeln!(
         md,
         "\n![relative RMSE against wall time, log-log](accuracy.svg)\n\n\

@@ -209,6 +209,11 @@ fn error_falls_with_beams_and_the_report_is_written() {
     assert!(e > 0.0 && (e / t) > 0.5 && (e / t) < 1.5, "estimate {e}, truth {t}");
     assert!(md.contains("## Does the renderer know its own error?"), "{md}");
     assert!(md.contains("### Estimate against truth"), "{md}");
+    // The knobs' gains: a column per pair, here "-" (every point is within 1/256 of the
+    // reference's paths, where its noise would count).
+    let gains = md.split("## What each variance-reduction knob buys").nth(1).unwrap();
+    assert!(gains.contains("hero wavelengths (BDPT): `bdpt` over `bdpt_beam`"), "{gains}");
+    assert!(gains.lines().any(|l| l.starts_with("| tiny | - | - |")), "{gains}");
     let svg = std::fs::read_to_string(dir.join("docs/accuracy.svg")).unwrap();
     assert!(svg.contains("<svg") && svg.contains("slope -1/2"));
 
@@ -308,6 +313,7 @@ fn a_biased_estimator_levels_off_and_is_not_extrapolated() {
         seconds,
         relative_rmse,
         mean_ratio: 0.5,
+        colour_rmse: 0.0,
     };
     // Falls at first, then flattens at 40%: the overall slope is steep enough to
     // extrapolate, the last three points say bias.
@@ -426,8 +432,22 @@ fn slopes_and_reach() {
         not_applicable: None,
         known_bias: None,
         points: vec![
-            AccuracyPoint { beams: 1, seed: 0, seconds: 1.0, relative_rmse: 0.2, mean_ratio: 1.0 },
-            AccuracyPoint { beams: 4, seed: 0, seconds: 4.0, relative_rmse: 0.1, mean_ratio: 1.0 },
+            AccuracyPoint {
+                beams: 1,
+                seed: 0,
+                seconds: 1.0,
+                relative_rmse: 0.2,
+                mean_ratio: 1.0,
+                colour_rmse: 0.0,
+            },
+            AccuracyPoint {
+                beams: 4,
+                seed: 0,
+                seconds: 4.0,
+                relative_rmse: 0.1,
+                mean_ratio: 1.0,
+                colour_rmse: 0.0,
+            },
         ],
         slope_vs_time: Some(-0.5),
         slope_vs_beams: Some(-0.5),
@@ -438,4 +458,97 @@ fn slopes_and_reach() {
     assert!((t - 16.0).abs() < 1e-9);
     assert!(matches!(time_to_reach(&result, 0.3), Reach::AtMost(_)));
     assert_ne!(sweep_seed(5, 0, 0), 5);
+}
+
+#[test]
+fn the_colour_part_of_the_error_ignores_brightness_and_adds_in_quadrature() {
+    let xyz = |x, y, z| Xyz { x, y, z };
+    let reference = [xyz(1.0, 2.0, 3.0), xyz(0.5, 0.5, 0.1)];
+    // Twice as bright everywhere: all error, no colour error.
+    let brighter: Vec<Xyz> =
+        reference.iter().map(|r| xyz(2.0 * r.x, 2.0 * r.y, 2.0 * r.z)).collect();
+    assert!((relative_rmse(&brighter, &reference).unwrap() - 1.0).abs() < 1e-12);
+    assert!(colour_relative_rmse(&brighter, &reference).unwrap() < 1e-7);
+    // Error orthogonal to the reference colour: all of it is colour.
+    let hue = [xyz(1.0 + 2.0, 2.0 - 1.0, 3.0), reference[1]];
+    let (total, colour) =
+        (relative_rmse(&hue, &reference).unwrap(), colour_relative_rmse(&hue, &reference).unwrap());
+    assert!(total > 0.1 && (colour - total).abs() < 1e-12, "{total} {colour}");
+    // A mixture: brightness^2 + colour^2 = total^2, each part strictly inside.
+    let mixed = [xyz(2.0 + 2.0, 4.0 - 1.0, 6.0), reference[1]];
+    let (total, colour) = (
+        relative_rmse(&mixed, &reference).unwrap(),
+        colour_relative_rmse(&mixed, &reference).unwrap(),
+    );
+    let norm = reference.iter().map(|r| r.x * r.x + r.y * r.y + r.z * r.z).sum::<f64>();
+    let brightness = 14f64.sqrt() / norm.sqrt();
+    assert!((total * total - colour * colour - brightness * brightness).abs() < 1e-12);
+    assert!(colour > 0.0 && colour < total);
+    // Light where the reference is black has no colour to keep: all of it counts.
+    let black = [xyz(0.0, 0.0, 0.0), xyz(1.0, 1.0, 1.0)];
+    let lit = [xyz(0.3, 0.0, 0.0), xyz(1.0, 1.0, 1.0)];
+    let c = colour_relative_rmse(&lit, &black).unwrap();
+    assert!((c - relative_rmse(&lit, &black).unwrap()).abs() < 1e-12 && c > 0.0);
+    assert!(colour_relative_rmse(&lit, &black[..1]).is_err());
+}
+
+#[test]
+fn a_knobs_gain_is_its_variance_over_its_peers_at_equal_paths_and_time() {
+    let point = |beams, seconds, relative_rmse, colour_rmse| AccuracyPoint {
+        beams,
+        seed: 0,
+        seconds,
+        relative_rmse,
+        mean_ratio: 1.0,
+        colour_rmse,
+    };
+    let result = |configuration, points| ConfigurationResult {
+        configuration,
+        changed: String::new(),
+        not_applicable: None,
+        known_bias: None,
+        points,
+        slope_vs_time: None,
+        slope_vs_beams: None,
+    };
+    // bdpt: half the pixel variance, a quarter of the colour variance, 1.5x the time; the last
+    // point (too close to the reference's 1024 paths) is left out.
+    let hero = vec![point(1, 1.5, 0.1, 0.05), point(2, 3.0, 0.2, 0.1), point(8, 9.0, 9.0, 9.0)];
+    let beam = vec![
+        point(1, 1.0, 0.1 * 2f64.sqrt(), 0.1),
+        point(2, 2.0, 0.2 * 2f64.sqrt(), 0.2),
+        point(8, 1.0, 0.01, 0.01),
+    ];
+    let mut scene = SceneResult {
+        scene: "s.json".to_owned(),
+        name: "s".to_owned(),
+        width: 1,
+        height: 1,
+        effects_summary: String::new(),
+        auto_picks: IntegratorChoice::Bdpt,
+        auto_reason: String::new(),
+        reference: ReferenceInfo {
+            integrator: IntegratorChoice::Bdpt,
+            beams: 1024,
+            seed: 0,
+            seconds: 0.0,
+            cached: false,
+            file: String::new(),
+        },
+        estimate_check: None,
+        configurations: vec![
+            result(Configuration::Bdpt, hero),
+            result(Configuration::BdptBeam, beam),
+        ],
+    };
+    let g = gains::gain(&scene, Configuration::Bdpt, Configuration::BdptBeam).unwrap();
+    assert_eq!(g.points, 2);
+    assert!((g.pixel - 0.5).abs() < 1e-12 && (g.colour - 0.25).abs() < 1e-12, "{g:?}");
+    assert!((g.time - 1.5).abs() < 1e-12);
+    // Not swept, or from a report without the colour part: no gain.
+    assert!(gains::gain(&scene, Configuration::Path, Configuration::BdptBeam).is_none());
+    for p in &mut scene.configurations[0].points {
+        p.colour_rmse = 0.0;
+    }
+    assert!(gains::gain(&scene, Configuration::Bdpt, Configuration::BdptBeam).is_none());
 }

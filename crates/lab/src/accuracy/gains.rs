@@ -1,0 +1,137 @@
+//! What a variance-reduction knob buys: the variance of one configuration over its peer's (the
+//! same estimator without the knob), in pixels (XYZ) and in colour, at equal paths and at
+//! equal time, from the sweep points both rendered.
+
+use super::report::sig;
+use super::*;
+use std::fmt::Write as _;
+
+/// The knobs whose gain the report states: (with the knob, its peer, what the knob is).
+pub(super) const GAIN_PAIRS: [(Configuration, Configuration, &str); 6] = [
+    (Configuration::Bdpt, Configuration::BdptBeam, "hero wavelengths (BDPT)"),
+    (Configuration::BdptSobol, Configuration::Bdpt, "Sobol points (BDPT)"),
+    (Configuration::PathSobol, Configuration::Path, "Sobol points (path)"),
+    (
+        Configuration::Path,
+        Configuration::PathUniformWavelengths,
+        "visible camera wavelengths (path)",
+    ),
+    (Configuration::ObserverWavelengths, Configuration::Baseline, "observer wavelengths (light)"),
+    (Configuration::Sobol, Configuration::Baseline, "Sobol points (light)"),
+];
+
+/// Sweep points whose path count is at most this fraction of the reference's enter the ratios:
+/// there the reference's own noise adds at most 1/256 of the variance to either side.
+const REFERENCE_SHARE: u64 = 256;
+
+/// Variance ratios of a configuration over its peer.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Gain {
+    /// Squared relative RMSE of XYZ over the peer's, summed over the shared points: the pixel
+    /// variance at equal paths.
+    pub pixel: f64,
+    /// The same for the colour part of the error ([`colour_relative_rmse`]).
+    pub colour: f64,
+    /// Wall time over the peer's over the same points: the ratios at equal time are the ratios
+    /// at equal paths times this.
+    pub time: f64,
+    /// Sweep points used.
+    pub points: usize,
+}
+
+/// The gain of `with` over `peer` on a scene: `None` when either was not swept, no point is
+/// small enough beside the reference, or an error is missing (a report from before the colour
+/// part was measured).
+pub(super) fn gain(scene: &SceneResult, with: Configuration, peer: Configuration) -> Option<Gain> {
+    let find = |c| scene.configurations.iter().find(|r| r.configuration == c);
+    let (a, b) = (find(with)?, find(peer)?);
+    let limit = scene.reference.beams / REFERENCE_SHARE;
+    let (mut sums, mut points) = ([0.0; 6], 0);
+    for (p, q) in a.points.iter().zip(&b.points) {
+        if p.beams != q.beams || p.beams > limit || p.colour_rmse <= 0.0 || q.colour_rmse <= 0.0 {
+            continue;
+        }
+        let add = [
+            p.relative_rmse.powi(2),
+            q.relative_rmse.powi(2),
+            p.colour_rmse.powi(2),
+            q.colour_rmse.powi(2),
+            p.seconds,
+            q.seconds,
+        ];
+        for (s, v) in sums.iter_mut().zip(add) {
+            *s += v;
+        }
+        points += 1;
+    }
+    let ratio = |n: f64, d: f64| (d > 0.0 && n.is_finite()).then(|| n / d);
+    Some(Gain {
+        pixel: ratio(sums[0], sums[1])?,
+        colour: ratio(sums[2], sums[3])?,
+        time: ratio(sums[4], sums[5])?,
+        points: (points > 0).then_some(points)?,
+    })
+}
+
+/// One table cell: pixel and colour variance ratios, at equal paths or at equal time.
+fn cell(gain: Option<Gain>, equal_time: bool, biased: bool) -> String {
+    let Some(g) = gain else { return "-".to_owned() };
+    let t = if equal_time { g.time } else { 1.0 };
+    let mark = if biased { " (biased)" } else { "" };
+    format!("{} / {}{mark}", sig(g.pixel * t), sig(g.colour * t))
+}
+
+/// The section "What each variance-reduction knob buys": two tables (equal paths, equal time),
+/// a row per scene, a column per knob in [`GAIN_PAIRS`] that the run swept.
+pub(super) fn gains_markdown(md: &mut String, report: &AccuracyReport) {
+    let swept = |c| report.options.configurations.contains(&c);
+    let pairs: Vec<_> = GAIN_PAIRS.iter().filter(|(a, b, _)| swept(*a) && swept(*b)).collect();
+    if pairs.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        md,
+        "\n## What each variance-reduction knob buys\n\n\
+         Per scene, the variance with a knob over the variance without it (the same estimator, \
+         the peer named in brackets), as `pixel / colour`: pixel is the squared relative RMSE of \
+         XYZ, colour its part that changes a pixel's colour rather than its brightness (each \
+         pixel's error minus its component along the reference pixel's XYZ). Below 1 the knob \
+         helps. Summed over the sweep points both rendered with at most 1/{REFERENCE_SHARE} of \
+         the reference's paths, so that the reference's own noise is negligible; each point is \
+         one render, so ratios carry a few percent of noise. `(biased)`: either side converges \
+         to another image than the reference (its error includes a floor), `-`: not swept or \
+         not applicable (hero wavelengths are off where a scene disperses, fluoresces or has \
+         line spectra, so `bdpt` and `bdpt_beam` render alike there).\n"
+    );
+    for (title, equal_time) in [("At equal paths", false), ("At equal time", true)] {
+        let _ = writeln!(md, "{title}:\n");
+        let mut header = "| scene |".to_owned();
+        let mut rule = "|---|".to_owned();
+        for (a, b, what) in &pairs {
+            let _ = write!(header, " {what}: `{}` over `{}` |", a.name(), b.name());
+            rule.push_str("---:|");
+        }
+        let _ = writeln!(md, "{header}\n{rule}");
+        for scene in &report.scenes {
+            let mut row = format!("| {} |", scene.name);
+            for (a, b, _) in &pairs {
+                let applies = |c| {
+                    scene
+                        .configurations
+                        .iter()
+                        .any(|r| r.configuration == c && r.not_applicable.is_none())
+                };
+                let biased = [a, b].iter().any(|&&c| {
+                    scene
+                        .configurations
+                        .iter()
+                        .any(|r| r.configuration == c && !report::converges(scene, r))
+                });
+                let g = (applies(*a) && applies(*b)).then(|| gain(scene, *a, *b)).flatten();
+                let _ = write!(row, " {} |", cell(g, equal_time, biased));
+            }
+            let _ = writeln!(md, "{row}");
+        }
+        let _ = writeln!(md);
+    }
+}
