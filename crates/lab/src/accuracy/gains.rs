@@ -20,15 +20,15 @@ pub(super) const GAIN_PAIRS: [(Configuration, Configuration, &str); 6] = [
     (Configuration::Sobol, Configuration::Baseline, "Sobol points (light)"),
 ];
 
-/// Sweep points whose path count is at most this fraction of the reference's enter the ratios:
-/// there the reference's own noise adds at most 1/256 of the variance to either side.
-const REFERENCE_SHARE: u64 = 256;
+/// Shared sweep points the ratios use at most: the last ones (the most paths) where both
+/// sides' variance is at least twice the reference's own.
+const LAST_POINTS: usize = 4;
 
 /// Variance ratios of a configuration over its peer.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct Gain {
-    /// Squared relative RMSE of XYZ over the peer's, summed over the shared points: the pixel
-    /// variance at equal paths.
+    /// Variance of XYZ (squared relative RMSE, the reference's noise taken out) over the peer's,
+    /// summed over the points used: the pixel variance at equal paths.
     pub pixel: f64,
     /// The same for the colour part of the error ([`colour_relative_rmse`]).
     pub colour: f64,
@@ -39,37 +39,55 @@ pub(super) struct Gain {
     pub points: usize,
 }
 
-/// The gain of `with` over `peer` on a scene: `None` when either was not swept, no point is
-/// small enough beside the reference, or an error is missing (a report from before the colour
-/// part was measured).
+/// The reference's own noise, as (relative RMSE, its colour part): the reference estimator's
+/// last sweep point scaled to the reference's paths (see [`super::report::reference_noise`]).
+fn reference_noise(scene: &SceneResult) -> Option<(f64, f64)> {
+    let (same, noise) = super::report::reference_noise(scene)?;
+    let last = scene.configurations.iter().find(|c| c.configuration == same)?.points.last()?;
+    let colour = last.colour_rmse * noise / last.relative_rmse;
+    (noise.is_finite() && colour.is_finite()).then_some((noise, colour))
+}
+
+/// The gain of `with` over `peer` on a scene, from the last [`LAST_POINTS`] sweep points both
+/// rendered at equal paths where every measured variance (pixel and colour, both sides) is at
+/// least twice the reference's own, which is subtracted (they add). `None` when either was not
+/// swept, no point qualifies, or a colour error is missing (a report from before it was
+/// measured).
 pub(super) fn gain(scene: &SceneResult, with: Configuration, peer: Configuration) -> Option<Gain> {
     let find = |c| scene.configurations.iter().find(|r| r.configuration == c);
     let (a, b) = (find(with)?, find(peer)?);
-    let limit = scene.reference.beams / REFERENCE_SHARE;
-    let (mut sums, mut points) = ([0.0; 6], 0);
-    for (p, q) in a.points.iter().zip(&b.points) {
-        if p.beams != q.beams || p.beams > limit || p.colour_rmse <= 0.0 || q.colour_rmse <= 0.0 {
-            continue;
+    let (r, rc) = reference_noise(scene)?;
+    let (r2, rc2) = (r * r, rc * rc);
+    let usable: Vec<[f64; 6]> = a
+        .points
+        .iter()
+        .zip(&b.points)
+        .filter(|(p, q)| p.beams == q.beams && p.colour_rmse > 0.0 && q.colour_rmse > 0.0)
+        .map(|(p, q)| {
+            [
+                p.relative_rmse.powi(2) - r2,
+                q.relative_rmse.powi(2) - r2,
+                p.colour_rmse.powi(2) - rc2,
+                q.colour_rmse.powi(2) - rc2,
+                p.seconds,
+                q.seconds,
+            ]
+        })
+        .filter(|v| v[0] >= r2 && v[1] >= r2 && v[2] >= rc2 && v[3] >= rc2)
+        .collect();
+    let used = &usable[usable.len().saturating_sub(LAST_POINTS)..];
+    let mut sums = [0.0; 6];
+    for v in used {
+        for (s, x) in sums.iter_mut().zip(v) {
+            *s += x;
         }
-        let add = [
-            p.relative_rmse.powi(2),
-            q.relative_rmse.powi(2),
-            p.colour_rmse.powi(2),
-            q.colour_rmse.powi(2),
-            p.seconds,
-            q.seconds,
-        ];
-        for (s, v) in sums.iter_mut().zip(add) {
-            *s += v;
-        }
-        points += 1;
     }
     let ratio = |n: f64, d: f64| (d > 0.0 && n.is_finite()).then(|| n / d);
     Some(Gain {
         pixel: ratio(sums[0], sums[1])?,
         colour: ratio(sums[2], sums[3])?,
         time: ratio(sums[4], sums[5])?,
-        points: (points > 0).then_some(points)?,
+        points: (!used.is_empty()).then_some(used.len())?,
     })
 }
 
@@ -96,10 +114,12 @@ pub(super) fn gains_markdown(md: &mut String, report: &AccuracyReport) {
          the peer named in brackets), as `pixel / colour`: pixel is the squared relative RMSE of \
          XYZ, colour its part that changes a pixel's colour rather than its brightness (each \
          pixel's error minus its component along the reference pixel's XYZ). Below 1 the knob \
-         helps. Summed over the sweep points both rendered with at most 1/{REFERENCE_SHARE} of \
-         the reference's paths, so that the reference's own noise is negligible; each point is \
-         one render, so ratios carry a few percent of noise. `(biased)`: either side converges \
-         to another image than the reference (its error includes a floor), `-`: not swept or \
+         helps. Summed over the last {LAST_POINTS} sweep points (the most paths) that both \
+         rendered where each measured variance is at least twice the reference's own noise, \
+         which is taken out (variances add); Sobol's gain grows with the sample count, so it \
+         is measured where the sweep has the most samples. Each point is one render, so ratios \
+         carry some noise. `(biased)`: either side converges to another image than the \
+         reference (its error includes a floor), `-`: not swept or no point qualifies, or \
          not applicable (hero wavelengths are off where a scene disperses, fluoresces or has \
          line spectra, so `bdpt` and `bdpt_beam` render alike there).\n"
     );

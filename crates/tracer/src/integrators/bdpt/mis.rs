@@ -77,49 +77,50 @@ pub(super) fn build_mis_path(
 ) -> bool {
     let Strategy { light, camera, s, t } = strategy;
     mis.clear();
-    let qs = if s == 1 {
-        sampled.light.copied().or_else(|| light.first().copied())
+    // References, not copies: a vertex is a few hundred bytes and this runs per strategy.
+    let qs: Option<&Vertex> = if s == 1 {
+        sampled.light.or_else(|| light.first())
     } else if s > 0 {
-        Some(light[s - 1])
+        Some(&light[s - 1])
     } else {
         None
     };
-    let pt = match sampled.camera {
-        Some(c) if t == 1 => *c,
-        _ => camera[t - 1],
+    let pt: &Vertex = match sampled.camera {
+        Some(c) if t == 1 => c,
+        _ => &camera[t - 1],
     };
-    let qs_minus = if s >= 2 { Some(light[s - 2]) } else { None };
-    let pt_minus = if t >= 2 { Some(camera[t - 2]) } else { None };
+    let qs_minus = if s >= 2 { Some(&light[s - 2]) } else { None };
+    let pt_minus = if t >= 2 { Some(&camera[t - 2]) } else { None };
     for (i, v) in light.iter().take(s).enumerate() {
-        let v = if i + 1 == s { qs.unwrap_or(*v) } else { *v };
+        let v = if i + 1 == s { qs.unwrap_or(v) } else { v };
         mis.push(MisVertex { from_light: v.pdf_fwd, from_camera: v.pdf_rev, delta: v.delta });
     }
     for (j, v) in camera[..t].iter().enumerate().rev() {
-        let v = if j + 1 == t { pt } else { *v };
+        let v = if j + 1 == t { pt } else { v };
         mis.push(MisVertex { from_light: v.pdf_rev, from_camera: v.pdf_fwd, delta: v.delta });
     }
     let ip = s; // index of pt in the full path
     let light_id = if s == 0 { Some(end.id) } else { None };
     // pt as sampled from the light side.
-    mis[ip].from_light = match qs.as_ref() {
-        Some(q) => bdpt.pdf(q, qs_minus.as_ref(), &pt, None),
+    mis[ip].from_light = match qs {
+        Some(q) => bdpt.pdf(q, qs_minus, pt, None),
         None => {
             let dir = pt_minus.map_or(DVec3::ZERO, |m| m.point - pt.point);
             end.pmf * bdpt.light_pdfs(end.id, pt.point, dir).0
         }
     };
     mis[ip].delta = if s == 0 { end.flags.delta_direction } else { false };
-    if let Some(m) = pt_minus.as_ref() {
-        mis[ip + 1].from_light = match qs.as_ref() {
-            Some(q) => bdpt.pdf(&pt, Some(q), m, None),
-            None => bdpt.pdf(&pt, None, m, light_id),
+    if let Some(m) = pt_minus {
+        mis[ip + 1].from_light = match qs {
+            Some(q) => bdpt.pdf(pt, Some(q), m, None),
+            None => bdpt.pdf(pt, None, m, light_id),
         };
     }
-    if let Some(q) = qs.as_ref() {
-        mis[s - 1].from_camera = bdpt.pdf(&pt, pt_minus.as_ref(), q, None);
+    if let Some(q) = qs {
+        mis[s - 1].from_camera = bdpt.pdf(pt, pt_minus, q, None);
         mis[s - 1].delta = if s == 1 { end.first_vertex_delta() } else { false };
-        if let Some(qm) = qs_minus.as_ref() {
-            mis[s - 2].from_camera = bdpt.pdf(q, Some(&pt), qm, None);
+        if let Some(qm) = qs_minus {
+            mis[s - 2].from_camera = bdpt.pdf(q, Some(pt), qm, None);
         }
     }
     let on_surface = match s {
