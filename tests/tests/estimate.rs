@@ -69,8 +69,8 @@ fn truth_and_estimate(s: &Scene, integrator: IntegratorChoice, effort: u64, k: u
 /// The promise at small scale: on shipped scenes with the estimator `auto` picks, the
 /// estimate is within 20% of the true error. Eight renders of 32 samples per pixel: the truth
 /// from their spread has 7 degrees of freedom per pixel over 1,536 pixels (a few percent of
-/// noise), the estimates 31 each. Sky is BDPT with hero wavelengths (measured 0.0931 true,
-/// 0.0876 estimated), prism BDPT with one wavelength per sample (dispersive).
+/// noise), the estimates 31 each. Sky is BDPT with hero wavelengths (measured 0.0812 true,
+/// 0.0884 estimated), prism BDPT with one wavelength per sample (dispersive).
 #[test]
 fn the_estimate_is_within_20_percent_of_the_true_error_on_shipped_scenes() {
     for (name, integrator) in [
@@ -98,23 +98,29 @@ fn the_estimate_is_within_20_percent_of_the_true_error_on_shipped_scenes() {
 /// pixel's passes are one stratified sequence, not independent batches: the estimate measures
 /// the independent sampler's error, an upper bound of the true one. Same renders as above.
 /// Measured estimated / true: 1.92 (Cornell box, path; its independent renders: 0.1293 true
-/// error, 0.0695 under Sobol) and 1.28 (sky, BDPT with hero wavelengths: 0.0931 independent,
-/// 0.0688 under Sobol; 1.68 with one wavelength per sample, whose colour noise Sobol's
-/// stratified wavelength dimension removed and hero wavelengths now remove without it). Asserted above 1.2: the estimate bounds the
-/// error from above with a margin larger than its own noise (the 20% allowed above), which
-/// only holds if Sobol's true error is well below the independent sampler's.
+/// error, 0.0695 under Sobol), 1.65 (laser, BDPT with one wavelength), 1.40 (plastic, BDPT with
+/// hero wavelengths) and 1.01 (sky, BDPT with hero wavelengths). Asserted above 1.2 where Sobol
+/// points gain at 32 samples per pixel: the estimate bounds the error from above with a margin
+/// larger than its own noise (the 20% allowed above), which only holds if Sobol's true error is
+/// well below the independent sampler's. On the sky they gain little at 32 samples per pixel
+/// (with one wavelength per sample they took its colour noise, 1.68; hero wavelengths now do),
+/// so there the assertion is only that the estimate does not fall below the truth by more than
+/// its own noise.
 #[test]
 fn under_sobol_points_the_estimate_is_an_upper_bound() {
-    for (name, integrator) in
-        [("cornell.json", IntegratorChoice::Path), ("sky.json", IntegratorChoice::Bdpt)]
-    {
+    for (name, integrator, bound) in [
+        ("cornell.json", IntegratorChoice::Path, 1.2),
+        ("laser.json", IntegratorChoice::Bdpt, 1.2),
+        ("plastic.json", IntegratorChoice::Bdpt, 1.2),
+        ("sky.json", IntegratorChoice::Bdpt, 0.8),
+    ] {
         let mut s = small(name, 48, 32);
         s.settings.sampler = SamplerKind::Auto;
         let (truth, estimated) = truth_and_estimate(&s, integrator, 32 * 48 * 32, 8);
         eprintln!(
             "{name} ({integrator:?}, sobol): true error {truth:.4}, estimated {estimated:.4}"
         );
-        assert!(estimated / truth > 1.2, "{name}: estimated {estimated}, true {truth}");
+        assert!(estimated / truth > bound, "{name}: estimated {estimated}, true {truth}");
     }
 }
 

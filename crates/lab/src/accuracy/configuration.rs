@@ -161,8 +161,8 @@ impl Configuration {
             }
             Configuration::PathUniformWavelengths => {
                 "the path tracer with camera wavelengths uniform over 360-830 nm \
-                 (settings.camera_wavelengths \"uniform\") instead of the visible density: the \
-                 camera side's wavelength strategy"
+                 (settings.camera_wavelengths \"uniform\") instead of the visible density, with \
+                 independent sampling: the camera side's wavelength strategy, the peer of `path`"
             }
             Configuration::BdptBeam => {
                 "bidirectional path tracing with one wavelength per sample, the beam's \
@@ -174,15 +174,16 @@ impl Configuration {
 
     /// The sampler the configuration sets (`settings.sampler`; `None`: as written, which
     /// `auto` resolves per estimator): Sobol for the `*sobol` configurations, independent
-    /// sampling for `path` and `bdpt`, their peers.
+    /// sampling for `path`, `bdpt` and their peers `bdpt_beam` and `path_uniform_wavelengths`.
     pub fn sampler(self) -> Option<SamplerKind> {
         match self {
             Configuration::Sobol | Configuration::PathSobol | Configuration::BdptSobol => {
                 Some(SamplerKind::Sobol)
             }
-            Configuration::Path | Configuration::Bdpt | Configuration::BdptBeam => {
-                Some(SamplerKind::Independent)
-            }
+            Configuration::Path
+            | Configuration::Bdpt
+            | Configuration::BdptBeam
+            | Configuration::PathUniformWavelengths => Some(SamplerKind::Independent),
             _ => None,
         }
     }

@@ -115,7 +115,7 @@ use serde::{Deserialize, Serialize};
 use spectrace_lights::LightSource;
 use spectrace_spectrum::SpectralPowerDistribution;
 
-use super::common::SampleLayout;
+use super::common::{CameraSamples, SampleLayout};
 use super::pass::{PassEstimator, pixel_of};
 use crate::{
     CameraWavelengths, ChunkSampler, Effects, HERO, LightTracerScene, SceneFeatures, Splat,
@@ -312,16 +312,17 @@ impl<'a> Bdpt<'a> {
         stats: &mut TraceStats,
     ) {
         let scene = self.scene;
+        // The camera sample's uniforms come first, as in the path tracer: the pixel point takes
+        // Sobol dimensions 0 and 1 (the best stratified pair) and the hero wavelength a fixed
+        // dimension, whatever the beam draws after them.
+        let camera_u = CameraSamples::draw(&self.camera_layout, rng);
         let beam = LightSource::next_beam(scene.lights, rng);
-        // Drawn after the beam, so that the beam keeps the first Sobol dimensions, as in one-
-        // wavelength mode (drawn first, it cost sky's Sobol gain a third of its error ratio).
-        let hero_u = self.hero.then(|| spectrace_sampling::uniform(rng));
-        let wl = self.wavelengths(beam.lambda, hero_u);
+        let wl = self.wavelengths(beam.lambda, self.hero.then_some(camera_u.wavelength));
         let camera_strategies = Self::camera_strategies(&beam, &wl);
         let Some(light) = self.light_end(beam.parent, &wl) else { return };
         self.light_subpath(&beam, &light, &wl, rng, buffers, stats);
         if camera_strategies {
-            self.camera_subpath(px, py, &wl, rng, buffers, stats);
+            self.camera_subpath((px, py), &camera_u, &wl, rng, buffers, stats);
         } else {
             buffers.camera.clear();
             buffers.camera.push(Vertex::camera(scene.camera.position(), wl.lambda()));

@@ -44,18 +44,18 @@ struct Walk {
 impl Bdpt<'_> {
     /// The camera subpath of a sample of pixel `(px, py)` into `buffers.camera`: the pinhole (or
     /// a uniform point of the lens), then a random walk from a ray through a uniform point of
-    /// the pixel ([`crate::PinholeCamera::generate_ray`]).
+    /// the pixel ([`crate::PinholeCamera::generate_ray`]), from the sample's camera uniforms `u`
+    /// (drawn first in the sample).
     pub(super) fn camera_subpath(
         &self,
-        px: u32,
-        py: u32,
+        (px, py): (u32, u32),
+        u: &CameraSamples,
         wl: &Wavelengths,
         rng: &mut dyn rand::Rng,
         buffers: &mut Buffers,
         stats: &mut TraceStats,
     ) {
         let camera = self.scene.camera;
-        let u = CameraSamples::draw(&self.camera_layout, rng);
         let camera_ray = camera.generate_ray(px, py, u.film, u.lens);
         let ray = Ray { origin: camera_ray.origin, direction: camera_ray.direction };
         buffers.camera.clear();

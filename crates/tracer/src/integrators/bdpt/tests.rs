@@ -197,12 +197,12 @@ fn check_sample(
     buffers: &mut Buffers,
 ) -> Vec<(usize, usize)> {
     let mut stats = TraceStats::default();
-    let hero_u = bdpt.hero.then(|| spectrace_sampling::uniform(rng));
+    let u = CameraSamples::draw(&bdpt.camera_layout, rng);
     let beam = LightSource::next_beam(bdpt.scene.lights, rng);
-    let wl = bdpt.wavelengths(beam.lambda, hero_u);
+    let wl = bdpt.wavelengths(beam.lambda, bdpt.hero.then_some(u.wavelength));
     let end = bdpt.light_end(beam.parent, &wl).unwrap();
     bdpt.light_subpath(&beam, &end, &wl, rng, buffers, &mut stats);
-    bdpt.camera_subpath(pixel.0, pixel.1, &wl, rng, buffers, &mut stats);
+    bdpt.camera_subpath(pixel, &u, &wl, rng, buffers, &mut stats);
     let (lv, cv) = (buffers.light.clone(), buffers.camera.clone());
     let mut gave = Vec::new();
     for t in 1..=cv.len() {
