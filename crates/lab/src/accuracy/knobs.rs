@@ -94,6 +94,8 @@ pub fn apply(configuration: Configuration, scene: &mut Scene) -> Result<String, 
         if scene.settings.camera_wavelengths == CameraWavelengths::Uniform {
             return Err("the scene already draws camera wavelengths uniformly".to_owned());
         }
+        // Independent sampling, as its peer `path` (configuration.rs).
+        scene.settings.sampler = SamplerKind::Independent;
         scene.settings.camera_wavelengths = CameraWavelengths::Uniform;
         return Ok("settings.camera_wavelengths = uniform".to_owned());
     }

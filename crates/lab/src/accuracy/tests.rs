@@ -74,10 +74,14 @@ fn the_knobs_are_set_on_the_typed_scene() {
         assert_eq!(apply(c, &mut so).unwrap(), "");
         assert_eq!(so.settings.sampler, expected, "{c:?}");
     }
+    // The camera-wavelength peer of `path`: independent sampling like it, whatever the scene's.
     let mut uw = scene(TINY);
+    uw.settings.sampler = SamplerKind::Sobol;
     let c = Configuration::PathUniformWavelengths;
     assert_eq!(apply(c, &mut uw).unwrap(), "settings.camera_wavelengths = uniform");
     assert_eq!(uw.settings.camera_wavelengths, spectrace_tracer::CameraWavelengths::Uniform);
+    assert_eq!(uw.settings.sampler, SamplerKind::Independent);
+    assert_eq!(c.sampler(), Some(SamplerKind::Independent));
     assert_eq!(c.integrator(), IntegratorChoice::Path);
     assert!(apply(c, &mut uw).is_err(), "already uniform: nothing to compare");
     // BDPT's one-wavelength peer: independent sampling, beam wavelengths; refused where BDPT
