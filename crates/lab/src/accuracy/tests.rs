@@ -367,30 +367,16 @@ fn a_biased_estimator_levels_off_and_is_not_extrapolated() {
         slope_vs_time: Some(-0.5),
         ..biased.clone()
     };
-    let mut scene = SceneResult {
-        scene: "s.json".to_owned(),
-        name: "s".to_owned(),
-        width: 1,
-        height: 1,
-        effects_summary: String::new(),
-        auto_picks: IntegratorChoice::Path,
-        auto_reason: String::new(),
-        reference: ReferenceInfo {
-            integrator: IntegratorChoice::Bdpt,
-            beams: 1,
-            seed: 0,
-            seconds: 0.0,
-            cached: false,
-            file: String::new(),
-        },
-        estimate_check: None,
-        configurations: vec![
+    let mut scene = scene_result(
+        IntegratorChoice::Path,
+        1,
+        vec![
             result(Configuration::Baseline, 1.0),
             result(Configuration::Path, 4.0),
             ConfigurationResult { configuration: Configuration::Bdpt, ..biased.clone() },
             result(Configuration::Auto, 2.0),
         ],
-    };
+    );
     let (ratio, text) = auto_ratio(&scene);
     assert!(ratio.is_some_and(|r| (r - 2.0).abs() < 1e-9), "{ratio:?}");
     assert_eq!(text, "2.00 (fastest: light)");
@@ -527,28 +513,14 @@ fn a_knobs_gain_is_its_variance_over_its_peers_at_equal_paths_and_time() {
         .enumerate()
         .map(|(k, &e)| point(1 << k, 1.0, if k == 0 { e } else { e * 2f64.sqrt() }))
         .collect();
-    let mut scene = SceneResult {
-        scene: "s.json".to_owned(),
-        name: "s".to_owned(),
-        width: 1,
-        height: 1,
-        effects_summary: String::new(),
-        auto_picks: IntegratorChoice::Bdpt,
-        auto_reason: String::new(),
-        reference: ReferenceInfo {
-            integrator: IntegratorChoice::Bdpt,
-            beams: 1 << 40,
-            seed: 0,
-            seconds: 0.0,
-            cached: false,
-            file: String::new(),
-        },
-        estimate_check: None,
-        configurations: vec![
+    let mut scene = scene_result(
+        IntegratorChoice::Bdpt,
+        1 << 40,
+        vec![
             result(Configuration::Bdpt, hero.clone()),
             result(Configuration::BdptBeam, beam.clone()),
         ],
-    };
+    );
     // A reference of 2^40 paths has no noise to speak of: the last four points, ratio 1/2 in
     // pixels and colour alike; the first point (ratio 1) is left out.
     let g = gains::gain(&scene, Configuration::Bdpt, Configuration::BdptBeam).unwrap();
@@ -573,4 +545,32 @@ fn a_knobs_gain_is_its_variance_over_its_peers_at_equal_paths_and_time() {
         p.colour_rmse = 0.0;
     }
     assert!(gains::gain(&scene, Configuration::Bdpt, Configuration::BdptBeam).is_none());
+}
+
+/// A scene's results for the analysis tests: `auto` picks `auto_picks`, the reference is BDPT's
+/// at `reference_beams` paths, and `configurations` were swept.
+fn scene_result(
+    auto_picks: IntegratorChoice,
+    reference_beams: u64,
+    configurations: Vec<ConfigurationResult>,
+) -> SceneResult {
+    SceneResult {
+        scene: "s.json".to_owned(),
+        name: "s".to_owned(),
+        width: 1,
+        height: 1,
+        effects_summary: String::new(),
+        auto_picks,
+        auto_reason: String::new(),
+        reference: ReferenceInfo {
+            integrator: IntegratorChoice::Bdpt,
+            beams: reference_beams,
+            seed: 0,
+            seconds: 0.0,
+            cached: false,
+            file: String::new(),
+        },
+        estimate_check: None,
+        configurations,
+    }
 }
