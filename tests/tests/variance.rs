@@ -322,3 +322,52 @@ fn a_bad_sampler_or_wavelength_sampling_names_the_field() {
     let e = Scene::from_json(&bad, Path::new("inline.json")).unwrap_err().to_string();
     assert!(e.contains("wavelength_sampling") && e.contains("observer"), "{e}");
 }
+
+#[test]
+fn bdpt_says_how_many_wavelengths_its_samples_carried() {
+    // A point light over a diffuse plane: hero wavelengths by default, the beam's one with
+    // `settings.bdpt_wavelengths: "beam"`; the sidecar says which and why, and only for BDPT.
+    let dir = std::env::temp_dir().join(format!("spectrace-bdpt-wl-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let beam = POINT_OVER_PLANE
+        .replace(r#""lights""#, r#""settings": {"bdpt_wavelengths": "beam"}, "lights""#);
+    let cases = [
+        (POINT_OVER_PLANE, IntegratorChoice::Bdpt, Some("hero: 4 wavelengths per sample")),
+        (beam.as_str(), IntegratorChoice::Bdpt, Some("beam: one wavelength per sample")),
+        (POINT_OVER_PLANE, IntegratorChoice::Path, None),
+    ];
+    for (k, (text, integrator, expected)) in cases.into_iter().enumerate() {
+        let s = Scene::from_json(text, Path::new("inline.json")).unwrap();
+        let options = RenderOptions {
+            spp: Some(1),
+            integrator: Some(integrator),
+            out_dir: dir.join(k.to_string()),
+            threads: Some(1),
+            ..RenderOptions::default()
+        };
+        render_scene(&s, &options).unwrap();
+        let sidecar = dir.join(k.to_string()).join("inline.json");
+        let sidecar: Value =
+            serde_json::from_str(&std::fs::read_to_string(sidecar).unwrap()).unwrap();
+        let said = sidecar.get("bdpt_wavelengths").and_then(Value::as_str);
+        match expected {
+            Some(start) => {
+                let said = said.unwrap();
+                assert!(said.starts_with(start) && !said.contains("  "), "{said}");
+            }
+            None => assert!(said.is_none(), "{said:?}"),
+        }
+    }
+    assert!(
+        std::fs::read_to_string(dir.join("1/inline.json"))
+            .unwrap()
+            .contains("settings.bdpt_wavelengths"),
+        "the beam render names the setting that chose it"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+    // Any other value is an error naming the field and the accepted names.
+    let bad = POINT_OVER_PLANE
+        .replace(r#""lights""#, r#""settings": {"bdpt_wavelengths": "four"}, "lights""#);
+    let e = Scene::from_json(&bad, Path::new("inline.json")).unwrap_err().to_string();
+    assert!(e.contains("settings.bdpt_wavelengths") && e.contains("hero"), "{e}");
+}

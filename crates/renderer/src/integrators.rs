@@ -126,7 +126,8 @@ pub(crate) fn bdpt_wavelengths_text(setting: BdptWavelengths, features: &SceneFe
         (BdptWavelengths::Beam, _) => format!("{beam} (settings.bdpt_wavelengths)"),
         (BdptWavelengths::Hero, Err(why)) => format!("{beam} ({why})"),
         (BdptWavelengths::Hero, Ok(())) => format!(
-            "hero: {HERO} wavelengths per sample from the camera's density, shared by both              subpaths"
+            "hero: {HERO} wavelengths per sample from the camera's density, shared by both \
+             subpaths"
         ),
     }
 }

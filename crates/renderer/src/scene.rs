@@ -102,8 +102,9 @@ pub struct Settings {
     /// Camera samples per pixel for the camera integrators (`path`, `bdpt`); the upper limit
     /// when `time_seconds` is set.
     pub spp: u64,
-    /// How the path tracer's camera paths draw their wavelengths: `"visible"` (in proportion to
-    /// the observer's sensitivity, the default) or `"uniform"` (360-830 nm).
+    /// How the path tracer's camera paths, and BDPT's hero wavelengths, draw their
+    /// wavelengths: `"visible"` (in proportion to the observer's sensitivity, the default) or
+    /// `"uniform"` (360-830 nm).
     pub camera_wavelengths: CameraWavelengths,
     /// How many wavelengths a BDPT sample carries: `"hero"` (the default: four, drawn like
     /// the path tracer's and shared by both subpaths, wherever nothing disperses or fluoresces

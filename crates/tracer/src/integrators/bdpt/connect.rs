@@ -8,6 +8,7 @@ use super::MisVertex;
 use super::mis::{Sampled, build_mis_path, mis_weight};
 use super::vertex::{
     Lanes, LightEnd, NO_SAMPLES, Vertex, VertexKind, Wavelengths, light_normal, scaled, times,
+    useful,
 };
 use super::{Bdpt, Strategy};
 use crate::integrators::common::{
@@ -237,9 +238,4 @@ impl Bdpt<'_> {
         let value = times(times(light_side, f_camera), pt.beta);
         Some(Joined::at_pixel(value, wl, *beam_light))
     }
-}
-
-/// Whether some lane of `values` is positive and none is infinite or NaN.
-pub(super) fn useful(values: &[f64]) -> bool {
-    values.iter().all(|v| v.is_finite()) && values.iter().any(|&v| v > 0.0)
 }

@@ -6,7 +6,8 @@
 //! way of joining them, `(s, t)` with `s` light vertices and `t` camera vertices:
 //! - the light subpath starts with one beam of the light set ([`LightSource::next_beam`]): its
 //!   light `l` (chosen by power), origin, direction and (with one wavelength per sample)
-//!   wavelength `lambda` (drawn from the light's SPD), then a random walk ([`Transport::Importance`]) with Russian roulette;
+//!   wavelength `lambda` (drawn from the light's SPD), then a random walk
+//!   ([`Transport::Importance`]) with Russian roulette;
 //! - the camera subpath is a ray through a uniform point of pixel `p` from the pinhole, or from a
 //!   uniform point of a thin lens ([`crate::PinholeCamera::generate_ray`]; a pinhole draws no
 //!   lens uniforms), then a random walk ([`Transport::Radiance`]);
@@ -26,7 +27,8 @@
 //! A sample carries either [`HERO`] wavelengths or one.
 //!
 //! **Hero wavelengths** ([`BdptWavelengths::Hero`], the default, wherever
-//! [`Bdpt::hero_possible`]): one uniform, drawn first, gives four stratified wavelengths from the
+//! [`Bdpt::hero_possible`]): the camera sample's wavelength uniform (drawn first, with the pixel
+//! point) gives four stratified wavelengths from the
 //! camera's density `p` ([`CameraWavelengths::sample_hero`], as the path tracer's), shared by
 //! both subpaths. The light subpath starts from a beam of the light set (its light `l` chosen by
 //! power, `pmf(l) = Phi_l / Phi`; its origin and direction, which for a light with
@@ -281,9 +283,9 @@ impl<'a> Bdpt<'a> {
         wl.is_hero() || (beam.scale == 1.0 && wl.density > 0.0 && wl.density.is_finite())
     }
 
-    /// The sample's wavelengths: [`HERO`](HERO) of them from the observer's density when
-    /// the render carries hero wavelengths (one uniform, drawn before the beam), else the
-    /// beam's own.
+    /// The sample's wavelengths: [`HERO`] of them from the camera's density, drawn with
+    /// `hero_u` (the camera sample's wavelength uniform) when the render carries hero
+    /// wavelengths, else the beam's own.
     fn wavelengths(&self, beam_lambda: f64, hero_u: Option<f64>) -> Wavelengths {
         match hero_u {
             Some(u) => {
@@ -353,7 +355,7 @@ impl<'a> Bdpt<'a> {
                     let undo = if c.weight > 0.0 { 1.0 / c.weight } else { 0.0 };
                     c.value = vertex::scaled(c.value, undo);
                 }
-                if !connect::useful(&c.value[..wl.n]) {
+                if !vertex::useful(&c.value[..wl.n]) {
                     continue;
                 }
                 match c.raster {

@@ -7,7 +7,9 @@ use spectrace_lights::{Beam, LightSource};
 use spectrace_materials::{Incoming, ScatterKind, Transport};
 
 use super::Bdpt;
-use super::vertex::{Lanes, LightEnd, Vertex, VertexKind, Wavelengths, light_normal, scaled};
+use super::vertex::{
+    Lanes, LightEnd, Vertex, VertexKind, Wavelengths, light_normal, scaled, useful,
+};
 use crate::integrators::common::{
     CameraSamples, Direction, ScatterSamples, VertexSamples, choose_lobe, relative_throughput,
     roulette, shading_correction,
@@ -222,7 +224,7 @@ impl Bdpt<'_> {
                 let Some(survive) = roulette(relative, go.roulette, stats) else { return };
                 beta = scaled(beta, 1.0 / survive);
             }
-            if !super::connect::useful(&beta[..wl.n]) {
+            if !useful(&beta[..wl.n]) {
                 return;
             }
             ray = hit.spawn_ray(s.direction);

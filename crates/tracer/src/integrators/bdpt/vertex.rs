@@ -140,8 +140,8 @@ pub(super) struct Wavelengths {
 impl Wavelengths {
     /// The one wavelength `lambda` of a beam, drawn with density `density`.
     pub(super) fn single(lambda: f64, density: f64) -> Self {
-        let mut lambdas = [lambda; HERO];
-        lambdas[1..].fill(0.0);
+        let mut lambdas = [0.0; HERO];
+        lambdas[0] = lambda;
         let mut weights = [0.0; HERO];
         weights[0] = 1.0;
         Self { lambdas, weights, n: 1, density }
@@ -172,6 +172,11 @@ impl Wavelengths {
 /// `a * k`, lane by lane.
 pub(super) fn scaled(a: Lanes, k: f64) -> Lanes {
     a.map(|x| x * k)
+}
+
+/// Whether some lane of `values` is positive and none is infinite or NaN.
+pub(super) fn useful(values: &[f64]) -> bool {
+    values.iter().all(|v| v.is_finite()) && values.iter().any(|&v| v > 0.0)
 }
 
 /// `a * b`, lane by lane.
