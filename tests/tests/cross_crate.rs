@@ -11,6 +11,7 @@ mod measured_auto;
 mod photometry;
 mod rendering;
 mod rough_materials;
+mod time_budget;
 mod variance;
 
 use rand::SeedableRng;

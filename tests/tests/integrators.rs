@@ -137,12 +137,12 @@ const ESTIMATORS: [IntegratorChoice; 3] =
 /// probability 0.3%, one of a 16x16 row's 4 blocks with 0.06%. Between estimators (12 or 16
 /// seeds each) the difference over its combined standard error has at least about 22 degrees of
 /// freedom (Welch): beyond 5 with probability 5e-5 per block.
-const Z_BLOCK: f64 = 5.0;
+pub(crate) const Z_BLOCK: f64 = 5.0;
 
 /// Tolerance of the image mean against a closed form, in standard errors: the closed-form rows
 /// render 16 seeds, and Student's t with 15 degrees of freedom exceeds 4 with probability 0.12%
 /// (the strictest of the tests this replaces: BDPT's furnace used 4 over 6 seeds, the others 5).
-const Z_CLOSED_FORM: f64 = 4.0;
+pub(crate) const Z_CLOSED_FORM: f64 = 4.0;
 
 /// What an estimator can see of a row's scene (see the module's table).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -160,8 +160,8 @@ enum Sight {
 /// One cell of the matrix: the work per seed (beams for the light tracer, camera samples for
 /// the others: `effort / pixels` per pixel) and what the estimator sees.
 #[derive(Debug, Clone, Copy)]
-struct Cell {
-    effort: u64,
+pub(crate) struct Cell {
+    pub(crate) effort: u64,
     sight: Sight,
 }
 
@@ -171,32 +171,32 @@ const fn all(effort: u64) -> Cell {
 }
 
 /// A closed form: Y of pixel `(x, y)` of the scene's camera, in film units.
-type ClosedForm = Box<dyn Fn(&Scene, usize, usize) -> f64>;
+pub(crate) type ClosedForm = Box<dyn Fn(&Scene, usize, usize) -> f64>;
 
 /// A row of the matrix: a scene and how each estimator fares on it.
-struct Row {
-    name: &'static str,
-    scene: Scene,
+pub(crate) struct Row {
+    pub(crate) name: &'static str,
+    pub(crate) scene: Scene,
     /// The estimator the renderer picks on its own.
-    auto: IntegratorChoice,
+    pub(crate) auto: IntegratorChoice,
     /// The effects analysis' mode (`"effects": {"mode": ...}` in the scene).
-    effects: EffectsMode,
+    pub(crate) effects: EffectsMode,
     /// Y of pixel `(x, y)` in closed form, and what evaluating it may be off by (relative).
-    closed_form: Option<(ClosedForm, f64)>,
+    pub(crate) closed_form: Option<(ClosedForm, f64)>,
     /// The light tracer's, the path tracer's and BDPT's cells ([`ESTIMATORS`]' order).
-    cells: [Cell; 3],
+    pub(crate) cells: [Cell; 3],
     /// The index of the glass among the scene's shapes, for the rows with glass.
-    glass: Option<u32>,
+    pub(crate) glass: Option<u32>,
     /// Independent renders per estimator.
-    seeds: u64,
+    pub(crate) seeds: u64,
     /// Largest standard error allowed, relative to the value: the test must be sharp.
-    sharp: f64,
+    pub(crate) sharp: f64,
     /// Tolerance of the agreement of image means, in combined standard errors. 3 in the rows
     /// carried over from BDPT's unit tests (their tolerance), 4 in the others (that of the
     /// tests they replace). With 12 seeds per side the difference over its combined standard
     /// error is Student's t with about 22 degrees of freedom: beyond 3 with probability 0.7%,
     /// beyond 4 with 0.06%, per pair.
-    mean_z: f64,
+    pub(crate) mean_z: f64,
 }
 
 /// What [`check_row`] rendered: per estimator, one image per seed; and the pixels that see no
@@ -209,7 +209,7 @@ struct Renders {
 
 /// Mean and standard error over seeds of the mean Y over the pixels `keep` keeps (`None` when
 /// it keeps none).
-fn region_stats(images: &[Vec<Xyz>], keep: &[bool]) -> Option<(f64, f64)> {
+pub(crate) fn region_stats(images: &[Vec<Xyz>], keep: &[bool]) -> Option<(f64, f64)> {
     let n = keep.iter().filter(|k| **k).count();
     if n == 0 {
         return None;
@@ -226,7 +226,7 @@ fn region_stats(images: &[Vec<Xyz>], keep: &[bool]) -> Option<(f64, f64)> {
 }
 
 /// The 8x8 blocks of a `w x h` image, each as a mask restricted to `keep`.
-fn blocks(w: usize, h: usize, keep: &[bool]) -> Vec<((usize, usize), Vec<bool>)> {
+pub(crate) fn blocks(w: usize, h: usize, keep: &[bool]) -> Vec<((usize, usize), Vec<bool>)> {
     let mut out = Vec::new();
     for by in 0..h / 8 {
         for bx in 0..w / 8 {
@@ -426,7 +426,7 @@ fn effects_off(json: &str) -> String {
 }
 
 /// The lit plane ([`POINT_OVER_PLANE`]): the closed form per pixel.
-fn lit_plane() -> Row {
+pub(crate) fn lit_plane() -> Row {
     Row {
         name: "lit_plane",
         scene: scene(POINT_OVER_PLANE),
@@ -620,7 +620,7 @@ fn cornell_box() -> Row {
 /// The coloured spot with two point lights, a rectangle and a disk light: next-event estimation
 /// samples every point or spot light and chooses among the area lights by power; MIS on emission
 /// must use that choice's probability. A mix of both kinds checks it.
-fn five_lights() -> Row {
+pub(crate) fn five_lights() -> Row {
     let json = SPOT_OVER_PLANE.replace(
         r#""power": 50, "spd": {"type": "Blackbody", "kelvin": 3000}}]"#,
         r#""power": 50, "spd": {"type": "Blackbody", "kelvin": 3000}},

@@ -113,18 +113,18 @@ pub fn render_xyz(
     let effects = decide_effects(scene, Some(mode));
     scene.lights.reset_count();
     let started = Instant::now();
-    // The image by the estimator's own `image_scale` (its documented film units; the same as
+    // The image by the estimator's own normalisation (its documented film units; the same as
     // the renderer's `normalisation`).
-    let (output, scale) = with_integrator(scene, choice, effects, |tracer| {
+    let (output, image) = with_integrator(scene, choice, effects, |tracer| {
         render(tracer, &plan, &|_| {}).map(|out| {
-            let scale = tracer.image_scale(out.beams);
-            (out, scale)
+            let image = tracer.image(&out);
+            (out, image)
         })
     })
     .map_err(|e| e.to_string())?;
     let seconds = started.elapsed().as_secs_f64();
     scene.lights.reset_count();
-    Ok((output.film.to_xyz(scale), seconds, output.beams))
+    Ok((image, seconds, output.beams))
 }
 
 /// One estimator's measurement in [`integrator_benchmark`].

@@ -134,10 +134,10 @@ fn exponent(x: f64) -> i64 {
 /// done), as the EXR stores it; see the module docs for the scaling of images beyond the range of
 /// 32-bit floats.
 pub fn encode_image(output: &RenderOutput, norm: Normalisation) -> EncodedImage {
-    let Normalisation { light_power, factor } = norm;
+    let light_power = norm.light_power;
     // `into_iter().map().collect()` reuses the XYZ allocation for the RGB (same layout): the
     // conversion needs 24 bytes per pixel, plus 12 for the f32 copy.
-    let exact = output.film.to_xyz(norm.scale(output.beams));
+    let exact = norm.image(output);
     let rgb: Vec<[f64; 3]> = exact.into_iter().map(|p| p.to_linear_srgb()).collect();
     let largest =
         rgb.iter().flatten().try_fold(0.0f64, |m, &c| c.is_finite().then(|| m.max(c.abs())));
@@ -148,12 +148,11 @@ pub fn encode_image(output: &RenderOutput, norm: Normalisation) -> EncodedImage 
         return EncodedImage { rgb: to_f32(&rgb), scale_log2: 0, out_of_range_values: 0 };
     }
     drop(rgb);
-    // Recompute without overflow: the power's mantissa over the beams, then powers of two.
-    let beams = output.beams.max(1) as f64;
+    // Recompute without overflow: with the power's mantissa, then powers of two.
     let power_exp = if light_power > 0.0 { exponent(light_power) } else { 0 };
-    let base = ldexp(light_power, -power_exp) / beams * factor;
+    let mantissa = Normalisation { light_power: ldexp(light_power, -power_exp), ..norm };
     let rgb: Vec<[f64; 3]> =
-        output.film.to_xyz(base).into_iter().map(|p| p.to_linear_srgb()).collect();
+        mantissa.image(output).into_iter().map(|p| p.to_linear_srgb()).collect();
     let largest = rgb.iter().flatten().fold(0.0f64, |m, &c| m.max(c.abs()));
     if !(largest > 0.0 && largest.is_finite()) {
         return EncodedImage { rgb: to_f32(&rgb), scale_log2: 0, out_of_range_values: 0 };

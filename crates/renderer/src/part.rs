@@ -5,7 +5,8 @@
 //! anything larger than [`MAX_PART_BYTES`](crate::MAX_PART_BYTES), any claimed length beyond
 //! that limit, trailing bytes, and any value a render could not have produced (non-finite or
 //! non-positive light power, a pixel array that does not match the image size, negative pixel
-//! sums, chunks outside the plan, more beams than the chunks hold, an inconsistent effects
+//! sums, a pass layer no render of the part's kind keeps, chunks outside the plan, cut chunks
+//! not among them or not cut, beams other than the chunks hold, an inconsistent effects
 //! decision, an output name that is not a plain file name).
 
 use std::path::Path;
@@ -45,7 +46,7 @@ pub struct PartialFilm {
 }
 
 /// Current [`PartialFilm::version`].
-pub const PARTIAL_VERSION: u32 = 6;
+pub const PARTIAL_VERSION: u32 = 7;
 
 /// bincode's configuration for part files: the standard encoding, with every claimed length
 /// bounded by the file-size limit so a forged length cannot make the decoder reserve memory.
@@ -115,6 +116,16 @@ impl PartialFilm {
         }
         let out = &self.output;
         validate_film(out)?;
+        if out.film.has_pass_layer()
+            && (self.plan.time_budget.is_none()
+                || !crate::integrators::is_camera_integrator(self.integrator))
+        {
+            return bad(
+                "output.film",
+                "has a pass layer, which only a camera estimator's render with a time budget keeps"
+                    .to_owned(),
+            );
+        }
         validate_chunks(&self.plan, out)?;
         validate_moments(&self.plan, out)?;
         if !(out.seconds >= 0.0 && out.seconds.is_finite()) {
@@ -181,33 +192,24 @@ fn validate_film(out: &RenderOutput) -> Result<(), String> {
     if w == 0 || h == 0 || u64::from(w) * u64::from(h) > 1 << 25 {
         return bad("output.film", format!("size {w}x{h} is not a valid image size"));
     }
-    let pixels = out.film.to_xyz(1.0);
+    out.film.check_sums().or_else(|e| bad("output.film", e))?;
     // Shards fill no sensors, so a part's film is its pixels and nothing more.
     let extra = out.film.sensor_cells();
-    if pixels.len() as u64 != u64::from(w) * u64::from(h) || extra != 0 {
+    if extra != 0 {
         return bad(
             "output.film",
             format!(
-                "holds {} pixels, but a {w}x{h} image has {}",
-                pixels.len() + extra as usize,
+                "holds {} sums, but a {w}x{h} image has {} pixels (and a part no sensor cells)",
+                w * h + extra,
                 w * h
-            ),
-        );
-    }
-    if let Some(i) = pixels.iter().position(|p| !(p.x >= 0.0 && p.y >= 0.0 && p.z >= 0.0)) {
-        return bad(
-            "output.film",
-            format!(
-                "pixel {i} has a negative sum ({:?}): light adds, it never subtracts",
-                pixels[i]
             ),
         );
     }
     Ok(())
 }
 
-/// The chunks: strictly increasing, in the plan, and holding exactly the beams counted (at most
-/// them with a time budget, which cuts the last chunks short).
+/// The chunks: strictly increasing, in the plan; the cut ones among them, cut, and only with a
+/// time budget; and exactly the beams counted: the whole chunks' plus the cut ones' counts.
 fn validate_chunks(plan: &RenderPlan, out: &RenderOutput) -> Result<(), String> {
     let total_chunks = plan.chunks();
     if let Some(pair) = out.chunks.windows(2).find(|p| p[0] >= p[1]) {
@@ -222,14 +224,17 @@ fn validate_chunks(plan: &RenderPlan, out: &RenderOutput) -> Result<(), String> 
             format!("chunk {c} does not exist: the plan has {total_chunks} chunks"),
         );
     }
+    validate_cut(plan, out)?;
     let capacity = out
         .chunks
         .iter()
         .try_fold(0u64, |acc, &c| acc.checked_add(plan.beams_in_chunk(c)))
         .unwrap_or(u64::MAX);
-    let consistent =
-        if plan.time_budget.is_some() { out.beams <= capacity } else { out.beams == capacity };
-    if !consistent || out.stats.beams != out.beams {
+    // Every cut chunk is listed with its count, so the beams are known exactly.
+    let shortfall = out.cut.iter().fold(0u64, |sum, &(c, done)| {
+        sum.saturating_add(plan.beams_in_chunk(c).saturating_sub(done))
+    });
+    if out.beams != capacity.saturating_sub(shortfall) || out.stats.beams != out.beams {
         return bad(
             "output.beams",
             format!(
@@ -240,6 +245,36 @@ fn validate_chunks(plan: &RenderPlan, out: &RenderOutput) -> Result<(), String> 
                 out.chunks.len()
             ),
         );
+    }
+    Ok(())
+}
+
+/// The cut chunks: strictly increasing, each among the chunks and cut (at least one item, fewer
+/// than the chunk's), and only with a time budget.
+fn validate_cut(plan: &RenderPlan, out: &RenderOutput) -> Result<(), String> {
+    if out.cut.is_empty() {
+        return Ok(());
+    }
+    if plan.time_budget.is_none() {
+        return bad("output.cut", "chunks cut short without a time budget".to_owned());
+    }
+    if let Some(pair) = out.cut.windows(2).find(|p| p[0].0 >= p[1].0) {
+        return bad(
+            "output.cut",
+            format!("not strictly increasing (chunk {} then {})", pair[0].0, pair[1].0),
+        );
+    }
+    for &(c, done) in &out.cut {
+        if out.chunks.binary_search(&c).is_err() {
+            return bad("output.cut", format!("chunk {c} is not among the part's chunks"));
+        }
+        let planned = plan.beams_in_chunk(c);
+        if done == 0 || done >= planned {
+            return bad(
+                "output.cut",
+                format!("chunk {c} did {done} of its {planned} items: not a cut chunk"),
+            );
+        }
     }
     Ok(())
 }
@@ -264,22 +299,17 @@ fn validate_moments(plan: &RenderPlan, out: &RenderOutput) -> Result<(), String>
         );
     }
     // Chunks cut short by a time budget are rendered but not in the moments.
-    let cut_short_allowed = plan.time_budget.is_some();
-    let (chunks, items) = (out.chunks.len() as u64, out.beams);
-    let matches = if cut_short_allowed {
-        m.chunks() <= chunks && m.items() <= items
-    } else {
-        m.chunks() == chunks && m.items() == items
-    };
+    let cut_items = out.cut.iter().fold(0u64, |sum, &(_, done)| sum.saturating_add(done));
+    let chunks = out.chunks.len().saturating_sub(out.cut.len()) as u64;
+    let items = out.beams.saturating_sub(cut_items);
+    let matches = m.chunks() == chunks && m.items() == items;
     if !matches {
         return bad(
             "output.moments",
             format!(
-                "{} chunks of {} items, but the part rendered {} chunks of {} items",
+                "{} chunks of {} items, but the part rendered {chunks} whole chunks of {items} items",
                 m.chunks(),
-                m.items(),
-                out.chunks.len(),
-                out.beams
+                m.items()
             ),
         );
     }

@@ -2,7 +2,10 @@
 //! the normalisation that turns the film into the image.
 
 use spectrace_lights::LightSource;
-use spectrace_tracer::{Effects, EffectsMode, IntegratorChoice, RenderPlan, image_scale};
+use spectrace_spectrum::Xyz;
+use spectrace_tracer::{
+    Effects, EffectsMode, IntegratorChoice, RenderOutput, RenderPlan, camera_image, image_scale,
+};
 
 use crate::integrators::is_camera_integrator;
 use crate::{RenderError, RenderOptions, Scene};
@@ -19,7 +22,9 @@ pub fn choose_integrator(
 }
 
 /// What turns a film's exact sums into the image: `light_power * factor / items`, where the
-/// items are the work items done (see [`normalisation`]).
+/// items are the work items done (see [`normalisation`]), or for a camera render with passes
+/// cut short by a time budget, each pixel over its own sample count
+/// ([`Normalisation::image`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Normalisation {
     /// Total power of the lights (W): every integrator's film holds sums relative to it, so
@@ -28,6 +33,8 @@ pub struct Normalisation {
     /// 1 for the light tracer (items are beams, each carrying `light_power / beams`); the pixel
     /// count for camera integrators (items are camera samples: the image is the mean per pixel).
     pub factor: f64,
+    /// A camera integrator's render (its chunks are passes over the pixels).
+    pub camera: bool,
 }
 
 impl Normalisation {
@@ -36,12 +43,24 @@ impl Normalisation {
     pub fn scale(&self, items: u64) -> f64 {
         image_scale(self.light_power, items) * self.factor
     }
+
+    /// The image of a render's output, XYZ per pixel: the film times [`Normalisation::scale`]
+    /// of the items done, or for a camera render [`spectrace_tracer::camera_image`] (the same
+    /// when every pass is whole; each pixel over its own sample count when a pass was cut).
+    pub fn image(&self, output: &RenderOutput) -> Vec<Xyz> {
+        if self.camera {
+            camera_image(output, self.light_power, self.factor as u64)
+        } else {
+            output.film.to_xyz(self.scale(output.beams))
+        }
+    }
 }
 
 /// The normalisation of a render by `integrator` of an image of `pixels` pixels.
 pub fn normalisation(integrator: IntegratorChoice, light_power: f64, pixels: u64) -> Normalisation {
-    let factor = if is_camera_integrator(integrator) { pixels as f64 } else { 1.0 };
-    Normalisation { light_power, factor }
+    let camera = is_camera_integrator(integrator);
+    let factor = if camera { pixels as f64 } else { 1.0 };
+    Normalisation { light_power, factor, camera }
 }
 
 /// The normalisation of a render of `scene` by `choice`.

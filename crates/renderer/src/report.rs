@@ -45,6 +45,11 @@ pub struct RenderReport {
     pub bdpt_wavelengths: Option<String>,
     /// Beams traced.
     pub beams: u64,
+    /// Work chunks a time budget cut short (for `path` and `bdpt`, passes whose first pixels, in
+    /// the pass's order, got a sample the others did not: each pixel is normalised by its own
+    /// count).
+    #[serde(default)]
+    pub chunks_cut: u64,
     /// Wall time (s).
     pub wall_seconds: f64,
     /// Beams per second.
@@ -230,6 +235,7 @@ pub(crate) fn report(
         kernel: scalar_kernel(),
         bdpt_wavelengths: None,
         beams: output.beams,
+        chunks_cut: output.cut.len() as u64,
         wall_seconds: wall,
         beams_per_second: if wall > 0.0 { output.beams as f64 / wall } else { 0.0 },
         rejected_contributions: output.film.rejected(),

@@ -33,7 +33,7 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
     // number. The first part's film becomes the merged film.
     let mut first = read_part(first_path)?;
     let size = (first.output.film.width(), first.output.film.height());
-    check_merge_memory(size)?;
+    check_merge_memory(size, first.output.film.has_pass_layer())?;
     planned_outputs(out_dir, &first.name, &first.output_settings, None, parts, Vec::new())?;
     let mut merged = take_output(&mut first)?;
     // Which part holds each chunk: coverage is checked by chunk identity, not by count.
@@ -61,10 +61,12 @@ fn read_part(path: &Path) -> Result<PartialFilm, RenderError> {
     PartialFilm::read(path).map_err(|message| RenderError::File { path: path.to_owned(), message })
 }
 
-/// Checks that the merged film and one part of `width x height` fit in memory.
-fn check_merge_memory((w, h): (u32, u32)) -> Result<(), RenderError> {
+/// Checks that the merged film and one part of `width x height` (with or without a pass layer)
+/// fit in memory.
+fn check_merge_memory((w, h): (u32, u32), pass_layer: bool) -> Result<(), RenderError> {
     let limit = MemoryLimit::system();
-    let needed = Film::bytes_for(w, h).saturating_mul(2);
+    let film = if pass_layer { Film::bytes_with_pass_layer(w, h) } else { Film::bytes_for(w, h) };
+    let needed = film.saturating_mul(2);
     if needed > limit.bytes {
         return Err(RenderError::Options(format!(
             "merging {w}x{h} films needs {} (the merged film and one part), more than the {} \
@@ -86,6 +88,7 @@ fn take_output(part: &mut PartialFilm) -> Result<RenderOutput, RenderError> {
         beams: 0,
         seconds: 0.0,
         moments: None,
+        cut: Vec::new(),
     };
     Ok(std::mem::replace(&mut part.output, placeholder))
 }

@@ -1,9 +1,10 @@
 //! Warnings about a result that is not an error: light the chosen estimator cannot reach,
-//! sensors that miss light or are not written, a black image, contributions the film left out.
+//! sensors that miss light or are not written, a black image, pixels a time budget left without
+//! a sample, contributions the film left out.
 
-use spectrace_tracer::{IntegratorChoice, RenderOutput, RenderPlan};
+use spectrace_tracer::{IntegratorChoice, RenderOutput, RenderPlan, SampleCounts};
 
-use crate::{ProbeOutcome, Scene, SensorIntegrator};
+use crate::{Normalisation, ProbeOutcome, Scene, SensorIntegrator};
 
 /// What a user should know before a render by `choice` with `plan`: light the estimator cannot
 /// reach, and sensors that will miss light or not be written.
@@ -87,6 +88,25 @@ pub(crate) fn black_image_warning(probed: &ProbeOutcome, output: &RenderOutput) 
             "no light reached the camera: the image is black (the pre-render probe ran out of \
              time after {} paths, and none of the {} paths rendered lit a point the camera sees)",
             probed.beams, output.beams
+        )
+    })
+}
+
+/// The warning for a camera render whose time budget ran out inside its first pass, so that
+/// some pixels got no camera sample (`None` when every pixel got one, and for the light tracer).
+pub(crate) fn unsampled_warning(output: &RenderOutput, norm: Normalisation) -> Option<String> {
+    if !norm.camera || output.cut.is_empty() {
+        return None;
+    }
+    let pixels = norm.factor as u64;
+    let unsampled = SampleCounts::of(output, pixels).unsampled();
+    (unsampled > 0).then(|| {
+        format!(
+            "{unsampled} of {pixels} pixels ({:.1}%) got no camera sample: the time budget ran \
+             out inside the first pass over the image (one pass takes longer than the budget); \
+             they show only light joined to the camera from light paths (BDPT), or black. Give \
+             more time (--time) or lower the resolution",
+            100.0 * unsampled as f64 / pixels.max(1) as f64
         )
     })
 }

@@ -61,9 +61,9 @@ pub struct Written {
     pub warnings: Vec<String>,
 }
 
-/// The final image of a render: XYZ per pixel in film units.
+/// The final image of a render: XYZ per pixel in film units ([`Normalisation::image`]).
 pub fn image(output: &RenderOutput, norm: Normalisation) -> Vec<spectrace_spectrum::Xyz> {
-    output.film.to_xyz(norm.scale(output.beams))
+    norm.image(output)
 }
 
 /// Writes the EXR and PNG of a finished render (each to a temporary name, then renamed into
@@ -93,6 +93,7 @@ pub fn write_outputs(
             image.out_of_range_values, image.scale_log2
         ));
     }
+    written.warnings.extend(crate::warnings::unsampled_warning(output, numerator));
     let file_error = |path: &Path| {
         let path = path.to_owned();
         move |message| RenderError::File { path, message }

@@ -70,6 +70,7 @@ pub use integrators::bdpt::{Bdpt, BdptSettings, BdptWavelengths};
 pub use integrators::light_tracer::{
     LightTracer, LightTracerSettings, MAX_DEPTH, image_scale, trace_chunk, trace_chunk_until,
 };
+pub use integrators::pass::{SampleCounts, camera_image};
 pub use integrators::path_tracer::{PathTracer, PathTracerSettings};
 pub use integrators::sensor_path::SensorPathTracer;
 pub use integrators::{

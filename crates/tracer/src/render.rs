@@ -134,8 +134,16 @@ impl RenderPlan {
 
     /// Bytes [`render`] needs for a `width x height` image: one shared film plus one
     /// [`FilmWriter`] buffer per working thread. It does not grow with the thread count beyond
-    /// the small buffers.
+    /// the small buffers. With a time budget it counts the film's pass layer, which camera
+    /// estimators may need ([`RenderPlan::memory_bytes_with`]).
     pub fn memory_bytes(&self, width: u32, height: u32) -> u64 {
+        self.memory_bytes_with(width, height, self.time_budget.is_some())
+    }
+
+    /// Bytes [`render`] needs for a `width x height` image with (`pass_layer`) or without a
+    /// film pass layer ([`Film::with_pass_layer`]: a camera estimator's render with a time
+    /// budget).
+    pub fn memory_bytes_with(&self, width: u32, height: u32, pass_layer: bool) -> u64 {
         let threads = self.worker_threads() as u64;
         let estimate = if self.keeps_estimate() {
             let pixels = u64::from(width) * u64::from(height);
@@ -145,9 +153,12 @@ impl RenderPlan {
         } else {
             0
         };
-        Film::bytes_for(width, height)
-            .saturating_add(threads.saturating_mul(FilmWriter::BYTES))
-            .saturating_add(estimate)
+        let film = if pass_layer {
+            Film::bytes_with_pass_layer(width, height)
+        } else {
+            Film::bytes_for(width, height)
+        };
+        film.saturating_add(threads.saturating_mul(FilmWriter::BYTES)).saturating_add(estimate)
     }
 
     /// The target error this shard stops at: the image's target times `sqrt(N)` for one of `N`
@@ -164,7 +175,8 @@ impl RenderPlan {
         self.error_estimate || self.target_error.is_some()
     }
 
-    /// Checks that a `width x height` render fits in `limit`; returns the bytes it needs.
+    /// Checks that a `width x height` render fits in `limit`; returns the bytes it needs
+    /// ([`RenderPlan::memory_bytes`]).
     ///
     /// # Errors
     /// [`FilmError::TooLarge`] saying how much is needed and how much may be used.
@@ -174,7 +186,21 @@ impl RenderPlan {
         height: u32,
         limit: &MemoryLimit,
     ) -> Result<u64, FilmError> {
-        let needed = self.memory_bytes(width, height);
+        self.check_memory_with(width, height, self.time_budget.is_some(), limit)
+    }
+
+    /// [`RenderPlan::check_memory`] with or without a film pass layer.
+    ///
+    /// # Errors
+    /// As [`RenderPlan::check_memory`].
+    pub fn check_memory_with(
+        &self,
+        width: u32,
+        height: u32,
+        pass_layer: bool,
+        limit: &MemoryLimit,
+    ) -> Result<u64, FilmError> {
+        let needed = self.memory_bytes_with(width, height, pass_layer);
         if needed <= limit.bytes {
             return Ok(needed);
         }
@@ -184,8 +210,13 @@ impl RenderPlan {
             height,
             needed,
             breakdown: format!(
-                "a film of {} at 48 bytes per pixel{} and {threads} thread buffer{} of {}",
-                spectrace_geometry::human_bytes(Film::bytes_for(width, height)),
+                "a film of {} at {} bytes per pixel{} and {threads} thread buffer{} of {}",
+                spectrace_geometry::human_bytes(if pass_layer {
+                    Film::bytes_with_pass_layer(width, height)
+                } else {
+                    Film::bytes_for(width, height)
+                }),
+                if pass_layer { "96 (with a pass layer)" } else { "48" },
                 if self.keeps_estimate() {
                     ", the error estimate's moments at 72 bytes per pixel and 29 per pixel and thread"
                 } else {
@@ -220,6 +251,11 @@ pub struct RenderOutput {
     /// a time budget are left out: see [`FilmWriter::discard_chunk`]).
     #[serde(default)]
     pub moments: Option<Moments>,
+    /// The chunks a time budget cut short, sorted, each with the items it did (also listed in
+    /// `chunks`): a camera estimator's image normalises each pixel by its own sample count
+    /// from them ([`crate::camera_image`]).
+    #[serde(default)]
+    pub cut: Vec<(u64, u64)>,
 }
 
 impl RenderOutput {
@@ -245,6 +281,8 @@ impl RenderOutput {
         self.stats.merge(&other.stats);
         self.chunks.extend(&other.chunks);
         self.chunks.sort_unstable();
+        self.cut.extend(&other.cut);
+        self.cut.sort_unstable();
         self.beams += other.beams;
         self.seconds = self.seconds.max(other.seconds);
         Ok(())
@@ -308,8 +346,15 @@ pub fn render_observed(
 ) -> Result<RenderOutput, FilmError> {
     let started = Instant::now();
     let (w, h) = integrator.resolution();
-    plan.check_memory(w, h, &MemoryLimit::system())?;
-    let film = Mutex::new(Film::with_sensor_cells(w, h, integrator.sensor_cells())?);
+    // A pass cut short needs its per-pass splats apart from the per-sample ones.
+    let pass_layer = plan.time_budget.is_some() && integrator.pass_splats();
+    plan.check_memory_with(w, h, pass_layer, &MemoryLimit::system())?;
+    let cells = integrator.sensor_cells();
+    let film = Mutex::new(if pass_layer {
+        Film::with_pass_layer(w, h, cells)?
+    } else {
+        Film::with_sensor_cells(w, h, cells)?
+    });
     let moments = if plan.keeps_estimate() { Some(Mutex::new(Moments::new(w, h)?)) } else { None };
     let next = AtomicU64::new(0);
     let done = AtomicU64::new(0);
@@ -324,7 +369,7 @@ pub fn render_observed(
         let m = moments.as_ref()?.lock().unwrap_or_else(PoisonError::into_inner);
         Some(m.quick_estimate())
     };
-    let results: Mutex<Vec<(TraceStats, Vec<u64>)>> = Mutex::new(Vec::new());
+    let results: Mutex<Vec<ThreadResult>> = Mutex::new(Vec::new());
     std::thread::scope(|scope| {
         for _ in 0..plan.worker_threads() {
             scope.spawn(|| {
@@ -334,6 +379,7 @@ pub fn render_observed(
                 };
                 let mut stats = TraceStats::default();
                 let mut mine = Vec::new();
+                let mut cut = Vec::new();
                 loop {
                     // The time budget stops new claims, but the first chunk always runs.
                     if deadline.is_some_and(|d| Instant::now() >= d)
@@ -351,6 +397,7 @@ pub fn render_observed(
                     let s = integrator.render_chunk(work, &mut writer);
                     if s.beams < n {
                         writer.discard_chunk();
+                        cut.push((c, s.beams));
                     } else {
                         writer.end_chunk(s.beams);
                     }
@@ -376,7 +423,7 @@ pub fn render_observed(
                 }
                 writer.flush();
                 if let Ok(mut r) = results.lock() {
-                    r.push((stats, mine));
+                    r.push(ThreadResult { stats, chunks: mine, cut });
                 }
             });
         }
@@ -385,11 +432,14 @@ pub fn render_observed(
     let moments = moments.map(|m| m.into_inner().unwrap_or_else(PoisonError::into_inner));
     let mut stats = TraceStats::default();
     let mut rendered = Vec::new();
-    for (s, c) in results.into_inner().unwrap_or_default() {
-        stats.merge(&s);
-        rendered.extend(c);
+    let mut cut = Vec::new();
+    for r in results.into_inner().unwrap_or_default() {
+        stats.merge(&r.stats);
+        rendered.extend(r.chunks);
+        cut.extend(r.cut);
     }
     rendered.sort_unstable();
+    cut.sort_unstable();
     // Without a budget every chunk of the shard was traced whole; with one, the rendered set is
     // the chunks claimed, the last ones possibly cut short, and the beams are counted exactly.
     Ok(RenderOutput {
@@ -399,7 +449,18 @@ pub fn render_observed(
         chunks: rendered,
         seconds: started.elapsed().as_secs_f64(),
         moments,
+        cut,
     })
+}
+
+/// What one worker thread of [`render_observed`] did.
+struct ThreadResult {
+    /// Its counters.
+    stats: TraceStats,
+    /// The chunks it rendered.
+    chunks: Vec<u64>,
+    /// Those a time budget cut short, with the items each did.
+    cut: Vec<(u64, u64)>,
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@
 use spectrace_geometry::Hit;
 
 use super::LANES;
-use crate::integrators::pass::{PassEstimator, pass_items, pixel_of};
+use crate::integrators::pass::{PassEstimator, pass_items_until, pixel_of};
 use crate::integrators::path_tracer::{CameraPath, Connection, PathTracer, Shading, Vertex};
 use crate::{ChunkSampler, ChunkWork, Splat, TraceStats};
 
@@ -24,15 +24,16 @@ struct Lanes<'a> {
     queue: Vec<(usize, Connection)>,
 }
 
-/// Renders the camera samples of pass `work.chunk` (`work.items` pixels) with the batched
-/// kernel into `film`; the returned `stats.beams` counts them.
+/// Renders the camera samples of pass `work.chunk` (`work.items` pixels, or a prefix of them
+/// once `work.deadline` has passed) with the batched kernel into `film`; the returned
+/// `stats.beams` counts them.
 pub(crate) fn render_pass<'a>(
     tracer: &PathTracer<'a>,
     work: ChunkWork,
     film: &mut dyn Splat,
 ) -> TraceStats {
     let mut stats = TraceStats::default();
-    let mut items = pass_items(work.chunk, work.items, tracer.items());
+    let mut items = pass_items_until(work.chunk, work.items, tracer.items(), work.deadline);
     let mut lanes = Lanes::<'a> {
         paths: Vec::with_capacity(LANES),
         rngs: Vec::with_capacity(LANES),

@@ -9,13 +9,19 @@ use super::{ExactSum, Splat};
 
 /// A film of `width x height` pixels, each accumulating X, Y, Z exactly, followed by the cells
 /// of the scene's sensors (if any), each accumulating `[radiant, luminous, luminous^2]` the same
-/// way (see [`crate::SensorSums`]).
+/// way (see [`crate::SensorSums`]); optionally a second layer of pixel sums, the *pass layer*,
+/// for contributions normalised per pass rather than per pixel sample (see
+/// [`Film::with_pass_layer`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Film {
     pub(super) width: u32,
     pub(super) height: u32,
     /// `[X, Y, Z]` per pixel, row-major from the top-left pixel, then the sensor cells.
     pub(super) sums: Vec<[ExactSum; 3]>,
+    /// The pass layer: `[X, Y, Z]` per pixel of contributions normalised per pass (empty when
+    /// the film has none).
+    #[serde(default)]
+    pub(super) pass_sums: Vec<[ExactSum; 3]>,
     /// Contributions that were not finite or out of range (never added).
     pub(super) rejected: u64,
     /// Contributions added.
@@ -42,9 +48,53 @@ impl Film {
             width,
             height,
             sums: vec![[ExactSum::default(); 3]; n + cells as usize],
+            pass_sums: Vec::new(),
             rejected: 0,
             accepted: 0,
         })
+    }
+
+    /// An empty film with a pass layer: a second sum per pixel for the contributions a camera
+    /// estimator normalises per pass (BDPT's light paths splatted to the camera, the path
+    /// tracer's point lights seen directly), added by [`Film::add_pass`]. A pass cut short
+    /// by a time budget samples some pixels one more time than others; the pixel layer is then
+    /// normalised per pixel and the pass layer by the passes' share of work (see
+    /// [`crate::camera_image`]). Without the layer, [`Film::add_pass`] adds to the pixel, which
+    /// is the same image when every pass is whole.
+    ///
+    /// `cells` sensor cells follow the pixels, as for [`Film::with_sensor_cells`].
+    ///
+    /// # Errors
+    /// As [`Film::new`].
+    pub fn with_pass_layer(width: u32, height: u32, cells: u32) -> Result<Self, FilmError> {
+        let mut film = Self::with_sensor_cells(width, height, cells)?;
+        film.pass_sums = vec![[ExactSum::default(); 3]; film.pixels()];
+        Ok(film)
+    }
+
+    /// `true` if the film has a pass layer ([`Film::with_pass_layer`]).
+    pub fn has_pass_layer(&self) -> bool {
+        !self.pass_sums.is_empty()
+    }
+
+    /// Adds an XYZ contribution normalised per pass to pixel `(x, y)`: to the pass layer if the
+    /// film has one, else to the pixel. Rejections as [`Film::add`].
+    #[inline]
+    pub fn add_pass(&mut self, x: u32, y: u32, xyz: Xyz) -> bool {
+        match (pixel_index(x, y, self.width, self.height), xyz_to_fixed(xyz)) {
+            (Some(index), Some(fixed)) => self.add_fixed(self.pass_index(index), fixed),
+            _ => {
+                self.rejected += 1;
+                false
+            }
+        }
+    }
+
+    /// The index [`Film::add_fixed`] takes for pixel `index`'s pass-layer sum: after the pixels
+    /// and the sensor cells, or the pixel itself without a pass layer.
+    #[inline]
+    pub(super) fn pass_index(&self, index: usize) -> usize {
+        if self.has_pass_layer() { self.sums.len() + index } else { index }
     }
 
     /// The number of sensor cells after the pixels.
@@ -86,6 +136,11 @@ impl Film {
         raster_bytes(width, height, PIXEL_BYTES, std::mem::size_of::<Film>())
     }
 
+    /// Bytes a `width x height` film with a pass layer occupies: 96 per pixel plus the struct.
+    pub fn bytes_with_pass_layer(width: u32, height: u32) -> u64 {
+        raster_bytes(width, height, 2 * PIXEL_BYTES, std::mem::size_of::<Film>())
+    }
+
     /// Width in pixels.
     pub fn width(&self) -> u32 {
         self.width
@@ -110,11 +165,15 @@ impl Film {
         }
     }
 
-    /// Adds a contribution already in fixed point to pixel `index`: all three components or
-    /// none (a rejection is counted when the index is outside or a sum would overflow).
+    /// Adds a contribution already in fixed point to sum `index` (the pixels, then the sensor
+    /// cells, then the pass layer: see [`Film::pass_index`]): all three components or none (a
+    /// rejection is counted when the index is outside or a sum would overflow).
     #[inline]
     pub(super) fn add_fixed(&mut self, index: usize, fixed: [i128; 3]) -> bool {
-        let Some(pixel) = self.sums.get_mut(index) else {
+        let n = self.sums.len();
+        let slot =
+            if index < n { self.sums.get_mut(index) } else { self.pass_sums.get_mut(index - n) };
+        let Some(pixel) = slot else {
             self.rejected += 1;
             return false;
         };
@@ -135,16 +194,13 @@ impl Film {
     /// [`FilmError::SizeMismatch`] if the sizes differ.
     pub fn merge(&mut self, other: &Film) -> Result<(), FilmError> {
         same_size(self.width, self.height, (other.width, other.height))?;
-        if self.sums.len() != other.sums.len() {
-            // Same raster, different sensor cells.
-            return Err(FilmError::SizeMismatch(
-                self.width,
-                self.height,
-                other.width,
-                other.height,
-            ));
+        if self.sums.len() != other.sums.len() || self.pass_sums.len() != other.pass_sums.len() {
+            // Same raster, different sensor cells or pass layers.
+            let total = |f: &Film| (f.sums.len() + f.pass_sums.len()) as u64;
+            return Err(FilmError::LayerMismatch(total(self), total(other)));
         }
-        for (a, b) in self.sums.iter_mut().zip(&other.sums) {
+        let layers = self.sums.iter_mut().chain(self.pass_sums.iter_mut());
+        for (a, b) in layers.zip(other.sums.iter().chain(&other.pass_sums)) {
             for c in 0..3 {
                 if !a[c].merge(b[c]) {
                     self.rejected += 1;
@@ -157,13 +213,71 @@ impl Film {
     }
 
     /// The accumulated XYZ of every pixel, row-major, multiplied by `scale` (the estimator's
-    /// normalisation, e.g. `1 / beams`).
+    /// normalisation, e.g. `1 / beams`); a pixel's pass-layer sum is added to it exactly first
+    /// (the image when every pass is whole).
     pub fn to_xyz(&self, scale: f64) -> Vec<Xyz> {
+        let value = |p: &[ExactSum; 3], c: usize, q: Option<&[ExactSum; 3]>| {
+            let sum = q.map_or(p[c].0, |q| p[c].0.saturating_add(q[c].0));
+            ExactSum(sum).value() * scale
+        };
         self.sums
             .iter()
             .take(self.pixels())
-            .map(|p| Xyz::new(p[0].value() * scale, p[1].value() * scale, p[2].value() * scale))
+            .enumerate()
+            .map(|(i, p)| {
+                let q = self.pass_sums.get(i);
+                Xyz::new(value(p, 0, q), value(p, 1, q), value(p, 2, q))
+            })
             .collect()
+    }
+
+    /// The XYZ of every pixel, row-major, with each layer normalised on its own: pixel `i`'s
+    /// sum times `pixel_scale(i)` plus its pass-layer sum times `pass_scale` (a film without
+    /// a pass layer has only the first).
+    pub fn to_xyz_layers(&self, pixel_scale: impl Fn(usize) -> f64, pass_scale: f64) -> Vec<Xyz> {
+        let xyz = |p: &[ExactSum; 3], s: f64| {
+            Xyz::new(p[0].value() * s, p[1].value() * s, p[2].value() * s)
+        };
+        let none = [ExactSum::default(); 3];
+        (0..self.pixels())
+            .map(|i| {
+                let pixel = self.sums.get(i).map_or(Xyz::default(), |p| xyz(p, pixel_scale(i)));
+                pixel + xyz(self.pass_sums.get(i).unwrap_or(&none), pass_scale)
+            })
+            .collect()
+    }
+
+    /// Checks what a render always leaves: at least the pixels' sums, a pass layer of exactly
+    /// the pixels' size or none, and no negative sum (light adds, it never subtracts); for a
+    /// film read from a file.
+    ///
+    /// # Errors
+    /// What is wrong, in words.
+    pub fn check_sums(&self) -> Result<(), String> {
+        let pixels = self.pixels();
+        if self.sums.len() < pixels {
+            return Err(format!("holds {} sums for {pixels} pixels", self.sums.len()));
+        }
+        if !self.pass_sums.is_empty() && self.pass_sums.len() != pixels {
+            return Err(format!(
+                "its pass layer holds {} sums for {pixels} pixels",
+                self.pass_sums.len()
+            ));
+        }
+        let negative = |sums: &[[ExactSum; 3]]| sums.iter().position(|p| p.iter().any(|c| c.0 < 0));
+        if let Some(i) = negative(&self.sums) {
+            return Err(format!(
+                "sum {i} is negative ({:?}): light adds, it never subtracts",
+                self.sums[i].map(ExactSum::value)
+            ));
+        }
+        if let Some(i) = negative(&self.pass_sums) {
+            return Err(format!(
+                "pass-layer sum {i} is negative ({:?}): light adds, it never subtracts",
+                self.pass_sums[i].map(ExactSum::value)
+            ));
+        }
+        Ok(())
     }
 
     /// Contributions rejected (non-finite, out of range, or outside the film).
@@ -181,6 +295,11 @@ impl Splat for Film {
     #[inline]
     fn splat(&mut self, x: u32, y: u32, xyz: Xyz) -> bool {
         self.add(x, y, xyz)
+    }
+
+    #[inline]
+    fn splat_pass(&mut self, x: u32, y: u32, xyz: Xyz) -> bool {
+        self.add_pass(x, y, xyz)
     }
 
     fn splat_sensor(&mut self, cell: u32, sums: crate::SensorSums) -> bool {

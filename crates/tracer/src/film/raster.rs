@@ -14,6 +14,11 @@ pub enum FilmError {
     /// Two films of different sizes cannot be merged.
     #[error("film sizes differ: {0}x{1} vs {2}x{3}")]
     SizeMismatch(u32, u32, u32, u32),
+    /// Two films of one size with different sensor cells or pass layers cannot be merged.
+    #[error(
+        "films of one size differ in their sensor cells or pass layer ({0} and {1} sums): not parts of one render"
+    )]
+    LayerMismatch(u64, u64),
     /// A width or height of zero, or a pixel count that does not fit in memory.
     #[error(
         "film size {0}x{1} is invalid: both must be at least 1 and their product at most 2^25 (33.5 million pixels)"

@@ -16,6 +16,16 @@ pub trait Splat {
     /// (films and writers then count a rejection and add nothing).
     fn splat(&mut self, x: u32, y: u32, xyz: Xyz) -> bool;
 
+    /// Adds an XYZ contribution normalised per *pass* rather than per pixel sample to pixel
+    /// `(x, y)`: a light path splatted to the camera, or a point light seen directly, whose
+    /// estimates count the passes, not the samples of the pixel they land in. A [`Film`] with a
+    /// pass layer keeps them apart (so that a pass cut short keeps the image exact); everything
+    /// else, by default, adds them as [`splat`](Self::splat) does.
+    #[inline]
+    fn splat_pass(&mut self, x: u32, y: u32, xyz: Xyz) -> bool {
+        self.splat(x, y, xyz)
+    }
+
     /// Adds `[radiant, luminous, luminous^2]` to sensor cell `cell` (numbered over all the
     /// scene's sensors, see [`crate::SensorSet`]); same rejections as `splat`. The default, for
     /// targets without sensors, rejects.

@@ -146,9 +146,71 @@ fn sensor_cells_sum_apart_from_the_pixels_and_merge_exactly() {
 }
 
 #[test]
+fn the_pass_layer_sums_apart_from_the_pixels_and_merges_exactly() {
+    let mut direct = Film::with_pass_layer(3, 2, 1).unwrap();
+    assert!(direct.has_pass_layer() && !Film::new(3, 2).unwrap().has_pass_layer());
+    assert!(direct.add(1, 0, Xyz::new(1.0, 2.0, 3.0)));
+    assert!(direct.add_pass(1, 0, Xyz::new(0.5, 0.25, 0.125)));
+    assert!(direct.add_pass(2, 1, Xyz::new(4.0, 4.0, 4.0)));
+    assert!(!direct.add_pass(3, 0, Xyz::new(1.0, 1.0, 1.0)), "outside the film");
+    assert!(!direct.add_pass(0, 0, Xyz::new(f64::INFINITY, 1.0, 1.0)));
+    assert!(direct.add_sensor(0, [7.0, 7.0, 49.0]));
+    assert_eq!((direct.rejected(), direct.accepted()), (2, 4));
+    // Whole passes: both layers together, exactly; the sensor cell stays apart.
+    let image = direct.to_xyz(2.0);
+    assert_eq!(image[1], Xyz::new(3.0, 4.5, 6.25));
+    assert_eq!(image[5], Xyz::new(8.0, 8.0, 8.0));
+    assert_eq!(direct.sensor_sums(1.0)[0], [7.0, 7.0, 49.0]);
+    // Each layer normalised on its own.
+    let layers = direct.to_xyz_layers(|i| if i == 1 { 10.0 } else { 0.0 }, 100.0);
+    assert_eq!(layers[1], Xyz::new(60.0, 45.0, 42.5));
+    assert_eq!(layers[5], Xyz::new(400.0, 400.0, 400.0));
+    assert_eq!(layers[0], Xyz::default());
+    // A film without the layer adds per-pass contributions to the pixel: the same image.
+    let mut plain = Film::with_sensor_cells(3, 2, 1).unwrap();
+    assert!(plain.add(1, 0, Xyz::new(1.0, 2.0, 3.0)));
+    assert!(plain.add_pass(1, 0, Xyz::new(0.5, 0.25, 0.125)));
+    assert!(plain.add_pass(2, 1, Xyz::new(4.0, 4.0, 4.0)));
+    assert_eq!(plain.to_xyz(2.0), image);
+    // Through a buffered writer with the estimate's tally: bit for bit the same film, and the
+    // estimate counts a pass-layer contribution at its pixel.
+    let shared = Mutex::new(Film::with_pass_layer(3, 2, 1).unwrap());
+    let moments = Mutex::new(Moments::new(3, 2).unwrap());
+    {
+        let mut w = FilmWriter::with_moments(&shared, &moments);
+        assert!(w.splat(1, 0, Xyz::new(1.0, 2.0, 3.0)));
+        assert!(w.splat_pass(1, 0, Xyz::new(0.5, 0.25, 0.125)));
+        assert!(w.splat_pass(2, 1, Xyz::new(4.0, 4.0, 4.0)));
+        assert!(!w.splat_pass(3, 0, Xyz::new(1.0, 1.0, 1.0)));
+        assert!(!w.splat_pass(0, 0, Xyz::new(f64::INFINITY, 1.0, 1.0)));
+        assert!(w.splat_sensor(0, [7.0, 7.0, 49.0]));
+        w.end_chunk(6);
+    }
+    let shared = shared.into_inner().unwrap();
+    assert_eq!(shared, direct);
+    let mut expected = Moments::new(3, 2).unwrap();
+    expected.add_chunk([(1, [1.5, 2.25, 3.125]), (5, [4.0, 4.0, 4.0])], 6);
+    assert_eq!(moments.into_inner().unwrap(), expected);
+    // Merging needs the same layers; the same film twice doubles both.
+    assert!(matches!(plain.merge(&direct), Err(FilmError::LayerMismatch(..))));
+    let mut twice = direct.clone();
+    twice.merge(&direct).unwrap();
+    assert_eq!(twice.to_xyz(1.0)[5], Xyz::new(8.0, 8.0, 8.0));
+    assert_eq!(twice.check_sums(), Ok(()));
+    // A forged negative pass-layer sum is found.
+    let mut forged = direct.clone();
+    forged.pass_sums[4][1] = ExactSum(-1);
+    assert!(forged.check_sums().unwrap_err().contains("pass-layer sum 4"));
+    forged.pass_sums.pop();
+    assert!(forged.check_sums().unwrap_err().contains("pass layer holds 5 sums for 6 pixels"));
+}
+
+#[test]
 fn film_bytes_are_48_per_pixel() {
     let b = Film::bytes_for(8192, 4096);
     assert!((48 << 25..(48 << 25) + 1024).contains(&b), "{b}");
+    let layered = Film::bytes_with_pass_layer(8192, 4096);
+    assert!((96 << 25..(96 << 25) + 1024).contains(&layered), "{layered}");
     assert_eq!(Film::bytes_for(u32::MAX, u32::MAX), u64::MAX);
 }
 

@@ -34,6 +34,8 @@ pub struct FilmWriter<'a> {
     height: u32,
     /// Sensor cells after the pixels.
     sensor_cells: u32,
+    /// The film has a pass layer (its sums follow the sensor cells).
+    pass_layer: bool,
     entries: Vec<Entry>,
     rejected: u64,
     /// The current chunk's sums for the error estimate, if the render keeps one.
@@ -51,15 +53,16 @@ impl<'a> FilmWriter<'a> {
 
     /// A writer into `film`.
     pub fn new(film: &'a Mutex<Film>) -> Self {
-        let (width, height, sensor_cells) = {
+        let (width, height, sensor_cells, pass_layer) = {
             let f = film.lock().unwrap_or_else(PoisonError::into_inner);
-            (f.width, f.height, f.sensor_cells())
+            (f.width, f.height, f.sensor_cells(), f.has_pass_layer())
         };
         Self {
             film,
             width,
             height,
             sensor_cells,
+            pass_layer,
             entries: Vec::with_capacity(Self::CAPACITY),
             rejected: 0,
             tally: None,
@@ -106,12 +109,21 @@ impl<'a> FilmWriter<'a> {
             self.entries.sort_unstable_by_key(|e| e.0);
         }
         let mut film = self.film.lock().unwrap_or_else(PoisonError::into_inner);
+        // Pass-layer sums follow the pixels and the sensor cells; the estimate counts them at
+        // their pixel.
+        let layer_start = film.pass_index(0);
         for &(index, fixed) in &self.entries {
             // Only what the film accepts counts for the estimate.
             if film.add_fixed(index as usize, fixed)
                 && let Some(t) = &mut self.tally
             {
-                t.add(index as usize, fixed.map(fixed_to_f64));
+                let index = index as usize;
+                let pixel = if film.has_pass_layer() && index >= layer_start {
+                    index - layer_start
+                } else {
+                    index
+                };
+                t.add(pixel, fixed.map(fixed_to_f64));
             }
         }
         film.rejected += self.rejected;
@@ -121,15 +133,21 @@ impl<'a> FilmWriter<'a> {
     }
 }
 
-impl Splat for FilmWriter<'_> {
+impl FilmWriter<'_> {
+    /// Buffers a contribution to pixel `(x, y)`, at its pixel sum or (`pass`, with a pass layer)
+    /// its pass-layer sum.
     #[inline]
-    fn splat(&mut self, x: u32, y: u32, xyz: Xyz) -> bool {
+    fn push_pixel(&mut self, x: u32, y: u32, xyz: Xyz, pass: bool) -> bool {
         match (pixel_index(x, y, self.width, self.height), xyz_to_fixed(xyz)) {
             (Some(index), Some(fixed)) => {
                 if self.entries.len() >= Self::CAPACITY {
                     self.flush();
                 }
-                self.entries.push((index as u32, fixed));
+                // The pass layer follows the pixels and the sensor cells (at most 2^26 + 2^22
+                // entries in all: fits u32).
+                let pixels = self.width * self.height;
+                let offset = if pass && self.pass_layer { pixels + self.sensor_cells } else { 0 };
+                self.entries.push((index as u32 + offset, fixed));
                 true
             }
             _ => {
@@ -137,6 +155,18 @@ impl Splat for FilmWriter<'_> {
                 false
             }
         }
+    }
+}
+
+impl Splat for FilmWriter<'_> {
+    #[inline]
+    fn splat(&mut self, x: u32, y: u32, xyz: Xyz) -> bool {
+        self.push_pixel(x, y, xyz, false)
+    }
+
+    #[inline]
+    fn splat_pass(&mut self, x: u32, y: u32, xyz: Xyz) -> bool {
+        self.push_pixel(x, y, xyz, true)
     }
 
     fn splat_sensor(&mut self, cell: u32, sums: crate::SensorSums) -> bool {

@@ -70,13 +70,28 @@ pub trait Integrator: Send + Sync {
     /// into `film`, drawing every random number from the chunk's own stream, so that the result
     /// depends only on `(seed, chunk, items)`. With a `work.deadline`, may stop early once it
     /// has passed (checking the clock every few microseconds of work, between items, after at
-    /// least one item; camera estimators never cut a pass). The returned `stats.beams` is the
-    /// number of items done, which the normalisation must use.
+    /// least one item; a camera estimator's cut pass is a prefix of the pass's item order). The
+    /// returned `stats.beams` is the number of items done, which the normalisation must use.
     fn render_chunk(&self, work: ChunkWork, film: &mut dyn Splat) -> TraceStats;
 
     /// The factor that turns the film's exact sums into the image after `samples_done` work
-    /// items over the whole render (all chunks, all shards); 0 for none.
+    /// items over the whole render (all chunks, all shards); 0 for none. For a camera
+    /// estimator, the factor when every pass is whole ([`Integrator::image`] handles cut ones).
     fn image_scale(&self, samples_done: u64) -> f64;
+
+    /// `true` if chunks splat contributions normalised per pass ([`Splat::splat_pass`]): a
+    /// render whose chunks may be cut short then gives the film a pass layer
+    /// ([`crate::Film::with_pass_layer`]). `false` by default.
+    fn pass_splats(&self) -> bool {
+        false
+    }
+
+    /// The image (XYZ per pixel, row-major) of a render's output: by default the film times
+    /// [`image_scale`](Self::image_scale) of the items done; camera estimators normalise each
+    /// pixel by its own sample count ([`crate::camera_image`]).
+    fn image(&self, output: &crate::RenderOutput) -> Vec<spectrace_spectrum::Xyz> {
+        output.film.to_xyz(self.image_scale(output.beams))
+    }
 
     /// Sensor cells this integrator fills after the film's pixels (see
     /// [`crate::Film::with_sensor_cells`]); 0 (the default) when it fills none. Their sums

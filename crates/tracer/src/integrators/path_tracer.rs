@@ -547,9 +547,11 @@ impl<'a> PathTracer<'a> {
     /// point light projects into receives its intensity towards the camera times the camera's
     /// importance (a finite pixel value, as the light tracer and BDPT show it). Once per pass,
     /// exactly (the light's colour is its SPD's XYZ integral, not a sampled wavelength), or with
-    /// one lens sample per pass for a thin lens.
+    /// one lens sample per pass for a thin lens; weighted by `share`, the part of the pass done,
+    /// into the film's pass layer.
     fn splat_delta_lights(
         &self,
+        share: f64,
         rng: &mut dyn rand::Rng,
         film: &mut dyn Splat,
         stats: &mut TraceStats,
@@ -569,8 +571,8 @@ impl<'a> PathTracer<'a> {
                 continue;
             };
             // Relative to the lights' total power, as every sample of this film.
-            let value = value * light.power() / scene.lights.power() * inv_y;
-            if film.splat(seen.x, seen.y, spectrace_spectrum::xyz_of(spd.as_ref()) * value) {
+            let value = value * light.power() / scene.lights.power() * inv_y * share;
+            if film.splat_pass(seen.x, seen.y, spectrace_spectrum::xyz_of(spd.as_ref()) * value) {
                 stats.splats += 1;
             }
         }
@@ -587,8 +589,18 @@ impl PassEstimator for PathTracer<'_> {
 
     fn scratch(&self) {}
 
-    fn start_pass(&self, rng: &mut ChunkSampler, film: &mut dyn Splat, stats: &mut TraceStats) {
-        self.splat_delta_lights(rng, film, stats);
+    fn pass_splats(&self) -> bool {
+        !self.scene.delta_lights().is_empty()
+    }
+
+    fn end_pass(
+        &self,
+        share: f64,
+        rng: &mut ChunkSampler,
+        film: &mut dyn Splat,
+        stats: &mut TraceStats,
+    ) {
+        self.splat_delta_lights(share, rng, film, stats);
     }
 
     fn render_items(&self, work: ChunkWork, film: &mut dyn Splat) -> TraceStats {

@@ -115,7 +115,7 @@ use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 use spectrace_lights::LightSource;
-use spectrace_spectrum::SpectralPowerDistribution;
+use spectrace_spectrum::{SpectralPowerDistribution, Xyz};
 
 use super::common::{CameraSamples, SampleLayout};
 use super::pass::{PassEstimator, pixel_of};
@@ -363,7 +363,10 @@ impl<'a> Bdpt<'a> {
                         let k = inv_power / pixels;
                         let value = vertex::scaled(vertex::times(c.value, wl.weights), k);
                         let lambdas = if wl.is_hero() { &wl.lambdas[..] } else { &[c.lambda][..] };
-                        if film.splat_spectral(x, y, lambdas, &value[..wl.n]) {
+                        // Normalised per pass (the pass's light paths together are one
+                        // estimate of the image): the film's pass layer.
+                        let xyz = crate::spectral_xyz(lambdas, &value[..wl.n]);
+                        if xyz != Xyz::default() && film.splat_pass(x, y, xyz) {
                             stats.splats += 1;
                         }
                     }
@@ -386,6 +389,11 @@ impl PassEstimator for Bdpt<'_> {
 
     fn scene(&self) -> &LightTracerScene<'_> {
         self.scene
+    }
+
+    /// Its `t = 1` strategies splat light paths to the camera, normalised per pass.
+    fn pass_splats(&self) -> bool {
+        true
     }
 
     fn scratch(&self) -> Buffers {
