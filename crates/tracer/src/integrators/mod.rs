@@ -22,12 +22,14 @@
 //! shard split: a chunk's contributions do not depend on how many items the whole render does.
 //!
 //! Pixel samples and light splats (pbrt's `AddSample` and `AddSplat`) share this one film with
-//! their own normalisations folded into one factor: camera estimators work in *passes* (a chunk
-//! is one sample of every pixel, never cut), so a pixel sample's normalisation `1 / passes` is the
-//! same for every pixel, and BDPT divides its light splats (`t = 1`) by the pixel count, the
-//! light paths of a pass, so that `image = film x power x pixels / samples` holds for both. The
-//! light tracer's `image = film x power / beams` is the same formula with the factor 1. A film
-//! layer with per-pixel weight sums would only be needed to cut passes short.
+//! their own normalisations: camera estimators work in *passes* (a chunk is one sample of every
+//! pixel), so while every pass is whole a pixel sample's normalisation `1 / passes` is the same
+//! for every pixel, and BDPT divides its light splats (`t = 1`) by the pixel count, the light
+//! paths of a pass, so that `image = film x power x pixels / samples` holds for both. The light
+//! tracer's `image = film x power / beams` is the same formula with the factor 1. A time budget
+//! may cut a pass short; the per-pass splats then go to a layer of their own
+//! ([`crate::Film::with_pass_layer`], [`Integrator::pass_splats`]) and each pixel is divided by
+//! its own sample count ([`Integrator::image`], [`crate::camera_image`]).
 
 use std::time::Instant;
 

@@ -33,8 +33,9 @@
 //!
 //! # Work items and determinism
 //! A work item is one camera sample; a chunk is one *pass* (see `pass`): one sample of every
-//! pixel, never cut short, so every pixel has had the same number of samples and the image is
-//! the plain mean, bit-identical for any thread count or shard split.
+//! pixel (a prefix of them when a time budget cuts it short: each pixel is then normalised by
+//! its own count), so the image is each pixel's plain mean, bit-identical for any thread count
+//! or shard split.
 //!
 //! # Two kernels, one set of steps
 //! A sample is a sequence of steps: `start` (camera ray and wavelengths), then per vertex
