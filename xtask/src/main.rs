@@ -9,6 +9,8 @@
 //!   release mode.
 //! - `cargo xtask callgrind [BINARY [OUTFILE]]`: instructions per work item of every estimator,
 //!   counted by callgrind (`xtask/scripts/callgrind.sh`): the cost measure of refactors.
+//! - `cargo xtask budget [BUDGET]`: how closely the path tracer and BDPT keep a `--time` budget
+//!   when one pass takes longer (`xtask/scripts/time-budget.sh`, the Cornell box at 1600 x 1600).
 //! - `cargo xtask ci`: runs `.ci/run` itself (rustfmt, clippy, the tests, the fuzz run, the
 //!   status page), so the two can never differ.
 //! - `cargo xtask render [SCENE] [options]`: builds the renderer in release mode and renders a
@@ -106,6 +108,7 @@ fn main() -> ExitCode {
         ]),
         "ci" => ci(),
         "callgrind" => callgrind(&args[1..]),
+        "budget" => budget(&args[1..]),
         "help" | "-h" | "--help" => {
             print_help();
             ExitCode::SUCCESS
@@ -303,6 +306,7 @@ fn print_help() {
          bench    run every crate's benchmarks (release)\n  \
          ci       run .ci/run: rustfmt, clippy -D warnings, tests, fuzz, status\n  \
          callgrind [BINARY [OUT]]  instructions per work item of every estimator (valgrind)\n  \
+         budget [SECONDS]  path and bdpt render time under --time when one pass takes longer\n  \
          help     this text"
     );
 }
@@ -353,6 +357,30 @@ fn callgrind(args: &[String]) -> ExitCode {
         Ok(s) if s.success() => ExitCode::SUCCESS,
         Ok(s) => {
             eprintln!("the callgrind script failed ({s})");
+            ExitCode::FAILURE
+        }
+        Err(e) => {
+            eprintln!("could not run bash: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// `cargo xtask budget [BUDGET]`: the path tracer's and BDPT's render time under `--time BUDGET`
+/// (default 1 s) on the Cornell box at 1600 x 1600, where one pass takes longer than the budget
+/// (`xtask/scripts/time-budget.sh`, with the `spectrace` release build, built first).
+fn budget(args: &[String]) -> ExitCode {
+    let binary = match build_release(&SPECTRACE) {
+        Ok(b) => b,
+        Err(code) => return code,
+    };
+    let script = workspace_root().join("xtask/scripts/time-budget.sh");
+    let budget = args.first().map_or("1", String::as_str);
+    eprintln!("$ bash {} {} {budget}", script.display(), binary.display());
+    match Command::new("bash").arg(&script).arg(&binary).arg(budget).status() {
+        Ok(s) if s.success() => ExitCode::SUCCESS,
+        Ok(s) => {
+            eprintln!("the time-budget script failed ({s})");
             ExitCode::FAILURE
         }
         Err(e) => {
