@@ -21,7 +21,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use spectrace_tracer::{EffectsMode, IntegratorChoice, Kernel};
+use spectrace_tracer::{EffectsMode, ErrorMeasure, IntegratorChoice, Kernel};
 
 use crate::say::{say, tell};
 use crate::{RenderOptions, merge_parts, render_file};
@@ -60,10 +60,15 @@ enum Command {
         /// --target-error: at most this long).
         #[arg(long, allow_negative_numbers = true, value_parser = parse_seconds)]
         time: Option<f64>,
-        /// Render until the estimated relative RMSE of the image is at most E (0.05 = 5%;
-        /// overrides settings.target_error); --time and --beams/--spp cap it.
+        /// Render until the estimated relative error of the image (in --error-measure) is at
+        /// most E (0.05 = 5%; overrides settings.target_error); --time and --beams/--spp cap it.
         #[arg(long, value_name = "E", allow_negative_numbers = true, value_parser = parse_target_error)]
         target_error: Option<f64>,
+        /// What the estimated error and the target measure: energy (relative RMSE weighted by
+        /// energy, the default), relmse (per-pixel relative error) or mean (RMSE over the
+        /// image's mean); overrides settings.error_measure.
+        #[arg(long, value_name = "MEASURE", value_parser = parse_error_measure)]
+        error_measure: Option<ErrorMeasure>,
         /// Output directory.
         #[arg(long, default_value = "out")]
         out: PathBuf,
@@ -134,6 +139,12 @@ enum Command {
         #[arg(long, default_value = "out")]
         out: PathBuf,
     },
+}
+
+/// An error measure's name.
+fn parse_error_measure(s: &str) -> Result<ErrorMeasure, String> {
+    ErrorMeasure::from_name(s.trim())
+        .ok_or_else(|| format!("`{s}`: must be relmse, energy or mean"))
 }
 
 /// A kernel name.
@@ -348,10 +359,12 @@ where
             spp,
             integrator,
             target_error,
+            error_measure,
             kernel,
         } => {
             let options = RenderOptions {
                 kernel,
+                error_measure,
                 target_error,
                 spp,
                 integrator,

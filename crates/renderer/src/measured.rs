@@ -112,6 +112,7 @@ pub fn measure_choice(
         seed: plan.seed,
         integrators: candidates.clone(),
         fixed_rounds: None,
+        error_measure: Some(plan.error_measure),
     };
     let start = Instant::now();
     let small = pilot_scene(scene, options)?;

@@ -37,6 +37,8 @@ pub struct RenderOptions {
     pub target_error: Option<f64>,
     /// The kernel of the path tracer's camera paths (overrides `settings.kernel`).
     pub kernel: Option<Kernel>,
+    /// The error measure of the estimate and the target (overrides `settings.error_measure`).
+    pub error_measure: Option<spectrace_tracer::ErrorMeasure>,
 }
 
 /// Why a render failed.

@@ -49,6 +49,8 @@ pub struct EstimateOptions {
     /// Rounds after the first, instead of as many as fit in the pilot time: a pilot whose
     /// work does not depend on the machine's speed (for tests).
     pub fixed_rounds: Option<u64>,
+    /// The error measure of the target (`None`: the scene's `settings.error_measure`).
+    pub error_measure: Option<spectrace_tracer::ErrorMeasure>,
 }
 
 impl Default for EstimateOptions {
@@ -60,6 +62,7 @@ impl Default for EstimateOptions {
             seed: 0x5EED_0001,
             integrators: ESTIMATORS.to_vec(),
             fixed_rounds: None,
+            error_measure: None,
         }
     }
 }
@@ -164,6 +167,7 @@ fn pilot(
         threads: Some(options.threads),
         seed: Some(options.seed),
         integrator: Some(choice),
+        error_measure: options.error_measure,
         ..RenderOptions::default()
     };
     // Round 1: one chunk per thread, all at once, times a chunk.
@@ -203,7 +207,7 @@ fn pilot(
         };
         let observe = |p: &Progress| {
             if let Some(e) = p.estimate
-                && let Some(r) = e.relative_rmse
+                && let Some(r) = e.relative_error
                 && e.batches >= MIN_PILOT_CHUNKS
                 && let Ok(mut v) = live.lock()
             {
@@ -215,12 +219,15 @@ fn pilot(
         output.merge(&more).map_err(|e| RenderError::Options(e.to_string()))?;
         output.seconds = round + more.seconds;
     }
-    let estimate = output.estimate().unwrap_or(spectrace_tracer::ErrorEstimate {
-        relative_rmse: None,
-        batches: 0,
-        items: 0,
-        degrees_of_freedom: 0.0,
-    });
+    let estimate =
+        output.estimate(first.error_measure).unwrap_or(spectrace_tracer::ErrorEstimate {
+            measure: first.error_measure,
+            relative_error: None,
+            by_measure: spectrace_tracer::ByMeasure::default(),
+            batches: 0,
+            items: 0,
+            degrees_of_freedom: 0.0,
+        });
     let live = live.into_inner().unwrap_or_default();
     let slope_vs_time = fit_log_slope(&live.iter().map(|&(t, _, e)| (t, e)).collect::<Vec<_>>());
     let slope_vs_items =
@@ -234,7 +241,7 @@ fn pilot(
     let target = options.target_error;
     // How many times the pilot's work reaching the target takes.
     let factor =
-        estimate.relative_rmse.filter(|&e| e > 0.0).map(|e| (e / target).powf(-1.0 / slope_used));
+        estimate.relative_error.filter(|&e| e > 0.0).map(|e| (e / target).powf(-1.0 / slope_used));
     // A render to a target runs at least MIN_BATCHES chunks before it trusts its estimate.
     let fewest = (MIN_BATCHES * first.chunk_beams) as f64;
     let predicted_items = factor.map(|f| (output.beams as f64 * f).max(fewest));
@@ -248,7 +255,7 @@ fn pilot(
         pilot_items: output.beams,
         pilot_chunks: estimate.batches,
         pilot_seconds: seconds,
-        pilot_error: estimate.relative_rmse,
+        pilot_error: estimate.relative_error,
         measured_slope,
         slope_used,
         predicted_items,

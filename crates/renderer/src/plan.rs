@@ -141,6 +141,9 @@ fn plan_light(scene: &Scene, options: &RenderOptions) -> Result<RenderPlan, Rend
             plan.beams = u64::MAX / 2;
         }
     }
+    if let Some(m) = options.error_measure {
+        plan.error_measure = m;
+    }
     if let Some(e) = options.target_error {
         crate::check_target_error(e)
             .map_err(|m| RenderError::Options(format!("--target-error {m}")))?;

@@ -57,10 +57,10 @@ fn progress_message(
     target: Option<f64>,
     seconds: f64,
 ) -> String {
-    let Some(r) = e.relative_rmse else {
+    let Some(r) = e.relative_error else {
         return format!("error: waiting for batches ({})", e.batches);
     };
-    let mut m = format!("error {:.2}%", r * 100.0);
+    let mut m = format!("{} {:.2}%", e.measure.name(), r * 100.0);
     if !e.is_trusted() {
         m.push_str(&format!(" ({} of {} batches)", e.batches, spectrace_tracer::MIN_BATCHES));
     }

@@ -89,14 +89,26 @@ pub const PREDICTED_ERRORS: [f64; 4] = [0.10, 0.05, 0.02, 0.01];
 /// `error_estimate`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AccuracyEstimate {
-    /// Estimated relative RMSE against the converged image (over all pixels and X, Y, Z: the
-    /// accuracy report's measure); `null` with fewer than two batches or a black image.
+    /// The measure of the headline, `relative_error`: `"energy"` (the default), `"relmse"` or
+    /// `"mean"` (`settings.error_measure`, `--error-measure`).
+    pub measure: String,
+    /// Estimated relative error against the converged image in `measure`; `null` with fewer
+    /// than two batches or a black image.
+    pub relative_error: Option<f64>,
+    /// The estimate in every measure: `relmse`, `energy` and `mean`.
+    pub relative_error_by_measure: spectrace_tracer::ByMeasure,
+    /// The `energy` estimate (relative RMSE over all pixels and X, Y, Z), as before the
+    /// measures were named.
     pub relative_rmse: Option<f64>,
-    /// One-sigma relative uncertainty of that estimate itself.
+    /// One-sigma relative uncertainty of the headline estimate itself.
     pub relative_uncertainty: f64,
+    /// The headline's one-sigma interval `[low, high]` (`relative_error` times
+    /// `1 -/+ relative_uncertainty`); `null` without an estimate.
+    pub interval: Option<[f64; 2]>,
     /// Independent batches (work chunks) it comes from.
     pub batches: u64,
-    /// `true` with at least [`spectrace_tracer::MIN_BATCHES`] batches.
+    /// `true` with at least [`spectrace_tracer::MIN_BATCHES`] batches and a relative
+    /// uncertainty below [`spectrace_tracer::MAX_TRUSTED_UNCERTAINTY`] (10%).
     pub trusted: bool,
     /// The target asked for (`--target-error`, `settings.target_error`), if any.
     pub target_error: Option<f64>,
@@ -122,7 +134,7 @@ impl AccuracyEstimate {
         target: Option<f64>,
         seconds: f64,
     ) -> Self {
-        let e = estimate.relative_rmse;
+        let e = estimate.relative_error;
         let predicted_seconds = match e {
             Some(e) if e > 0.0 => PREDICTED_ERRORS
                 .iter()
@@ -132,8 +144,12 @@ impl AccuracyEstimate {
             _ => Vec::new(),
         };
         Self {
-            relative_rmse: e,
+            measure: estimate.measure.name().to_owned(),
+            relative_error: e,
+            relative_error_by_measure: estimate.by_measure,
+            relative_rmse: estimate.by_measure.energy,
             relative_uncertainty: estimate.relative_uncertainty(),
+            interval: estimate.interval().map(|(lo, hi)| [lo, hi]),
             batches: estimate.batches,
             trusted: estimate.is_trusted(),
             target_error: target,
@@ -147,20 +163,22 @@ impl AccuracyEstimate {
         }
     }
 
-    /// One line for the terminal: `error 3.2% ±0.1% (64 batches); 2%: ~41 s`.
+    /// One line for the terminal: `estimated error (relmse) 3.2% ±0.1% (64 batches); 2%
+    /// would take ~41 s in all`.
     pub fn summary(&self) -> String {
-        let Some(e) = self.relative_rmse else {
+        let Some(e) = self.relative_error else {
             return format!(
                 "error: no estimate ({} batches, need 2 and a lit image)",
                 self.batches
             );
         };
         let mut line = format!(
-            "estimated error {:.2}% ±{:.2}% ({} batches{})",
+            "estimated error ({}) {:.2}% ±{:.2}% ({} batches{})",
+            self.measure,
             e * 100.0,
             e * self.relative_uncertainty * 100.0,
             self.batches,
-            if self.trusted { "" } else { ", too few to trust" }
+            if self.trusted { "" } else { ", not yet trusted" }
         );
         if let (Some(t), Some(reached)) = (self.target_error, self.target_reached) {
             line.push_str(&format!(
@@ -240,7 +258,7 @@ pub(crate) fn report(
         beams_per_second: if wall > 0.0 { output.beams as f64 / wall } else { 0.0 },
         rejected_contributions: output.film.rejected(),
         error_estimate: output
-            .estimate()
+            .estimate(plan.error_measure)
             .map(|e| AccuracyEstimate::new(&e, plan.target_error, output.seconds)),
         stats: output.stats,
         light_power,

@@ -14,8 +14,8 @@ use spectrace_materials::Material;
 use spectrace_spectrum::Reflectance;
 use spectrace_tracer::{
     BdptSettings, BdptWavelengths, CameraWavelengths, DEFAULT_CHUNK_BEAMS, EffectsMode, Emitter,
-    IntegratorChoice, Kernel, LightTracerSettings, MAX_DEPTH, ObjectEmission, ObjectLight,
-    PathTracerSettings, PinholeCamera, RenderPlan, SamplerKind, SceneFeatures,
+    ErrorMeasure, IntegratorChoice, Kernel, LightTracerSettings, MAX_DEPTH, ObjectEmission,
+    ObjectLight, PathTracerSettings, PinholeCamera, RenderPlan, SamplerKind, SceneFeatures,
 };
 use spectrace_tracer::{IrradianceSensor, SensorSet};
 
@@ -117,9 +117,14 @@ pub struct Settings {
     /// chunk's own stream) or `"sobol"` (Owen-scrambled Sobol points, see
     /// [`spectrace_tracer::ChunkSampler`]).
     pub sampler: SamplerKind,
-    /// Render until the estimated relative RMSE of the image is at most this (e.g. `0.05`),
-    /// instead of a fixed number of beams or samples; `time_seconds` caps it.
+    /// Render until the estimated relative error of the image (in `error_measure`) is at most
+    /// this (e.g. `0.05`), instead of a fixed number of beams or samples; `time_seconds` caps
+    /// it.
     pub target_error: Option<f64>,
+    /// What "relative error" means for the estimate's headline and the target: `"energy"`
+    /// (the default), `"relmse"` (per-pixel relative error) or `"mean"` (see
+    /// [`spectrace_tracer::ErrorMeasure`]).
+    pub error_measure: ErrorMeasure,
     /// Which kernel traces the path tracer's camera paths: `"scalar"` (one path at a time, the
     /// reference and the default) or `"batched"` (many paths stage by stage); the image is the
     /// same, bit for bit.
@@ -145,6 +150,7 @@ impl Default for Settings {
             bdpt_wavelengths: BdptWavelengths::Hero,
             sampler: SamplerKind::Auto,
             target_error: None,
+            error_measure: ErrorMeasure::Energy,
             kernel: Kernel::Scalar,
         }
     }
@@ -438,6 +444,7 @@ impl Scene {
             time_budget: self.settings.time_seconds,
             error_estimate: true,
             target_error: self.settings.target_error,
+            error_measure: self.settings.error_measure,
         }
     }
 

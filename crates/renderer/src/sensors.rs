@@ -133,6 +133,7 @@ pub fn sensor_pass_path(
         time_budget: None,
         error_estimate: false,
         target_error: None,
+        error_measure: Default::default(),
     };
     let output =
         render_plan(&tracer, &plan, &|_| {}).map_err(|e| RenderError::Options(e.to_string()))?;
@@ -152,6 +153,7 @@ pub fn sensor_plan(scene: &Scene, threads: usize) -> RenderPlan {
         time_budget: None,
         error_estimate: false,
         target_error: None,
+        error_measure: Default::default(),
     }
 }
 

@@ -80,7 +80,8 @@ pub use integrators::{
 
 // The film, the render loop and its error estimate.
 pub use film::{
-    ErrorEstimate, ExactSum, Film, FilmError, FilmWriter, MAX_PIXELS, MIN_BATCHES, Moments, Splat,
+    ByMeasure, ErrorEstimate, ErrorMeasure, ExactSum, Film, FilmError, FilmWriter, MAX_PIXELS,
+    MAX_TRUSTED_UNCERTAINTY, MIN_BATCHES, Moments, RELMSE_EPSILON, Splat, relative_error,
     spectral_xyz,
 };
 pub use render::{

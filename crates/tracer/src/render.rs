@@ -6,9 +6,10 @@ use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
 
-use crate::film::moments::ChunkTally;
+use crate::film::moments::{ChunkTally, LiveEstimate};
 use crate::{
-    ChunkWork, ErrorEstimate, Film, FilmError, FilmWriter, Integrator, Moments, TraceStats,
+    ChunkWork, ErrorEstimate, ErrorMeasure, Film, FilmError, FilmWriter, Integrator, Moments,
+    TraceStats,
 };
 
 /// Beams per work chunk by default: small enough to balance threads, large enough that the
@@ -35,10 +36,15 @@ pub struct RenderPlan {
     /// 29 per pixel and thread).
     #[serde(default)]
     pub error_estimate: bool,
-    /// Stop once the estimated relative RMSE is at most this (needs [`crate::MIN_BATCHES`]
-    /// chunks; implies `error_estimate`). Chunks being traced then finish.
+    /// Stop once the estimated relative error in `error_measure` is at most this (needs a
+    /// trusted estimate, [`ErrorEstimate::is_trusted`]; implies `error_estimate`). Chunks being
+    /// traced then finish.
     #[serde(default)]
     pub target_error: Option<f64>,
+    /// The measure of the error estimate's headline and of the target
+    /// ([`ErrorMeasure::Energy`] by default).
+    #[serde(default)]
+    pub error_measure: ErrorMeasure,
 }
 
 /// Memory a render may use when the available memory cannot be read (no `/proc/meminfo`):
@@ -259,9 +265,10 @@ pub struct RenderOutput {
 }
 
 impl RenderOutput {
-    /// The estimated accuracy of the image (`None` if the plan kept no moments).
-    pub fn estimate(&self) -> Option<ErrorEstimate> {
-        self.moments.as_ref().map(Moments::estimate)
+    /// The estimated accuracy of the image with `measure` as the headline (`None` if the plan
+    /// kept no moments).
+    pub fn estimate(&self, measure: ErrorMeasure) -> Option<ErrorEstimate> {
+        self.moments.as_ref().map(|m| m.estimate(measure))
     }
 
     /// Adds another shard's output (same film size); chunks must not overlap.
@@ -296,8 +303,8 @@ pub struct Progress {
     pub items: u64,
     /// Wall time since the render started (s).
     pub seconds: f64,
-    /// The error estimate after this chunk ([`Moments::quick_estimate`], from the running
-    /// totals), if the render keeps one.
+    /// The error estimate after this chunk in the plan's measure (for `energy` from the
+    /// running totals; for the others recomputed every few chunks), if the render keeps one.
     pub estimate: Option<ErrorEstimate>,
 }
 
@@ -364,10 +371,15 @@ pub fn render_observed(
         .time_budget
         .and_then(|s| Duration::try_from_secs_f64(s.max(0.0)).ok())
         .and_then(|d| started.checked_add(d));
-    // The live estimate from the running totals, in O(1), after every chunk.
-    let live_estimate = || -> Option<ErrorEstimate> {
+    // The live estimate after every chunk, at a cost of a few pixels per item.
+    let live = Mutex::new(LiveEstimate::new(
+        plan.error_measure,
+        u64::from(w) * u64::from(h),
+        plan.chunk_beams,
+    ));
+    let live_estimate = || -> Option<(ErrorEstimate, bool)> {
         let m = moments.as_ref()?.lock().unwrap_or_else(PoisonError::into_inner);
-        Some(m.quick_estimate())
+        Some(live.lock().unwrap_or_else(PoisonError::into_inner).update(&m))
     };
     let results: Mutex<Vec<ThreadResult>> = Mutex::new(Vec::new());
     std::thread::scope(|scope| {
@@ -404,10 +416,11 @@ pub fn render_observed(
                     stats.merge(&s);
                     mine.push(c);
                     let items = done.fetch_add(s.beams, Ordering::Relaxed) + s.beams;
-                    let estimate = live_estimate();
-                    if let (Some(e), Some(target)) = (estimate, plan.shard_target_error())
+                    let live = live_estimate();
+                    let estimate = live.map(|(e, _)| e);
+                    if let (Some((e, true)), Some(target)) = (live, plan.shard_target_error())
                         && e.is_trusted()
-                        && e.relative_rmse.is_some_and(|r| r <= target)
+                        && e.relative_error.is_some_and(|r| r <= target)
                     {
                         target_reached.store(true, Ordering::Relaxed);
                     }
@@ -477,6 +490,7 @@ mod tests {
             time_budget: None,
             error_estimate: false,
             target_error: None,
+            error_measure: ErrorMeasure::default(),
         }
     }
 
@@ -606,6 +620,7 @@ mod loop_tests {
             time_budget: None,
             error_estimate: false,
             target_error: None,
+            error_measure: ErrorMeasure::default(),
         }
     }
 

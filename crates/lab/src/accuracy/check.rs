@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use spectrace_renderer::pilot::{EstimateOptions, EstimateReport, Prediction, estimate};
 use spectrace_renderer::{RenderOptions, Scene, render_in_memory};
 use spectrace_spectrum::Xyz;
-use spectrace_tracer::IntegratorChoice;
+use spectrace_tracer::{ErrorMeasure, IntegratorChoice};
 
 use super::relative_rmse;
 
@@ -62,6 +62,7 @@ pub fn estimate_check(
             target_error: ESTIMATE_TARGET,
             threads,
             seed: seed ^ 0x9170_7000,
+            error_measure: Some(ErrorMeasure::Energy),
             ..EstimateOptions::default()
         },
     )
@@ -74,12 +75,14 @@ pub fn estimate_check(
             threads: Some(threads),
             seed: Some(seed ^ 0xE571_0000),
             integrator: Some(auto),
+            // The report's measure (until it is regenerated in relmse).
+            error_measure: Some(ErrorMeasure::Energy),
             ..RenderOptions::default()
         },
     )
     .map_err(|e| e.to_string())?;
-    let estimate = render.output.estimate();
-    let estimated_error = estimate.and_then(|e| e.relative_rmse);
+    let estimate = render.output.estimate(ErrorMeasure::Energy);
+    let estimated_error = estimate.and_then(|e| e.relative_error);
     Ok(EstimateCheck {
         integrator: auto,
         target: ESTIMATE_TARGET,

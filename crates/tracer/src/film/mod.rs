@@ -10,11 +10,12 @@
 //!
 //! The module's parts: [`ExactSum`] (`exact.rs`), the [`Splat`] trait and [`spectral_xyz`]
 //! (`splat.rs`), the [`Film`] itself (`buffer.rs`), a thread's buffered [`FilmWriter`]
-//! (`writer.rs`), the chunk [`Moments`] behind the live error estimate (`moments.rs`) and the
+//! (`writer.rs`), the chunk [`Moments`] behind the live error estimate (`moments.rs`), the [`ErrorMeasure`]s it reports in (`measure.rs`) and the
 //! pixel-count and size checks every buffer shares (`raster.rs`).
 
 mod buffer;
 mod exact;
+mod measure;
 pub(crate) mod moments;
 pub(crate) mod raster;
 mod splat;
@@ -22,7 +23,8 @@ mod writer;
 
 pub use buffer::Film;
 pub use exact::ExactSum;
-pub use moments::{ErrorEstimate, MIN_BATCHES, Moments};
+pub use measure::{ByMeasure, ErrorMeasure, RELMSE_EPSILON, relative_error};
+pub use moments::{ErrorEstimate, MAX_TRUSTED_UNCERTAINTY, MIN_BATCHES, Moments};
 pub use raster::{FilmError, MAX_PIXELS};
 pub use splat::{Splat, spectral_xyz};
 pub use writer::FilmWriter;
