@@ -32,17 +32,16 @@ fn options(integrator: IntegratorChoice, effort: u64, seed: u64) -> RenderOption
     }
 }
 
-/// The true relative error of one render in `measure`, from `k` independent renders: the
-/// mean over them of each render's squared error against their mean, times `k / (k - 1)` (the
-/// mean carries `1/k` of the variance), square-rooted. Also the mean over the renders of their
-/// own estimates in that measure.
+/// The true relative error of one render in each measure ([`ErrorMeasure::ALL`]'s order), from
+/// `k` independent renders: the mean over them of each render's squared error against their
+/// mean, times `k / (k - 1)` (the mean carries `1/k` of the variance), square-rooted; beside
+/// it the mean over the renders of their own estimates in that measure.
 fn truth_and_estimate(
     s: &Scene,
     integrator: IntegratorChoice,
     effort: u64,
     k: u64,
-    measure: ErrorMeasure,
-) -> (f64, f64) {
+) -> [(f64, f64); 3] {
     let renders: Vec<_> = (0..k)
         .map(|seed| render_in_memory(s, &options(integrator, effort, 9000 + seed)).unwrap())
         .collect();
@@ -53,27 +52,31 @@ fn truth_and_estimate(
             *m += *p * (1.0 / k as f64);
         }
     }
-    let squared: f64 =
-        renders.iter().map(|r| relative_error(measure, &r.image, &mean).unwrap().powi(2)).sum();
-    let truth = (squared / (k - 1) as f64).sqrt();
-    let estimated = renders
-        .iter()
-        .map(|r| {
-            let e = r.output.estimate(measure).unwrap();
-            assert!(e.batches >= MIN_BATCHES, "{} batches", e.batches);
-            e.relative_error.unwrap()
-        })
-        .sum::<f64>()
-        / k as f64;
-    (truth, estimated)
+    ErrorMeasure::ALL.map(|measure| {
+        let squared: f64 =
+            renders.iter().map(|r| relative_error(measure, &r.image, &mean).unwrap().powi(2)).sum();
+        let truth = (squared / (k - 1) as f64).sqrt();
+        let estimated = renders
+            .iter()
+            .map(|r| {
+                let e = r.output.estimate(measure).unwrap();
+                assert!(e.batches >= MIN_BATCHES, "{} batches", e.batches);
+                e.relative_error.unwrap()
+            })
+            .sum::<f64>()
+            / k as f64;
+        (truth, estimated)
+    })
 }
 
 /// The promise at small scale: on shipped scenes with the estimator `auto` picks, the
-/// estimate is within 20% of the true error in the `energy` and `mean` measures. Eight renders of 32 samples per
-/// pixel: the truth from their spread has 7 degrees of freedom per pixel over 1,536 pixels (a
-/// few percent of noise), the estimates 31 each. Sky is BDPT with hero wavelengths (measured
-/// 0.0812 true, 0.0884 estimated in `energy`), prism BDPT with one wavelength per sample
-/// (dispersive).
+/// estimate is within 20% of the true error in the `energy` and `mean` measures. Eight
+/// renders of 32 samples per pixel: the truth from their spread has 7 degrees of freedom per
+/// pixel over 1,536 pixels (a few percent of noise), the estimates 31 each. Sky is BDPT with
+/// hero wavelengths (measured 0.0812 true, 0.0884 estimated in `energy`), prism BDPT with one
+/// wavelength per sample (dispersive). The `relmse` estimate is printed beside the truth, not
+/// asserted (it is not yet within 20% everywhere: scenes/README.md);
+/// `SPECTRACE_ESTIMATE_EFFORT=K` renders K times the samples, for measuring it at lower noise.
 #[test]
 fn the_estimate_is_within_20_percent_of_the_true_error_on_shipped_scenes() {
     for (name, integrator) in [
@@ -88,19 +91,25 @@ fn the_estimate_is_within_20_percent_of_the_true_error_on_shipped_scenes() {
         s.settings.sampler = SamplerKind::Independent;
         // 32 samples per pixel, or 32 chunks of beams.
         let effort = if integrator == IntegratorChoice::Light { 32 << 14 } else { 32 * 48 * 32 };
-        // relmse's estimate is not yet within 20% (see `spectrace_tracer::ErrorMeasure`).
-        for measure in [ErrorMeasure::Energy, ErrorMeasure::Mean] {
-            let (truth, estimated) = truth_and_estimate(&s, integrator, effort, 8, measure);
+        let effort = effort * effort_factor();
+        let results = truth_and_estimate(&s, integrator, effort, 8);
+        for (measure, (truth, estimated)) in ErrorMeasure::ALL.into_iter().zip(results) {
             let m = measure.name();
             eprintln!(
                 "{name} ({integrator:?}, {m}): true error {truth:.4}, estimated {estimated:.4}"
             );
+            // relmse's estimate is not yet within 20% everywhere (scenes/README.md).
             assert!(
-                (estimated / truth - 1.0).abs() < 0.2,
+                measure == ErrorMeasure::RelMse || (estimated / truth - 1.0).abs() < 0.2,
                 "{name} ({m}): estimated {estimated}, true {truth}"
             );
         }
     }
+}
+
+/// `SPECTRACE_ESTIMATE_EFFORT` (a whole number, default 1): the estimate test's effort factor.
+fn effort_factor() -> u64 {
+    std::env::var("SPECTRACE_ESTIMATE_EFFORT").ok().and_then(|v| v.parse().ok()).unwrap_or(1).max(1)
 }
 
 /// Under Sobol points (the camera estimators' default for fixed efforts and time budgets) a
@@ -126,8 +135,7 @@ fn under_sobol_points_the_estimate_is_an_upper_bound() {
         let mut s = small(name, 48, 32);
         s.settings.sampler = SamplerKind::Auto;
         let effort = 32 * 48 * 32;
-        let (truth, estimated) =
-            truth_and_estimate(&s, integrator, effort, 8, ErrorMeasure::Energy);
+        let (truth, estimated) = truth_and_estimate(&s, integrator, effort, 8)[1];
         eprintln!(
             "{name} ({integrator:?}, sobol): true error {truth:.4}, estimated {estimated:.4}"
         );
