@@ -335,6 +335,8 @@ fn the_estimate_command_writes_its_report() {
             "0.1".as_ref(),
             "--integrators".as_ref(),
             "light,path".as_ref(),
+            "--error-measure".as_ref(),
+            "mean".as_ref(),
             "--json".as_ref(),
             out.as_os_str(),
         ])
@@ -345,8 +347,52 @@ fn the_estimate_command_writes_its_report() {
     assert_eq!(predictions.len(), 2);
     assert!(predictions.iter().all(|p| p["predicted_seconds"].as_f64().unwrap() > 0.0));
     assert!(report["recommended"].is_string());
+    assert_eq!(report["error_measure"], "mean");
     // The JSON may not replace the scene file.
     let before = std::fs::read(&scene).unwrap();
     assert_eq!(run(&scene), std::process::ExitCode::from(2));
     assert_eq!(std::fs::read(&scene).unwrap(), before);
+}
+
+/// `settings.error_measure` and `--error-measure` choose the headline of the sidecar's
+/// estimate, which gives every measure; a bad value names the field.
+#[test]
+fn the_error_measure_is_chosen_by_the_scene_or_the_command_line() {
+    let json = crate::rendering::POINT_OVER_PLANE.trim_end().strip_suffix('}').unwrap().to_owned();
+    let with = |measure: &str| format!("{json}, \"settings\": {{\"error_measure\": {measure}}}}}");
+    let s = Scene::from_json(&with("\"relmse\""), Path::new("inline.json")).unwrap();
+    assert_eq!(s.settings.error_measure, ErrorMeasure::RelMse);
+    let out = crate::rendering::temp_dir("error-measure");
+    let render = |measure: Option<ErrorMeasure>| {
+        let options = RenderOptions {
+            beams: Some(32 * 32 * 32),
+            threads: Some(2),
+            integrator: Some(IntegratorChoice::Path),
+            error_measure: measure,
+            out_dir: out.clone(),
+            ..RenderOptions::default()
+        };
+        render_scene(&s, &options).unwrap().error_estimate.unwrap()
+    };
+    let scene_choice = render(None);
+    assert_eq!(scene_choice.measure, "relmse");
+    assert_eq!(scene_choice.relative_error, scene_choice.relative_error_by_measure.relmse);
+    let by = scene_choice.relative_error_by_measure;
+    assert!(by.relmse.is_some() && by.energy.is_some() && by.mean.is_some(), "{by:?}");
+    assert_eq!(scene_choice.relative_rmse, by.energy);
+    let [lo, hi] = scene_choice.interval.unwrap();
+    assert!(lo < scene_choice.relative_error.unwrap() && scene_choice.relative_error.unwrap() < hi);
+    let overridden = render(Some(ErrorMeasure::Mean));
+    assert_eq!(overridden.measure, "mean");
+    assert_eq!(overridden.relative_error, overridden.relative_error_by_measure.mean);
+    let e = Scene::from_json(&with("\"rmse\""), Path::new("inline.json")).unwrap_err().to_string();
+    assert!(e.contains("settings.error_measure") && e.contains("`relmse`"), "{e}");
+    let code = spectrace_renderer::cli::main_with_args([
+        "spectrace",
+        "render",
+        "scene.json",
+        "--error-measure",
+        "rmse",
+    ]);
+    assert_eq!(code, std::process::ExitCode::from(2));
 }

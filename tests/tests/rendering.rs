@@ -757,3 +757,35 @@ fn a_closed_mirror_box_keeps_the_beam_count_and_the_time_budget() {
         report.warnings
     );
 }
+
+/// A scene's `settings.beams` counts the light tracer's beams; a camera estimator rendering
+/// the default `spp` of a scene that gives beams but no spp says so, and is silent when the
+/// scene gives `spp`, the command line sets the effort, or the light tracer renders.
+#[test]
+fn a_camera_render_says_when_it_does_not_use_the_scenes_beams() {
+    let with = |settings: &str| {
+        let json = POINT_OVER_PLANE.trim_end().strip_suffix('}').unwrap().to_owned();
+        scene(&format!("{json}, \"settings\": {{{settings}}}}}"))
+    };
+    let s = with(r#""beams": 20000"#);
+    assert!(s.settings_given.beams && !s.settings_given.spp);
+    let render = |s: &Scene, integrator, beams| {
+        let options = RenderOptions {
+            integrator: Some(integrator),
+            beams,
+            threads: Some(2),
+            out_dir: temp_dir("beams-warning"),
+            ..RenderOptions::default()
+        };
+        render_scene(s, &options).unwrap().warnings
+    };
+    let warned = |w: &[String]| w.iter().any(|w| w.contains("settings.beams = 20000"));
+    let path = render(&s, IntegratorChoice::Path, None);
+    assert!(warned(&path), "{path:?}");
+    assert!(path.iter().any(|w| w.contains("settings.spp = 64 samples per pixel")), "{path:?}");
+    assert!(!warned(&render(&s, IntegratorChoice::Path, Some(4096))));
+    assert!(!warned(&render(&s, IntegratorChoice::Light, None)));
+    // A scene that gives both has said what each estimator renders.
+    let both = with(r#""beams": 20000, "spp": 64"#);
+    assert!(!warned(&render(&both, IntegratorChoice::Path, None)));
+}

@@ -111,9 +111,13 @@ enum Command {
     Estimate {
         /// The scene file (JSON; see scenes/README.md).
         scene: PathBuf,
-        /// The target relative RMSE (0.05 = 5%).
+        /// The target relative error (0.05 = 5%), in --error-measure.
         #[arg(long, value_name = "E", allow_negative_numbers = true, value_parser = parse_target_error)]
         target_error: f64,
+        /// What the target measures: energy (the default), relmse or mean; overrides
+        /// settings.error_measure.
+        #[arg(long, value_name = "MEASURE", value_parser = parse_error_measure)]
+        error_measure: Option<ErrorMeasure>,
         /// Pilot time per estimator, in seconds (the pilot renders at least 4 whole chunks).
         #[arg(long, default_value_t = crate::pilot::DEFAULT_PILOT_SECONDS, allow_negative_numbers = true, value_parser = parse_seconds)]
         pilot_seconds: f64,
@@ -279,7 +283,7 @@ fn bench(scenes: &[PathBuf], beams: u64, threads: usize) -> ExitCode {
 /// `spectrace estimate`: the pilots, a Markdown table on stdout, and optionally the JSON.
 fn estimate_command(
     scene: &std::path::Path,
-    target_error: f64,
+    (target_error, error_measure): (f64, Option<ErrorMeasure>),
     pilot_seconds: f64,
     integrators: Vec<IntegratorChoice>,
     threads: usize,
@@ -297,6 +301,7 @@ fn estimate_command(
             target_error,
             pilot_seconds,
             threads,
+            error_measure,
             ..Default::default()
         };
         if !integrators.is_empty() {
@@ -384,6 +389,7 @@ where
         Command::Estimate {
             scene,
             target_error,
+            error_measure,
             pilot_seconds,
             integrators,
             threads,
@@ -392,7 +398,7 @@ where
         } => {
             return estimate_command(
                 &scene,
-                target_error,
+                (target_error, error_measure),
                 pilot_seconds,
                 integrators,
                 threads,

@@ -74,7 +74,7 @@ pub use report::{AccuracyEstimate, PREDICTED_ERRORS, RenderReport, duration};
 pub use run::{InMemoryRender, render_file, render_in_memory, render_scene};
 pub use scene::{
     DEFAULT_SENSOR_SPP, DEFAULT_SPP, EffectsSettings, LoadOptions, Object, OutputSettings, Scene,
-    SceneError, SceneFile, SensorIntegrator, Settings, check_target_error,
+    SceneError, SceneFile, SensorIntegrator, Settings, SettingsGiven, check_target_error,
 };
 pub use sensor_output::{
     MAX_SENSOR_CELLS, SensorGrid, SensorSummary, sensor_colour, write_sensor_files,

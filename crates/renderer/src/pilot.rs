@@ -36,7 +36,7 @@ pub const DEFAULT_PILOT_SECONDS: f64 = 1.5;
 /// What `spectrace estimate` is asked.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EstimateOptions {
-    /// The target relative RMSE.
+    /// The target relative error (in `error_measure`).
     pub target_error: f64,
     /// Pilot time per estimator (s).
     pub pilot_seconds: f64,
@@ -102,8 +102,10 @@ pub struct Prediction {
 pub struct EstimateReport {
     /// The scene file.
     pub scene: String,
-    /// The target relative RMSE.
+    /// The target relative error.
     pub target_error: f64,
+    /// The measure of the target and of the pilots' errors (`"energy"`, `"relmse"`, `"mean"`).
+    pub error_measure: String,
     /// One prediction per estimator tried.
     pub predictions: Vec<Prediction>,
     /// The fastest estimator that renders everything (or, if none does, the fastest).
@@ -149,6 +151,11 @@ pub fn estimate(scene: &Scene, options: &EstimateOptions) -> Result<EstimateRepo
     Ok(EstimateReport {
         scene: scene.path.display().to_string(),
         target_error: options.target_error,
+        error_measure: options
+            .error_measure
+            .unwrap_or(scene.settings.error_measure)
+            .name()
+            .to_owned(),
         predictions,
         recommended,
         auto_picks: auto.name().to_owned(),
@@ -308,11 +315,12 @@ pub fn fit_line(points: &[(f64, f64)]) -> Option<SlopeFit> {
 /// The report as a Markdown table with a recommendation.
 pub fn markdown(report: &EstimateReport) -> String {
     let mut md = format!(
-        "{}: time to {:.2}% relative RMSE, predicted from a pilot of each estimator\n\n\
+        "{}: time to {:.2}% relative error ({}), predicted from a pilot of each estimator\n\n\
          | estimator | pilot | pilot error | slope (measured, used) | predicted time | ± (1 sigma) | misses |\n\
          |---|---|---|---|---|---|---|\n",
         report.scene,
-        report.target_error * 100.0
+        report.target_error * 100.0,
+        report.error_measure
     );
     for p in &report.predictions {
         let slope = match p.measured_slope {

@@ -69,6 +69,23 @@ pub struct Object {
     pub transform: Option<Transform>,
 }
 
+/// Which effort settings a scene file gives itself, rather than leaving them at their defaults.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SettingsGiven {
+    /// `settings.beams`.
+    pub beams: bool,
+    /// `settings.spp`.
+    pub spp: bool,
+}
+
+impl SettingsGiven {
+    /// What the scene file's JSON gives.
+    fn of(value: &serde_json::Value) -> Self {
+        let given = |key: &str| value.get("settings").and_then(|s| s.get(key)).is_some();
+        Self { beams: given("beams"), spp: given("spp") }
+    }
+}
+
 /// Render settings.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -284,6 +301,8 @@ pub struct Scene {
     pub lights: LightSet,
     /// Render settings.
     pub settings: Settings,
+    /// Which of the effort settings the scene file gives (the rest are defaults).
+    pub settings_given: SettingsGiven,
     /// Effects setting.
     pub effects: EffectsSettings,
     /// Output settings.
@@ -384,6 +403,7 @@ impl Scene {
             object_shapes,
             lights,
             settings: file.settings,
+            settings_given: SettingsGiven::of(&value),
             effects: file.effects,
             output: file.output,
             inputs: parts.inputs,

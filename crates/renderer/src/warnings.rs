@@ -25,6 +25,7 @@ pub(crate) fn render_warnings(
                 .to_owned(),
         );
     }
+    warnings.extend(beams_warning(scene, choice, plan));
     if !scene.sensors.is_empty() && plan.shard.is_some() {
         warnings.push(
             "sensors are written by unsharded renders only (merge-parts writes the image): \
@@ -33,6 +34,28 @@ pub(crate) fn render_warnings(
         );
     }
     warnings
+}
+
+/// The warning for a scene file that gives `settings.beams` but not `settings.spp` when a
+/// camera estimator renders it with a fixed effort from the scene: that effort is
+/// `settings.spp` samples per pixel (its default), not the beams asked for.
+fn beams_warning(scene: &Scene, choice: IntegratorChoice, plan: &RenderPlan) -> Option<String> {
+    let fixed = plan.time_budget.is_none() && plan.target_error.is_none();
+    let pixels = u64::from(scene.camera.width()) * u64::from(scene.camera.height());
+    let spp = plan.beams / pixels.max(1);
+    let asked = scene.settings.beams;
+    let camera = crate::integrators::is_camera_integrator(choice);
+    let given = scene.settings_given;
+    (camera && fixed && given.beams && !given.spp && spp == scene.settings.spp).then(|| {
+        format!(
+            "settings.beams = {asked} counts the light tracer's beams: {} renders \
+                 settings.spp = {spp} samples per pixel ({} paths); set settings.spp, or give \
+                 --spp or --beams on the command line (camera estimators turn --beams into \
+                 samples per pixel)",
+            choice.name(),
+            plan.beams
+        )
+    })
 }
 
 /// What a user should know about the chosen estimator: light a camera integrator cannot reach.
