@@ -8,7 +8,7 @@ use std::path::Path;
 use serde_json::Value;
 use spectrace_renderer::pilot::{EstimateOptions, estimate};
 use spectrace_renderer::{
-    PartialFilm, RenderOptions, Scene, merge_parts, render_in_memory, render_scene,
+    ErrorImage, PartialFilm, RenderOptions, Scene, merge_parts, render_in_memory, render_scene,
 };
 use spectrace_spectrum::Xyz;
 use spectrace_tracer::{ErrorMeasure, IntegratorChoice, MIN_BATCHES, SamplerKind, relative_error};
@@ -185,7 +185,7 @@ fn sidecar(path: &Path) -> Value {
 #[test]
 fn a_render_to_a_target_stops_there_and_writes_its_error_image() {
     let mut s = small("fading_spot.json", 48, 32);
-    s.output.error_image = true;
+    s.output.error_image = ErrorImage::Absolute;
     let out = crate::rendering::temp_dir("estimate-target");
     let report = render_scene(
         &s,
@@ -395,4 +395,64 @@ fn the_error_measure_is_chosen_by_the_scene_or_the_command_line() {
         "rmse",
     ]);
     assert_eq!(code, std::process::ExitCode::from(2));
+}
+
+/// The pixels of an EXR written by the renderer (`width` pixels wide), as linear RGB.
+fn read_rgb(path: &Path, width: usize) -> Vec<[f32; 3]> {
+    let image = exr::prelude::read_first_rgba_layer_from_file(
+        path,
+        |size, _| vec![[0f32; 3]; size.0 * size.1],
+        move |px: &mut Vec<[f32; 3]>, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            px[pos.y() * width + pos.x()] = [r, g, b];
+        },
+    )
+    .unwrap();
+    image.layer_data.channel_data.pixels
+}
+
+/// `output.error_image: "relative"` writes each pixel's standard error over its value (`eps`,
+/// 1% of the image's mean level, below dark pixels): the same render's absolute error image
+/// divided by its image, to f32 rounding. `true` and `"absolute"` are the same; other values
+/// are refused naming the field.
+#[test]
+fn the_relative_error_image_is_the_absolute_one_over_the_image() {
+    let mut s = small("fading_spot.json", 48, 32);
+    let out = crate::rendering::temp_dir("relative-error-image");
+    let mut render = |kind: ErrorImage, dir: &str| {
+        s.output.error_image = kind;
+        let options = RenderOptions {
+            beams: Some(32 * 48 * 32),
+            seed: Some(5),
+            threads: Some(2),
+            integrator: Some(IntegratorChoice::Path),
+            out_dir: out.join(dir),
+            ..RenderOptions::default()
+        };
+        render_scene(&s, &options).unwrap();
+        let read = |name: &str| read_rgb(&out.join(dir).join(name), 48);
+        (read("fading_spot.exr"), read("fading_spot.error.exr"))
+    };
+    let (image, absolute) = render(ErrorImage::Absolute, "absolute");
+    let (same, relative) = render(ErrorImage::Relative, "relative");
+    assert_eq!(image, same, "the same render");
+    let level = image.iter().flatten().map(|&v| f64::from(v)).sum::<f64>() / (3.0 * 1536.0);
+    let eps = 0.01 * level;
+    let mut checked = 0;
+    for ((v, a), r) in image.iter().zip(&absolute).zip(&relative) {
+        for c in 0..3 {
+            let want = f64::from(a[c]) / f64::from(v[c]).abs().max(eps);
+            assert!((f64::from(r[c]) - want).abs() <= 1e-5 * want + 1e-30, "{r:?} vs {want}");
+            checked += usize::from(a[c] > 0.0);
+        }
+    }
+    assert!(checked > 1000, "only {checked} noisy channels");
+    let json = crate::rendering::POINT_OVER_PLANE.trim_end().strip_suffix('}').unwrap();
+    let with = |value: &str| format!("{json}, \"output\": {{\"error_image\": {value}}}}}");
+    let parse = |value: &str| Scene::from_json(&with(value), Path::new("inline.json"));
+    assert_eq!(parse("true").unwrap().output.error_image, ErrorImage::Absolute);
+    assert_eq!(parse("\"absolute\"").unwrap().output.error_image, ErrorImage::Absolute);
+    assert_eq!(parse("\"relative\"").unwrap().output.error_image, ErrorImage::Relative);
+    assert_eq!(parse("false").unwrap().output.error_image, ErrorImage::Off);
+    let e = parse("\"percent\"").unwrap_err().to_string();
+    assert!(e.contains("output.error_image") && e.contains("relative"), "{e}");
 }

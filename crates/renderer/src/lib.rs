@@ -73,8 +73,9 @@ pub use probe::{PROBE_BEAMS, PROBE_SECONDS, ProbeOutcome, probe, probe_with};
 pub use report::{AccuracyEstimate, PREDICTED_ERRORS, RenderReport, duration};
 pub use run::{InMemoryRender, render_file, render_in_memory, render_scene};
 pub use scene::{
-    DEFAULT_SENSOR_SPP, DEFAULT_SPP, EffectsSettings, LoadOptions, Object, OutputSettings, Scene,
-    SceneError, SceneFile, SensorIntegrator, Settings, SettingsGiven, check_target_error,
+    DEFAULT_SENSOR_FLOOR_LUX, DEFAULT_SENSOR_SPP, DEFAULT_SPP, EffectsSettings, ErrorImage,
+    LoadOptions, Object, OutputSettings, Scene, SceneError, SceneFile, SensorIntegrator, Settings,
+    SettingsGiven, check_target_error,
 };
 pub use sensor_output::{
     MAX_SENSOR_CELLS, SensorGrid, SensorSummary, sensor_colour, write_sensor_files,
@@ -82,7 +83,7 @@ pub use sensor_output::{
 pub use sensors::{
     SensorEstimate, SensorReport, SensorSource, check_sensor_names, planned_sensor_outputs,
     sensor_grid, sensor_integrator, sensor_pass, sensor_pass_path, sensor_plan, sensor_summary,
-    write_sensors,
+    worst_cell_error, write_sensors,
 };
 pub use shard::merge_parts;
 pub use write::{Written, image, write_outputs};

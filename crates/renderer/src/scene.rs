@@ -108,6 +108,12 @@ pub struct Settings {
     pub sensor_beams: Option<u64>,
     /// Samples per sensor cell of a path-tracer sensor pass (default 64).
     pub sensor_spp: Option<u64>,
+    /// Run the sensor pass until every cell at or above `sensor_floor_lux` has a relative
+    /// standard error of at most this (e.g. `0.01`), instead of `sensor_spp` / `sensor_beams`.
+    pub sensor_target_error: Option<f64>,
+    /// The illuminance (lux) below which `sensor_target_error` does not look at a cell
+    /// (default 1 lx).
+    pub sensor_floor_lux: f64,
     /// How sensors are filled when the image is rendered by a camera integrator: `"auto"` (the
     /// default: `"path"` when every light can be sampled from a point, else `"light"`), `"path"`
     /// (the path tracer samples points on the sensors, `sensor_spp` per cell) or `"light"` (a
@@ -160,6 +166,8 @@ impl Default for Settings {
             chunk_beams: DEFAULT_CHUNK_BEAMS,
             sensor_beams: None,
             sensor_spp: None,
+            sensor_target_error: None,
+            sensor_floor_lux: DEFAULT_SENSOR_FLOOR_LUX,
             sensor_integrator: SensorIntegrator::Auto,
             integrator: IntegratorChoice::Auto,
             spp: DEFAULT_SPP,
@@ -193,6 +201,9 @@ pub const DEFAULT_SENSOR_SPP: u64 = 64;
 /// Camera samples per pixel when a scene does not say (`settings.spp`).
 pub const DEFAULT_SPP: u64 = 64;
 
+/// `settings.sensor_floor_lux` by default: cells below 1 lx do not hold up a sensor target.
+pub const DEFAULT_SENSOR_FLOOR_LUX: f64 = 1.0;
+
 /// The effects analysis' setting.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -214,14 +225,83 @@ pub struct OutputSettings {
     pub png: bool,
     /// Write the linear EXR.
     pub exr: bool,
-    /// Write `NAME.error.exr`: the standard error of every pixel of the image, per linear sRGB
-    /// channel, in the image's units.
-    pub error_image: bool,
+    /// Write `NAME.error.exr`: `true` or `"absolute"` for the standard error of every pixel of
+    /// the image, per linear sRGB channel, in the image's units; `"relative"` for it over the
+    /// pixel's value; `false` (the default) for none.
+    pub error_image: ErrorImage,
 }
 
 impl Default for OutputSettings {
     fn default() -> Self {
-        Self { name: None, exposure: 0.0, png: true, exr: true, error_image: false }
+        Self { name: None, exposure: 0.0, png: true, exr: true, error_image: ErrorImage::Off }
+    }
+}
+
+/// What `NAME.error.exr` holds (`output.error_image`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ErrorImage {
+    /// No error image (`false`).
+    #[default]
+    Off,
+    /// Each pixel's standard error in the image's units (`true` or `"absolute"`).
+    Absolute,
+    /// Each pixel's standard error over its value, `se / max(|value|, eps)` per channel, `eps`
+    /// 1% of the image's mean level (`"relative"`).
+    Relative,
+}
+
+impl ErrorImage {
+    /// Its name in scene files (`"off"`, `"absolute"`, `"relative"`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Off => "off",
+            Self::Absolute => "absolute",
+            Self::Relative => "relative",
+        }
+    }
+
+    /// `true` unless [`ErrorImage::Off`].
+    pub fn wanted(self) -> bool {
+        self != Self::Off
+    }
+}
+
+impl Serialize for ErrorImage {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        // JSON keeps the documented `false` / `true` / `"relative"`; binary formats a name.
+        match (serializer.is_human_readable(), self) {
+            (true, Self::Off) => serializer.serialize_bool(false),
+            (true, Self::Absolute) => serializer.serialize_bool(true),
+            _ => serializer.serialize_str(self.name()),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for ErrorImage {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = ErrorImage;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("true, false, \"absolute\" or \"relative\"")
+            }
+            fn visit_bool<E: serde::de::Error>(self, v: bool) -> Result<ErrorImage, E> {
+                Ok(if v { ErrorImage::Absolute } else { ErrorImage::Off })
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<ErrorImage, E> {
+                match v {
+                    "off" => Ok(ErrorImage::Off),
+                    "absolute" => Ok(ErrorImage::Absolute),
+                    "relative" => Ok(ErrorImage::Relative),
+                    _ => Err(E::invalid_value(serde::de::Unexpected::Str(v), &self)),
+                }
+            }
+        }
+        if deserializer.is_human_readable() {
+            deserializer.deserialize_any(Visitor)
+        } else {
+            deserializer.deserialize_str(Visitor)
+        }
     }
 }
 
@@ -561,6 +641,15 @@ fn check_settings(file: &SceneFile, path: &Path) -> Result<(), SceneError> {
     }
     if s.sensor_beams == Some(0) {
         return Err(error("settings.sensor_beams", "must be at least 1".to_owned()));
+    }
+    if let Some(e) = s.sensor_target_error {
+        check_target_error(e).map_err(|m| error("settings.sensor_target_error", m))?;
+    }
+    if !(s.sensor_floor_lux >= 0.0 && s.sensor_floor_lux.is_finite()) {
+        return Err(error(
+            "settings.sensor_floor_lux",
+            format!("{}: must be a finite illuminance of at least 0 lx", s.sensor_floor_lux),
+        ));
     }
     if s.chunk_beams == 0 {
         return Err(error("settings.chunk_beams", "must be at least 1".to_owned()));

@@ -54,6 +54,16 @@ pub struct SensorReport {
     /// Predicted tracing time (s) for a 1% `average_relative_error` at this speed (error falls
     /// as one over the square root of the beams).
     pub predicted_seconds_for_1_percent: Option<f64>,
+    /// The largest relative standard error of a cell at or above `settings.sensor_floor_lux`
+    /// (`null` when no cell is that bright).
+    #[serde(default)]
+    pub worst_cell_relative_error: Option<f64>,
+    /// `settings.sensor_target_error`, when the sensor pass ran to it.
+    #[serde(default)]
+    pub target_error: Option<f64>,
+    /// Whether every cell at or above the floor reached it (`null` without a target).
+    #[serde(default)]
+    pub target_reached: Option<bool>,
     /// Files written.
     pub files: Vec<String>,
 }
@@ -117,6 +127,17 @@ pub fn sensor_pass_path(
     threads: usize,
     effects: Effects,
 ) -> Result<(Film, u64, f64), RenderError> {
+    sensor_pass_path_seeded(scene, passes, threads, effects, scene.settings.seed)
+}
+
+/// [`sensor_pass_path`] with its own seed (the rounds of a pass to a target).
+fn sensor_pass_path_seeded(
+    scene: &Scene,
+    passes: u64,
+    threads: usize,
+    effects: Effects,
+    seed: u64,
+) -> Result<(Film, u64, f64), RenderError> {
     let started = Instant::now();
     let traced = tracer_scene(scene);
     let tracer = SensorPathTracer::new(
@@ -127,7 +148,7 @@ pub fn sensor_pass_path(
     let plan = RenderPlan {
         beams: passes.saturating_mul(cells),
         chunk_beams: cells,
-        seed: scene.settings.seed,
+        seed,
         threads,
         shard: None,
         time_budget: None,
@@ -218,6 +239,74 @@ pub struct SensorSource<'a> {
     pub seconds: f64,
     /// `"image beams (light tracer)"` or `"sensor pass (light tracer)"`.
     pub filled_by: &'a str,
+    /// The sensor target the pass ran to, if any.
+    pub target: Option<f64>,
+}
+
+/// The largest relative standard error of a cell of `estimate` at or above `floor_lux` (`None`
+/// when none is).
+pub fn worst_cell_error(estimate: &SensorEstimate, floor_lux: f64) -> Option<f64> {
+    let lit = estimate.grid.illuminance.iter().zip(&estimate.illuminance_errors);
+    lit.filter(|(lux, _)| **lux >= floor_lux && **lux > 0.0)
+        .map(|(lux, se)| se / lux)
+        .fold(None, |m: Option<f64>, e| Some(m.map_or(e, |m| m.max(e))))
+}
+
+/// Most work items a sensor pass to a target does: 2^20 samples per cell (path tracer) or
+/// 2^40 beams (light tracer); a pass that stops there reports its target not reached.
+const SENSOR_TARGET_CAP: [u64; 2] = [1 << 20, 1 << 40];
+
+/// The sensor pass of `kind` run until every cell at or above `settings.sensor_floor_lux` has a
+/// relative standard error of at most `target`: in rounds, each on its own seed (so the rounds'
+/// samples are independent and their films add), the first of 16 samples per cell (or 16
+/// chunks of beams), each next one sized by the worst cell's error (its square falls as one
+/// over the work), at most eight times the work so far. Returns the summed film, the work items
+/// (the `N` of [`sensor_grid`]) and the seconds.
+///
+/// # Errors
+/// As [`sensor_pass`].
+fn sensor_pass_to_target(
+    scene: &Scene,
+    light: bool,
+    target: f64,
+    threads: usize,
+    effects: Effects,
+) -> Result<(Film, u64, f64), RenderError> {
+    let started = Instant::now();
+    let first = if light { 16 * scene.settings.chunk_beams.max(1) } else { 16 };
+    let cap = SENSOR_TARGET_CAP[usize::from(light)];
+    let (mut film, mut done, mut round) = (None::<Film>, 0u64, 0u64);
+    let mut next = first;
+    loop {
+        let seed = scene.settings.seed ^ round.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        let (part, items, _) = if light {
+            let plan = RenderPlan { beams: next, seed, ..sensor_plan(scene, threads) };
+            sensor_pass(scene, &plan, effects)?
+        } else {
+            sensor_pass_path_seeded(scene, next, threads, effects, seed)?
+        };
+        match film.as_mut() {
+            None => film = Some(part),
+            Some(f) => f.merge(&part).map_err(|e| RenderError::Options(e.to_string()))?,
+        }
+        done += items;
+        round += 1;
+        let sums = film.as_ref().map(|f| f.sensor_sums(1.0)).unwrap_or_default();
+        let worst = (0..scene.sensors.sensors().len())
+            .filter_map(|i| {
+                let estimate = sensor_grid(&scene.sensors, i, &sums, scene.lights.power(), done);
+                worst_cell_error(&estimate, scene.settings.sensor_floor_lux)
+            })
+            .fold(None, |m: Option<f64>, e| Some(m.map_or(e, |m| m.max(e))));
+        let Some(worst) = worst.filter(|&w| w > target && done < cap) else { break };
+        // Error squared falls as one over the work: the total the target needs, with 10% to
+        // spare, but at most eight times the work so far (a noisy first estimate).
+        let needed = (done as f64 * (worst / target).powi(2) * 1.1).min(done as f64 * 9.0);
+        next = (needed as u64).saturating_sub(done).clamp(first, cap.saturating_sub(done).max(1));
+    }
+    let film =
+        film.ok_or_else(|| RenderError::Options("the sensor pass rendered nothing".to_owned()))?;
+    Ok((film, done, started.elapsed().as_secs_f64()))
 }
 
 /// Writes every sensor's files into `dir` and returns their sidecar figures.
@@ -232,12 +321,15 @@ pub fn write_sensors(
     let sums = source.film.sensor_sums(1.0);
     let mut reports = Vec::new();
     for index in 0..scene.sensors.sensors().len() {
+        let estimate =
+            sensor_grid(&scene.sensors, index, &sums, scene.lights.power(), source.beams);
+        let worst = worst_cell_error(&estimate, scene.settings.sensor_floor_lux);
         let SensorEstimate {
             grid,
             average_relative_error: average_error,
             median_cell_relative_error: median,
             ..
-        } = sensor_grid(&scene.sensors, index, &sums, scene.lights.power(), source.beams);
+        } = estimate;
         let files = write_sensor_files(dir, &grid, &scene.inputs).map_err(|message| {
             RenderError::File { path: dir.join(format!("{}.*", grid.name)), message }
         })?;
@@ -257,6 +349,9 @@ pub fn write_sensors(
             filled_by: source.filled_by.to_owned(),
             seconds: source.seconds,
             predicted_seconds_for_1_percent: predicted,
+            worst_cell_relative_error: worst,
+            target_error: source.target,
+            target_reached: source.target.map(|t| worst.is_none_or(|w| w <= t)),
             files: files.iter().map(|p| p.display().to_string()).collect(),
         });
     }
@@ -307,23 +402,24 @@ pub(crate) fn render_sensors(
             beams: output.beams,
             seconds: output.seconds,
             filled_by: "image beams (light tracer)",
+            target: None,
         };
         return write_sensors(scene, dir, source);
     }
-    if sensor_integrator(scene) == SensorIntegrator::Light {
-        let (film, beams, seconds) =
-            sensor_pass(scene, &sensor_plan(scene, plan.threads), effects)?;
-        let source =
-            SensorSource { film: &film, beams, seconds, filled_by: "sensor pass (light tracer)" };
-        return write_sensors(scene, dir, source);
-    }
-    let passes = scene.settings.sensor_spp.unwrap_or(DEFAULT_SENSOR_SPP);
-    let (film, beams, seconds) = sensor_pass_path(scene, passes, plan.threads, effects)?;
-    let source = SensorSource {
-        film: &film,
-        beams,
-        seconds,
-        filled_by: "points sampled on the sensor (path tracer)",
+    let light = sensor_integrator(scene) == SensorIntegrator::Light;
+    let target = scene.settings.sensor_target_error;
+    let (film, beams, seconds) = match (target, light) {
+        (Some(t), _) => sensor_pass_to_target(scene, light, t, plan.threads, effects)?,
+        (None, true) => sensor_pass(scene, &sensor_plan(scene, plan.threads), effects)?,
+        (None, false) => {
+            let passes = scene.settings.sensor_spp.unwrap_or(DEFAULT_SENSOR_SPP);
+            sensor_pass_path(scene, passes, plan.threads, effects)?
+        }
     };
-    write_sensors(scene, dir, source)
+    let filled_by = if light {
+        "sensor pass (light tracer)"
+    } else {
+        "points sampled on the sensor (path tracer)"
+    };
+    write_sensors(scene, dir, SensorSource { film: &film, beams, seconds, filled_by, target })
 }

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use spectrace_tracer::RenderOutput;
 
 use crate::{
-    Normalisation, OutputSettings, RenderError, RenderReport, check_no_input_replaced,
+    ErrorImage, Normalisation, OutputSettings, RenderError, RenderReport, check_no_input_replaced,
     check_output_name, encode_image, prepare_out_dir, write_atomically, write_exr, write_png,
 };
 
@@ -32,7 +32,7 @@ pub(crate) fn planned_outputs(
             if settings.png {
                 v.push(out_dir.join(format!("{name}.png")));
             }
-            if settings.error_image {
+            if settings.error_image.wanted() {
                 v.push(out_dir.join(format!("{name}.error.exr")));
             }
             v.push(out_dir.join(format!("{name}.json")));
@@ -112,19 +112,19 @@ pub fn write_outputs(
         .map_err(file_error(&path))?;
         written.files.push(path.display().to_string());
     }
-    if settings.error_image {
+    if settings.error_image.wanted() {
         match &output.moments {
             Some(moments) => {
                 let path = dir.join(format!("{name}.error.exr"));
                 // In the image's units and with the image's EXR scale, so the two compare
                 // pixel by pixel.
                 let factor = numerator.scale(output.beams) * 2f64.powi(image.scale_log2);
-                let rgb: Vec<[f32; 3]> = moments
-                    .standard_error_rgb(factor)
-                    .into_iter()
-                    .map(|p| p.map(|v| v.min(f64::from(f32::MAX)) as f32))
-                    .collect();
-                write_atomically(&path, |p| write_exr(p, w, h, &rgb, image.scale_log2))
+                let se = moments.standard_error_rgb(factor);
+                let (rgb, scale_log2) = match settings.error_image {
+                    ErrorImage::Relative => (relative_error_image(&se, &image.rgb), 0),
+                    _ => (to_f32_values(&se), image.scale_log2),
+                };
+                write_atomically(&path, |p| write_exr(p, w, h, &rgb, scale_log2))
                     .map_err(file_error(&path))?;
                 written.files.push(path.display().to_string());
             }
@@ -134,6 +134,24 @@ pub fn write_outputs(
         }
     }
     Ok(written)
+}
+
+/// Standard errors as the EXR's 32-bit floats (saturating at the largest).
+fn to_f32_values(se: &[[f64; 3]]) -> Vec<[f32; 3]> {
+    se.iter().map(|p| p.map(|v| v.min(f64::from(f32::MAX)) as f32)).collect()
+}
+
+/// Each pixel's standard error over its value (`rgb`, in the same units), per channel:
+/// `se / max(|value|, eps)` with `eps` 1% of the image's mean level over pixels and channels
+/// ([`spectrace_tracer::RELMSE_EPSILON`]), so that black pixels do not divide by zero.
+fn relative_error_image(se: &[[f64; 3]], rgb: &[[f32; 3]]) -> Vec<[f32; 3]> {
+    let values = 3.0 * rgb.len().max(1) as f64;
+    let level = rgb.iter().flatten().map(|&v| f64::from(v)).sum::<f64>() / values;
+    let eps = (spectrace_tracer::RELMSE_EPSILON * level).max(f64::MIN_POSITIVE);
+    se.iter()
+        .zip(rgb)
+        .map(|(s, v)| std::array::from_fn(|c| (s[c] / f64::from(v[c]).abs().max(eps)) as f32))
+        .collect()
 }
 
 pub(crate) fn write_sidecar(
