@@ -379,7 +379,8 @@ pub fn render_observed(
     ));
     let live_estimate = || -> Option<(ErrorEstimate, bool)> {
         let m = moments.as_ref()?.lock().unwrap_or_else(PoisonError::into_inner);
-        Some(live.lock().unwrap_or_else(PoisonError::into_inner).update(&m))
+        let target = plan.shard_target_error();
+        Some(live.lock().unwrap_or_else(PoisonError::into_inner).update(&m, target))
     };
     let results: Mutex<Vec<ThreadResult>> = Mutex::new(Vec::new());
     std::thread::scope(|scope| {

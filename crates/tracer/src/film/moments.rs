@@ -346,8 +346,10 @@ impl Moments {
 
 /// The live estimate of a render in a measure: the full [`Moments::estimate`] (O(pixels),
 /// with the degrees of freedom that decide whether it is trusted), redone once `every` more
-/// chunks are in, so that its cost per work item stays that of a few pixels per item (`every` =
-/// pixels over items per chunk, at least 1).
+/// chunks are in, so that its cost stays below a pixel's worth per work item (`every` = four
+/// times the pixels over the items per chunk, at least 1); and for [`ErrorMeasure::Energy`]
+/// also whenever the O(1) [`Moments::quick_estimate`] says a target may be reached, so that a
+/// render to a target stops as soon as it is.
 #[derive(Debug, Clone)]
 pub(crate) struct LiveEstimate {
     measure: ErrorMeasure,
@@ -359,14 +361,24 @@ impl LiveEstimate {
     /// The live estimate in `measure` of a `pixels`-pixel film rendered in chunks of
     /// `chunk_items` items.
     pub(crate) fn new(measure: ErrorMeasure, pixels: u64, chunk_items: u64) -> Self {
-        Self { measure, every: pixels.div_ceil(chunk_items.max(1)).max(1), last: None }
+        let every = pixels.saturating_mul(4).div_ceil(chunk_items.max(1)).max(1);
+        Self { measure, every, last: None }
     }
 
-    /// The estimate after the chunks folded into `moments` so far; `fresh` says whether it was
-    /// computed now (a target may stop the render only on a fresh one).
-    pub(crate) fn update(&mut self, moments: &Moments) -> (ErrorEstimate, bool) {
+    /// The estimate after the chunks folded into `moments` so far, with `target` the error a
+    /// render stops at (if any); `fresh` says whether it was computed now (a target may stop
+    /// the render only on a fresh one).
+    pub(crate) fn update(
+        &mut self,
+        moments: &Moments,
+        target: Option<f64>,
+    ) -> (ErrorEstimate, bool) {
+        let due = self.last.is_none_or(|e| moments.chunks() >= e.batches + self.every);
+        let may_stop = self.measure == ErrorMeasure::Energy
+            && target
+                .is_some_and(|t| moments.quick_estimate().relative_error.is_some_and(|q| q <= t));
         match self.last {
-            Some(e) if moments.chunks() < e.batches + self.every => (e, false),
+            Some(e) if !due && !may_stop => (e, false),
             _ => {
                 let e = moments.estimate(self.measure);
                 self.last = Some(e);
@@ -570,6 +582,43 @@ mod tests {
         let quick = runs[0].0.quick_estimate().relative_error.unwrap();
         assert!((quick / e.relative_error.unwrap() - 1.0).abs() < 1e-9, "{quick} vs {e:?}");
         assert!(e.degrees_of_freedom > 100.0, "{}", e.degrees_of_freedom);
+    }
+
+    #[test]
+    fn the_live_estimate_is_redone_every_few_chunks_or_when_a_target_may_be_reached() {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(3);
+        let mut m = Moments::new(4, 1).unwrap();
+        let mut chunk = |m: &mut Moments| {
+            let v: f64 = rng.random_range(0.5..1.5);
+            m.add_chunk((0..4).map(|p| (p, [v, v * (1.0 + p as f64), v])), 4);
+        };
+        // 4 pixels in chunks of 4 items: redone every 4 chunks.
+        for measure in [ErrorMeasure::RelMse, ErrorMeasure::Energy] {
+            let mut live = LiveEstimate::new(measure, 4, 4);
+            let mut fresh = Vec::new();
+            let mut m = Moments::new(4, 1).unwrap();
+            for _ in 0..10 {
+                chunk(&mut m);
+                let (e, is_fresh) = live.update(&m, None);
+                assert_eq!(e.measure, measure);
+                fresh.push(is_fresh);
+            }
+            let want = [true, false, false, false, true, false, false, false, true, false];
+            assert_eq!(fresh, want, "{}", measure.name());
+            // A fresh estimate is the full one.
+            let (e, _) = live.update(&m, None);
+            assert!(e.batches <= m.chunks());
+        }
+        // With a target the energy estimate has reached, every chunk is checked at once.
+        let mut live = LiveEstimate::new(ErrorMeasure::Energy, 4, 4);
+        for _ in 0..3 {
+            chunk(&mut m);
+        }
+        assert!(live.update(&m, Some(0.99)).1);
+        chunk(&mut m);
+        assert!(live.update(&m, Some(0.99)).1, "the quick estimate says 0.99 is reached");
+        chunk(&mut m);
+        assert!(!live.update(&m, Some(1e-9)).1, "not due, and the target is far");
     }
 
     #[test]
