@@ -249,7 +249,7 @@ pub fn worst_cell_error(estimate: &SensorEstimate, floor_lux: f64) -> Option<f64
     let lit = estimate.grid.illuminance.iter().zip(&estimate.illuminance_errors);
     lit.filter(|(lux, _)| **lux >= floor_lux && **lux > 0.0)
         .map(|(lux, se)| se / lux)
-        .fold(None, |m: Option<f64>, e| Some(m.map_or(e, |m| m.max(e))))
+        .max_by(f64::total_cmp)
 }
 
 /// Most work items a sensor pass to a target does: 2^20 samples per cell (path tracer) or
@@ -297,7 +297,7 @@ fn sensor_pass_to_target(
                 let estimate = sensor_grid(&scene.sensors, i, &sums, scene.lights.power(), done);
                 worst_cell_error(&estimate, scene.settings.sensor_floor_lux)
             })
-            .fold(None, |m: Option<f64>, e| Some(m.map_or(e, |m| m.max(e))));
+            .max_by(f64::total_cmp);
         let Some(worst) = worst.filter(|&w| w > target && done < cap) else { break };
         // Error squared falls as one over the work: the total the target needs, with 10% to
         // spare, but at most eight times the work so far (a noisy first estimate).

@@ -112,17 +112,15 @@ impl<'a> FilmWriter<'a> {
         // Pass-layer sums follow the pixels and the sensor cells; the estimate counts them at
         // their pixel.
         let layer_start = film.pass_index(0);
+        let layered = film.has_pass_layer();
         for &(index, fixed) in &self.entries {
             // Only what the film accepts counts for the estimate.
             if film.add_fixed(index as usize, fixed)
                 && let Some(t) = &mut self.tally
             {
                 let index = index as usize;
-                let pixel = if film.has_pass_layer() && index >= layer_start {
-                    index - layer_start
-                } else {
-                    index
-                };
+                let pixel =
+                    if layered && index >= layer_start { index - layer_start } else { index };
                 t.add(pixel, fixed.map(fixed_to_f64));
             }
         }
