@@ -10,7 +10,6 @@ use spectrace_renderer::pilot::{EstimateOptions, estimate};
 use spectrace_renderer::{
     ErrorImage, PartialFilm, RenderOptions, Scene, merge_parts, render_in_memory, render_scene,
 };
-use spectrace_spectrum::Xyz;
 use spectrace_tracer::{ErrorMeasure, IntegratorChoice, MIN_BATCHES, SamplerKind, relative_error};
 
 /// A shipped scene at `width x height` pixels.
@@ -32,10 +31,16 @@ fn options(integrator: IntegratorChoice, effort: u64, seed: u64) -> RenderOption
     }
 }
 
-/// The true relative error of one render in each measure ([`ErrorMeasure::ALL`]'s order), from
-/// `k` independent renders: the mean over them of each render's squared error against their
-/// mean, times `k / (k - 1)` (the mean carries `1/k` of the variance), square-rooted; beside
-/// it the mean over the renders of their own estimates in that measure.
+/// How many times the samples of the renders under test the reference of
+/// [`truth_and_estimate`] gets.
+const REFERENCE_EFFORT: u64 = 16;
+
+/// The true relative error of one render in each measure ([`ErrorMeasure::ALL`]'s order)
+/// against a converged reference, as the measures define it: `k` independent renders of
+/// `effort`, each measured against one render of [`REFERENCE_EFFORT`] times the effort; the mean
+/// of their squared errors, less the reference's own share of the difference's variance
+/// (`1 / REFERENCE_EFFORT` of a render's), square-rooted. Beside it the mean over the renders of
+/// their own estimates in that measure.
 fn truth_and_estimate(
     s: &Scene,
     integrator: IntegratorChoice,
@@ -45,17 +50,15 @@ fn truth_and_estimate(
     let renders: Vec<_> = (0..k)
         .map(|seed| render_in_memory(s, &options(integrator, effort, 9000 + seed)).unwrap())
         .collect();
-    let pixels = renders[0].image.len();
-    let mut mean = vec![Xyz::default(); pixels];
-    for r in &renders {
-        for (m, p) in mean.iter_mut().zip(&r.image) {
-            *m += *p * (1.0 / k as f64);
-        }
-    }
+    let reference =
+        render_in_memory(s, &options(integrator, effort * REFERENCE_EFFORT, 8999)).unwrap().image;
+    let keep = REFERENCE_EFFORT as f64 / (REFERENCE_EFFORT + 1) as f64;
     ErrorMeasure::ALL.map(|measure| {
-        let squared: f64 =
-            renders.iter().map(|r| relative_error(measure, &r.image, &mean).unwrap().powi(2)).sum();
-        let truth = (squared / (k - 1) as f64).sqrt();
+        let squared: f64 = renders
+            .iter()
+            .map(|r| relative_error(measure, &r.image, &reference).unwrap().powi(2))
+            .sum();
+        let truth = (squared / k as f64 * keep).sqrt();
         let estimated = renders
             .iter()
             .map(|r| {
@@ -69,14 +72,16 @@ fn truth_and_estimate(
     })
 }
 
-/// The promise at small scale: on shipped scenes with the estimator `auto` picks, the
-/// estimate is within 20% of the true error in the `energy` and `mean` measures. Eight
+/// On shipped scenes with the estimator `auto` picks, the estimate is within 20% of the true
+/// error in the `energy` and `mean` measures even at 32 samples per pixel, far from
+/// converged. Eight
 /// renders of 32 samples per pixel: the truth from their spread has 7 degrees of freedom per
 /// pixel over 1,536 pixels (a few percent of noise), the estimates 31 each. Sky is BDPT with
-/// hero wavelengths (measured 0.0812 true, 0.0884 estimated in `energy`), prism BDPT with one
+/// hero wavelengths (measured 0.0857 true, 0.0884 estimated in `energy`), prism BDPT with one
 /// wavelength per sample (dispersive). The `relmse` estimate is printed beside the truth, not
-/// asserted (it is not yet within 20% everywhere: scenes/README.md);
-/// `SPECTRACE_ESTIMATE_EFFORT=K` renders K times the samples, for measuring it at lower noise.
+/// asserted: at these counts most pixels are 20% to 100% noisy, where no estimate from the
+/// render's own batches is within 20% (its promise is near the targets users ask for, tested
+/// below); `SPECTRACE_ESTIMATE_EFFORT=K` renders K times the samples.
 #[test]
 fn the_estimate_is_within_20_percent_of_the_true_error_on_shipped_scenes() {
     for (name, integrator) in [
@@ -98,13 +103,72 @@ fn the_estimate_is_within_20_percent_of_the_true_error_on_shipped_scenes() {
             eprintln!(
                 "{name} ({integrator:?}, {m}): true error {truth:.4}, estimated {estimated:.4}"
             );
-            // relmse's estimate is not yet within 20% everywhere (scenes/README.md).
+            // relmse's estimate is asserted near 10%, below.
             assert!(
                 measure == ErrorMeasure::RelMse || (estimated / truth - 1.0).abs() < 0.2,
                 "{name} ({m}): estimated {estimated}, true {truth}"
             );
         }
     }
+}
+
+/// The promise at small scale: a render to `--target-error 0.1` in the default measure
+/// (`relmse`) ends with a true relmse against a converged reference ([`REFERENCE_EFFORT`] times
+/// its items) within 20% of its estimate and of 10%. Three renders per scene at 16x12 pixels,
+/// their squared true errors averaged. Measured (estimated, true): spot and torus with the
+/// light tracer 0.0983, 0.1003; sky with BDPT and hero wavelengths 0.0991, 0.1041. At 24x16
+/// (left out here: their references take a minute): the Cornell box with the path tracer
+/// 0.0997, 0.1056; the dispersive prism with BDPT 0.0998, 0.0949.
+///
+/// Not yet held, so not asserted: the fading spot with the path tracer, 0.0977 estimated and
+/// 0.187 true (24x16). Its dark pixels are lit by rare paths, and one render's truth can be
+/// ruled by one firefly there (seed 9100: true 0.277), which an estimate from the render's own
+/// batches cannot tell from a pixel lit by rare paths. The estimate approaches the truth as
+/// the samples grow: over four renders of fixed effort it was 0.64 of the truth at 64 samples
+/// per pixel, 0.89 at 288 and 1.01 at 1,152.
+#[test]
+fn a_render_to_10_percent_relmse_is_10_percent_from_the_truth() {
+    for (name, integrator) in
+        [("spot_torus.json", IntegratorChoice::Light), ("sky.json", IntegratorChoice::Bdpt)]
+    {
+        let (mut squared, mut estimated) = (0.0, 0.0);
+        let seeds = 9100..9103;
+        for seed in seeds.clone() {
+            let (truth, e) = render_to_10_percent(name, integrator, seed);
+            squared += truth * truth;
+            estimated += e;
+        }
+        let k = seeds.count() as f64;
+        let (truth, estimated) = ((squared / k).sqrt(), estimated / k);
+        eprintln!("{name} ({integrator:?}): estimated {estimated:.4}, true {truth:.4}");
+        assert!((estimated / truth - 1.0).abs() < 0.2, "{name}: {estimated} vs {truth}");
+        assert!((truth / 0.1 - 1.0).abs() < 0.2, "{name}: true {truth}");
+    }
+}
+
+/// One render of shipped scene `name` to `--target-error 0.1` (relmse): its true relmse and
+/// its estimate.
+fn render_to_10_percent(name: &str, integrator: IntegratorChoice, seed: u64) -> (f64, f64) {
+    let s = small(name, 16, 12);
+    let target =
+        RenderOptions { target_error: Some(0.1), beams: None, ..options(integrator, 0, seed) };
+    let out = render_in_memory(&s, &target).unwrap();
+    let e = out.output.estimate(ErrorMeasure::default()).unwrap();
+    assert_eq!(e.measure, ErrorMeasure::RelMse);
+    assert!(e.is_trusted(), "{name}: {e:?}");
+    let mut reference = small(name, 16, 12);
+    reference.settings.sampler = SamplerKind::Independent;
+    let items = out.output.beams * REFERENCE_EFFORT;
+    let reference = render_in_memory(&reference, &options(integrator, items, seed + 500)).unwrap();
+    let keep = REFERENCE_EFFORT as f64 / (REFERENCE_EFFORT + 1) as f64;
+    let error = relative_error(ErrorMeasure::RelMse, &out.image, &reference.image).unwrap();
+    let truth = error * keep.sqrt();
+    let estimated = e.relative_error.unwrap();
+    eprintln!(
+        "{name} seed {seed}: {} items, estimated {estimated:.4}, true {truth:.4}",
+        out.output.beams
+    );
+    (truth, estimated)
 }
 
 /// `SPECTRACE_ESTIMATE_EFFORT` (a whole number, default 1): the estimate test's effort factor.
@@ -149,7 +213,7 @@ fn under_sobol_points_the_estimate_is_an_upper_bound() {
 #[test]
 fn the_work_the_pilot_predicts_reaches_the_target() {
     let s = small("fading_spot.json", 48, 32);
-    let target = 0.03;
+    let target = 0.1;
     for integrator in [IntegratorChoice::Path, IntegratorChoice::Light] {
         let report = estimate(
             &s,
@@ -169,7 +233,7 @@ fn the_work_the_pilot_predicts_reaches_the_target() {
         assert!(p.pilot_error.unwrap() > target, "the pilot should not reach the target");
         let items = p.predicted_items.unwrap().ceil() as u64;
         let out = render_in_memory(&s, &options(integrator, items, 77)).unwrap();
-        let e = out.output.estimate(ErrorMeasure::Energy).unwrap().relative_error.unwrap();
+        let e = out.output.estimate(ErrorMeasure::RelMse).unwrap().relative_error.unwrap();
         eprintln!("{integrator:?}: predicted {items} items for {target}: estimate {e:.4}");
         assert!((e / target - 1.0).abs() < 0.2, "{integrator:?}: {e} after {items} items");
         assert!(p.predicted_seconds.unwrap() > 0.0 && p.relative_uncertainty.is_finite());
@@ -190,7 +254,7 @@ fn a_render_to_a_target_stops_there_and_writes_its_error_image() {
     let report = render_scene(
         &s,
         &RenderOptions {
-            target_error: Some(0.04),
+            target_error: Some(0.1),
             threads: Some(2),
             integrator: Some(IntegratorChoice::Light),
             out_dir: out.clone(),
@@ -199,12 +263,14 @@ fn a_render_to_a_target_stops_there_and_writes_its_error_image() {
     )
     .unwrap();
     let e = report.error_estimate.clone().unwrap();
-    assert_eq!(e.target_error, Some(0.04));
+    assert_eq!(e.target_error, Some(0.1));
     assert_eq!(e.target_reached, Some(true));
-    assert!(e.relative_rmse.unwrap() <= 0.04 && e.batches >= MIN_BATCHES, "{e:?}");
+    // In the default measure, relmse.
+    assert_eq!(e.measure, "relmse");
+    assert!(e.relative_error.unwrap() <= 0.1 && e.batches >= MIN_BATCHES, "{e:?}");
     // Not far past it: the render stops within a few chunks of reaching it (the checks are
-    // spaced in wall time, so a loaded machine may overshoot; 0.02 would be 4x the work).
-    assert!(e.relative_rmse.unwrap() > 0.02, "{e:?}");
+    // spaced in wall time, so a loaded machine may overshoot; 0.05 would be 4x the work).
+    assert!(e.relative_error.unwrap() > 0.05, "{e:?}");
     let json = sidecar(&out.join("fading_spot.json"));
     assert_eq!(json["error_estimate"]["target_reached"], Value::Bool(true));
     let error = exr::prelude::read_first_rgba_layer_from_file(
@@ -228,7 +294,7 @@ fn a_render_to_a_target_stops_there_and_writes_its_error_image() {
 fn shards_stop_on_their_share_and_the_merge_reports_the_merged_estimate() {
     let s = small("fading_spot.json", 48, 32);
     let out = crate::rendering::temp_dir("estimate-shards");
-    let target = 0.04;
+    let target = 0.1;
     let mut parts = Vec::new();
     let mut batches = 0;
     for k in 0..2 {
@@ -245,15 +311,15 @@ fn shards_stop_on_their_share_and_the_merge_reports_the_merged_estimate() {
         )
         .unwrap();
         let e = r.error_estimate.unwrap();
-        assert!(e.relative_rmse.unwrap() <= target * 2f64.sqrt(), "{e:?}");
+        assert!(e.relative_error.unwrap() <= target * 2f64.sqrt(), "{e:?}");
         batches += e.batches;
         parts.push(out.join(format!("fading_spot.part-{k}-of-2.bin")));
     }
     let merged = merge_parts(&parts, &out.join("merged")).unwrap();
     let e = merged.error_estimate.unwrap();
     assert_eq!(e.batches, batches);
-    assert!(e.relative_rmse.unwrap() <= target * 1.05, "{e:?}");
-    assert_eq!(e.target_reached, Some(e.relative_rmse.unwrap() <= target));
+    assert!(e.relative_error.unwrap() <= target * 1.05, "{e:?}");
+    assert_eq!(e.target_reached, Some(e.relative_error.unwrap() <= target));
     // A part whose moments do not match its film is refused, naming the field.
     let mut part = PartialFilm::read(&parts[0]).unwrap();
     part.output.moments = Some(spectrace_tracer::Moments::new(3, 3).unwrap());
@@ -305,11 +371,11 @@ fn a_time_cap_stops_a_render_to_an_unreachable_target() {
     .unwrap();
     let e = report.error_estimate.unwrap();
     assert_eq!(e.target_reached, Some(false));
-    assert!(e.relative_rmse.unwrap() > 1e-5);
+    assert!(e.relative_error.unwrap() > 1e-5);
     // The sidecar predicts what the target would take (far beyond the cap), and lists only
     // errors below the one reached.
     assert!(e.seconds_to_target.unwrap() > 1e3 * report.wall_seconds, "{e:?}");
-    let reached = e.relative_rmse.unwrap();
+    let reached = e.relative_error.unwrap();
     assert!(e.predicted_seconds.iter().all(|[t, s]| *t < reached && *s > 0.0), "{e:?}");
 }
 
@@ -435,6 +501,12 @@ fn the_relative_error_image_is_the_absolute_one_over_the_image() {
     let (image, absolute) = render(ErrorImage::Absolute, "absolute");
     let (same, relative) = render(ErrorImage::Relative, "relative");
     assert_eq!(image, same, "the same render");
+    // The relative image also comes as a false-colour PNG of the image's size (its colours are
+    // checked in the renderer's unit tests); the absolute one does not.
+    assert!(!out.join("absolute/fading_spot.error.png").exists());
+    let png = std::fs::read(out.join("relative/fading_spot.error.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+    assert_eq!((&png[16..20], &png[20..24]), (&48u32.to_be_bytes()[..], &32u32.to_be_bytes()[..]));
     let level = image.iter().flatten().map(|&v| f64::from(v)).sum::<f64>() / (3.0 * 1536.0);
     let eps = 0.01 * level;
     let mut checked = 0;
@@ -455,4 +527,28 @@ fn the_relative_error_image_is_the_absolute_one_over_the_image() {
     assert_eq!(parse("false").unwrap().output.error_image, ErrorImage::Off);
     let e = parse("\"percent\"").unwrap_err().to_string();
     assert!(e.contains("output.error_image") && e.contains("relative"), "{e}");
+    // `--error-image` overrides the scene's: the relative kind writes both error files.
+    let scene = out.join("scene.json");
+    std::fs::write(&scene, crate::rendering::POINT_OVER_PLANE).unwrap();
+    let cli = |kind: &str, dir: &str| {
+        spectrace_renderer::cli::main_with_args(
+            ["spectrace", "render", &scene.display().to_string(), "--beams", "65536"]
+                .into_iter()
+                .map(String::from)
+                .chain(["--error-image".into(), kind.into(), "--quiet".into()])
+                .chain(["--out".into(), out.join(dir).display().to_string()]),
+        )
+    };
+    assert_eq!(cli("relative", "cli"), std::process::ExitCode::SUCCESS);
+    let name = scene_name(&scene);
+    for file in [format!("{name}.error.exr"), format!("{name}.error.png")] {
+        assert!(out.join("cli").join(&file).is_file(), "{file}");
+    }
+    assert_ne!(cli("percent", "bad"), std::process::ExitCode::SUCCESS);
+    assert!(!out.join("bad").exists());
+}
+
+/// The output base name of a scene file with no `output.name`: its file stem.
+fn scene_name(path: &Path) -> String {
+    path.file_stem().unwrap().to_string_lossy().into_owned()
 }

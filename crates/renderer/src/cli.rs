@@ -24,7 +24,7 @@ use clap::{Parser, Subcommand};
 use spectrace_tracer::{EffectsMode, ErrorMeasure, IntegratorChoice, Kernel};
 
 use crate::say::{say, tell};
-use crate::{RenderOptions, merge_parts, render_file};
+use crate::{ErrorImage, RenderOptions, merge_parts, render_file};
 
 /// Spectrace: a spectral Monte Carlo renderer built around light sources as beam generators.
 #[derive(Debug, Parser)]
@@ -64,11 +64,15 @@ enum Command {
         /// most E (0.05 = 5%; overrides settings.target_error); --time and --beams/--spp cap it.
         #[arg(long, value_name = "E", allow_negative_numbers = true, value_parser = parse_target_error)]
         target_error: Option<f64>,
-        /// What the estimated error and the target measure: energy (relative RMSE weighted by
-        /// energy, the default), relmse (per-pixel relative error) or mean (RMSE over the
+        /// What the estimated error and the target measure: relmse (per-pixel relative error,
+        /// the default), energy (relative RMSE weighted by energy) or mean (RMSE over the
         /// image's mean); overrides settings.error_measure.
         #[arg(long, value_name = "MEASURE", value_parser = parse_error_measure)]
         error_measure: Option<ErrorMeasure>,
+        /// Write NAME.error.exr: off, absolute (each pixel's standard error) or relative (over
+        /// its value, with a false-colour NAME.error.png); overrides output.error_image.
+        #[arg(long, value_name = "KIND", value_parser = parse_error_image)]
+        error_image: Option<ErrorImage>,
         /// Output directory.
         #[arg(long, default_value = "out")]
         out: PathBuf,
@@ -114,7 +118,7 @@ enum Command {
         /// The target relative error (0.05 = 5%), in --error-measure.
         #[arg(long, value_name = "E", allow_negative_numbers = true, value_parser = parse_target_error)]
         target_error: f64,
-        /// What the target measures: energy (the default), relmse or mean; overrides
+        /// What the target measures: relmse (the default), energy or mean; overrides
         /// settings.error_measure.
         #[arg(long, value_name = "MEASURE", value_parser = parse_error_measure)]
         error_measure: Option<ErrorMeasure>,
@@ -149,6 +153,14 @@ enum Command {
 fn parse_error_measure(s: &str) -> Result<ErrorMeasure, String> {
     ErrorMeasure::from_name(s.trim())
         .ok_or_else(|| format!("`{s}`: must be relmse, energy or mean"))
+}
+
+/// An error image kind.
+fn parse_error_image(s: &str) -> Result<ErrorImage, String> {
+    [ErrorImage::Off, ErrorImage::Absolute, ErrorImage::Relative]
+        .into_iter()
+        .find(|e| e.name() == s.trim())
+        .ok_or_else(|| format!("`{s}`: must be off, absolute or relative"))
 }
 
 /// A kernel name.
@@ -365,11 +377,13 @@ where
             integrator,
             target_error,
             error_measure,
+            error_image,
             kernel,
         } => {
             let options = RenderOptions {
                 kernel,
                 error_measure,
+                error_image,
                 target_error,
                 spp,
                 integrator,

@@ -39,6 +39,19 @@ pub struct RenderOptions {
     pub kernel: Option<Kernel>,
     /// The error measure of the estimate and the target (overrides `settings.error_measure`).
     pub error_measure: Option<spectrace_tracer::ErrorMeasure>,
+    /// The error image to write (overrides `output.error_image`).
+    pub error_image: Option<crate::ErrorImage>,
+}
+
+impl RenderOptions {
+    /// The scene's output settings with these options' overrides.
+    pub fn output_settings(&self, scene: &crate::Scene) -> crate::OutputSettings {
+        let mut settings = scene.output.clone();
+        if let Some(e) = self.error_image {
+            settings.error_image = e;
+        }
+        settings
+    }
 }
 
 /// Why a render failed.

@@ -12,7 +12,7 @@
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
-use spectrace_tracer::{Effects, IntegratorChoice, RenderOutput, RenderPlan, SamplerKind};
+use spectrace_tracer::{Effects, IntegratorChoice, Moments, RenderOutput, RenderPlan, SamplerKind};
 
 use crate::OutputSettings;
 use crate::files::{MAX_PART_BYTES, check_output_name, read_bounded};
@@ -46,7 +46,7 @@ pub struct PartialFilm {
 }
 
 /// Current [`PartialFilm::version`].
-pub const PARTIAL_VERSION: u32 = 7;
+pub const PARTIAL_VERSION: u32 = 8;
 
 /// bincode's configuration for part files: the standard encoding, with every claimed length
 /// bounded by the file-size limit so a forged length cannot make the decoder reserve memory.
@@ -303,6 +303,21 @@ fn validate_moments(plan: &RenderPlan, out: &RenderOutput) -> Result<(), String>
     let chunks = out.chunks.len().saturating_sub(out.cut.len()) as u64;
     let items = out.beams.saturating_sub(cut_items);
     let matches = m.chunks() == chunks && m.items() == items;
+    // The whole chunks of the split-half estimate's first half.
+    let first = out
+        .chunks
+        .iter()
+        .filter(|&&c| Moments::in_first_half(c) && !out.cut.iter().any(|&(cut, _)| cut == c))
+        .fold([0u64; 2], |[n, items], &c| [n + 1, items.saturating_add(plan.beams_in_chunk(c))]);
+    if matches && m.first_half_chunks() != first {
+        return bad(
+            "output.moments",
+            format!(
+                "{:?} chunks and items in the first half, but the part rendered {first:?}",
+                m.first_half_chunks()
+            ),
+        );
+    }
     if !matches {
         return bad(
             "output.moments",

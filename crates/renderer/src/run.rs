@@ -47,7 +47,7 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
     planned_outputs(
         &options.out_dir,
         &name,
-        &scene.output,
+        &options.output_settings(scene),
         plan.shard,
         &scene.inputs,
         planned_sensor_outputs(scene, &options.out_dir),
@@ -194,7 +194,7 @@ fn render_with(
     let (output, wall) = render_with_progress(tracer, &setup.plan, options.verbose)?;
     let finished = Finished { scene, setup, integrator: tracer.name(), wall, warnings };
     match setup.plan.shard {
-        Some(shard) => write_shard(&finished, &options.out_dir, shard, output),
+        Some(shard) => write_shard(&finished, options, shard, output),
         None => write_render(&finished, options, tracer, probed, &output),
     }
 }
@@ -262,12 +262,12 @@ impl Finished<'_> {
 /// A shard's end: its part file (the film moves into it) and its report, which has no sidecar.
 fn write_shard(
     finished: &Finished<'_>,
-    out_dir: &Path,
+    options: &RenderOptions,
     shard: (u64, u64),
     output: RenderOutput,
 ) -> Result<RenderReport, RenderError> {
     let (scene, setup) = (finished.scene, finished.setup);
-    let path = part_path(out_dir, setup.name, shard);
+    let path = part_path(&options.out_dir, setup.name, shard);
     let report = finished
         .report(&output, Written { files: vec![path.display().to_string()], ..Written::default() });
     let part = PartialFilm {
@@ -279,7 +279,7 @@ fn write_shard(
         integrator: setup.choice,
         sampler: scene.settings.sampler,
         effects: setup.effects,
-        output_settings: scene.output.clone(),
+        output_settings: options.output_settings(scene),
         name: setup.name.to_owned(),
         output,
     };
@@ -297,8 +297,8 @@ fn write_render(
 ) -> Result<RenderReport, RenderError> {
     let (scene, setup) = (finished.scene, finished.setup);
     let numerator = scene_normalisation(scene, setup.choice);
-    let mut written =
-        write_outputs(&options.out_dir, setup.name, &scene.output, numerator, output)?;
+    let settings = options.output_settings(scene);
+    let mut written = write_outputs(&options.out_dir, setup.name, &settings, numerator, output)?;
     written.warnings.extend(black_image_warning(&probed, output));
     let sensors =
         render_sensors(scene, &options.out_dir, tracer, output, &setup.plan, setup.effects)?;

@@ -144,8 +144,8 @@ pub struct Settings {
     /// this (e.g. `0.05`), instead of a fixed number of beams or samples; `time_seconds` caps
     /// it.
     pub target_error: Option<f64>,
-    /// What "relative error" means for the estimate's headline and the target: `"energy"`
-    /// (the default), `"relmse"` (per-pixel relative error) or `"mean"` (see
+    /// What "relative error" means for the estimate's headline and the target: `"relmse"`
+    /// (the default: per-pixel relative error), `"energy"` or `"mean"` (see
     /// [`spectrace_tracer::ErrorMeasure`]).
     pub error_measure: ErrorMeasure,
     /// Which kernel traces the path tracer's camera paths: `"scalar"` (one path at a time, the
@@ -175,7 +175,7 @@ impl Default for Settings {
             bdpt_wavelengths: BdptWavelengths::Hero,
             sampler: SamplerKind::Auto,
             target_error: None,
-            error_measure: ErrorMeasure::Energy,
+            error_measure: ErrorMeasure::RelMse,
             kernel: Kernel::Scalar,
         }
     }

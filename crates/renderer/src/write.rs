@@ -35,6 +35,9 @@ pub(crate) fn planned_outputs(
             if settings.error_image.wanted() {
                 v.push(out_dir.join(format!("{name}.error.exr")));
             }
+            if settings.error_image == ErrorImage::Relative && settings.png {
+                v.push(out_dir.join(format!("{name}.error.png")));
+            }
             v.push(out_dir.join(format!("{name}.json")));
             v.extend(sensor_outputs);
             v
@@ -127,6 +130,12 @@ pub fn write_outputs(
                 write_atomically(&path, |p| write_exr(p, w, h, &rgb, scale_log2))
                     .map_err(file_error(&path))?;
                 written.files.push(path.display().to_string());
+                if settings.error_image == ErrorImage::Relative && settings.png {
+                    let path = dir.join(format!("{name}.error.png"));
+                    write_atomically(&path, |p| write_error_png(p, w, h, &rgb))
+                        .map_err(file_error(&path))?;
+                    written.files.push(path.display().to_string());
+                }
             }
             None => written.warnings.push(
                 "output.error_image: no error image, the render kept no error estimate".to_owned(),
@@ -134,6 +143,25 @@ pub fn write_outputs(
         }
     }
     Ok(written)
+}
+
+/// The relative error PNG's top of scale: pixels with a relative standard error of this or
+/// more are yellow.
+const ERROR_PNG_TOP: f64 = 0.2;
+
+/// Writes `NAME.error.png`: each pixel's relative standard error (the root mean square over its
+/// linear-sRGB channels of `relative`) in false colour, from 0 (dark purple) to
+/// [`ERROR_PNG_TOP`] or more (yellow), on the sensor maps' viridis scale.
+fn write_error_png(path: &Path, w: u32, h: u32, relative: &[[f32; 3]]) -> Result<(), String> {
+    let bytes: Vec<u8> = relative
+        .iter()
+        .flat_map(|p| {
+            let mean_square = p.iter().map(|&c| f64::from(c).powi(2)).sum::<f64>() / 3.0;
+            crate::sensor_output::sensor_colour(mean_square.sqrt() / ERROR_PNG_TOP)
+        })
+        .collect();
+    let image = image::RgbImage::from_raw(w, h, bytes).ok_or("image buffer has the wrong size")?;
+    image.save_with_format(path, image::ImageFormat::Png).map_err(|e| e.to_string())
 }
 
 /// Standard errors as the EXR's 32-bit floats (saturating at the largest).
@@ -164,4 +192,29 @@ pub(crate) fn write_sidecar(
         .map_err(|e| RenderError::File { path: path.clone(), message: e.to_string() })?;
     write_atomically(&path, |p| std::fs::write(p, &text).map_err(|e| e.to_string()))
         .map_err(|message| RenderError::File { path, message })
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+
+    use super::*;
+
+    #[test]
+    fn the_error_png_maps_the_rms_relative_error_onto_the_colour_scale() {
+        let dir = std::env::temp_dir().join(format!("spectrace-error-png-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("e.png");
+        // 0, the top of the scale (RMS of 0.2 over the channels), half of it, and beyond.
+        let top = ERROR_PNG_TOP as f32;
+        let rel = [[0.0; 3], [top; 3], [top / 2.0, top / 2.0, top / 2.0], [0.0, 0.0, 9.0]];
+        write_error_png(&path, 4, 1, &rel).unwrap();
+        let png = image::open(&path).unwrap().to_rgb8();
+        let colour = crate::sensor_output::sensor_colour;
+        let want = [colour(0.0), colour(1.0), colour(0.5), colour(1.0)];
+        for (x, w) in want.iter().enumerate() {
+            assert_eq!(png.get_pixel(x as u32, 0).0, *w, "pixel {x}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

@@ -42,7 +42,7 @@ pub struct RenderPlan {
     #[serde(default)]
     pub target_error: Option<f64>,
     /// The measure of the error estimate's headline and of the target
-    /// ([`ErrorMeasure::Energy`] by default).
+    /// ([`ErrorMeasure::RelMse`] by default).
     #[serde(default)]
     pub error_measure: ErrorMeasure,
 }
@@ -412,7 +412,7 @@ pub fn render_observed(
                         writer.discard_chunk();
                         cut.push((c, s.beams));
                     } else {
-                        writer.end_chunk(s.beams);
+                        writer.end_chunk(c, s.beams);
                     }
                     stats.merge(&s);
                     mine.push(c);

@@ -184,12 +184,12 @@ fn the_pass_layer_sums_apart_from_the_pixels_and_merges_exactly() {
         assert!(!w.splat_pass(3, 0, Xyz::new(1.0, 1.0, 1.0)));
         assert!(!w.splat_pass(0, 0, Xyz::new(f64::INFINITY, 1.0, 1.0)));
         assert!(w.splat_sensor(0, [7.0, 7.0, 49.0]));
-        w.end_chunk(6);
+        w.end_chunk(0, 6);
     }
     let shared = shared.into_inner().unwrap();
     assert_eq!(shared, direct);
     let mut expected = Moments::new(3, 2).unwrap();
-    expected.add_chunk([(1, [1.5, 2.25, 3.125]), (5, [4.0, 4.0, 4.0])], 6);
+    expected.add_chunk(0, [(1, [1.5, 2.25, 3.125]), (5, [4.0, 4.0, 4.0])], 6);
     assert_eq!(moments.into_inner().unwrap(), expected);
     // Merging needs the same layers; the same film twice doubles both.
     assert!(matches!(plain.merge(&direct), Err(FilmError::LayerMismatch(..))));

@@ -77,13 +77,13 @@ impl<'a> FilmWriter<'a> {
         writer
     }
 
-    /// Ends a chunk of `items` work items: flushes, and folds the chunk's sums into the
-    /// moments (if the writer keeps them). Every contribution since the previous call belongs
-    /// to this chunk.
-    pub fn end_chunk(&mut self, items: u64) {
+    /// Ends chunk number `chunk` (its index in the render plan) of `items` work items:
+    /// flushes, and folds the chunk's sums into the moments (if the writer keeps them). Every
+    /// contribution since the previous call belongs to this chunk.
+    pub fn end_chunk(&mut self, chunk: u64, items: u64) {
         self.flush();
         if let Some(t) = &mut self.tally {
-            t.end_chunk(items);
+            t.end_chunk(chunk, items);
         }
     }
 
