@@ -89,7 +89,7 @@ pub const PREDICTED_ERRORS: [f64; 4] = [0.10, 0.05, 0.02, 0.01];
 /// `error_estimate`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AccuracyEstimate {
-    /// The measure of the headline, `relative_error`: `"energy"` (the default), `"relmse"` or
+    /// The measure of the headline, `relative_error`: `"relmse"` (the default), `"energy"` or
     /// `"mean"` (`settings.error_measure`, `--error-measure`).
     pub measure: String,
     /// Estimated relative error against the converged image in `measure`; `null` with fewer

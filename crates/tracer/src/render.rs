@@ -32,7 +32,7 @@ pub struct RenderPlan {
     /// Time budget (s): after it, no new chunk is claimed and the chunks being traced stop
     /// within a few microseconds of work (between beams; at least one beam is always traced).
     pub time_budget: Option<f64>,
-    /// Keep the per-chunk moments of the error estimate ([`Moments`]; 72 bytes per pixel and
+    /// Keep the per-chunk moments of the error estimate ([`Moments`]; 120 bytes per pixel and
     /// 29 per pixel and thread).
     #[serde(default)]
     pub error_estimate: bool,
@@ -224,7 +224,7 @@ impl RenderPlan {
                 }),
                 if pass_layer { "96 (with a pass layer)" } else { "48" },
                 if self.keeps_estimate() {
-                    ", the error estimate's moments at 72 bytes per pixel and 29 per pixel and thread"
+                    ", the error estimate's moments at 120 bytes per pixel and 29 per pixel and thread"
                 } else {
                     ""
                 },
