@@ -73,7 +73,8 @@ use spectrace_lights::WavelengthSampling;
 use spectrace_renderer::{Scene, choose_integrator, decide_effects, render_xyz};
 use spectrace_spectrum::{SpectralPowerDistribution, Xyz};
 use spectrace_tracer::{
-    CameraRepr, EffectsMode, IntegratorChoice, PinholeCamera, SamplerKind, SceneFeatures,
+    CameraRepr, EffectsMode, ErrorMeasure, IntegratorChoice, PinholeCamera, SamplerKind,
+    SceneFeatures, relative_error,
 };
 
 use cache::{cache_key, read_reference, write_reference};
@@ -175,6 +176,10 @@ pub struct AccuracyPoint {
     /// [`colour_relative_rmse`]); 0 in reports written before it was measured.
     #[serde(default)]
     pub colour_rmse: f64,
+    /// The per-pixel relative error against the reference ([`ErrorMeasure::RelMse`], the
+    /// renderer's default measure; the plot's); 0 in reports written before it was measured.
+    #[serde(default)]
+    pub relmse: f64,
 }
 
 /// The sweep of one configuration on one scene.
@@ -478,6 +483,7 @@ fn run_scene(
             let relative_rmse = relative_rmse(&xyz, &reference)?;
             let mean_ratio = mean_ratio(&xyz, &reference);
             let colour_rmse = colour_relative_rmse(&xyz, &reference)?;
+            let relmse = relative_error(ErrorMeasure::RelMse, &xyz, &reference)?;
             eprintln!(
                 "accuracy: {name}: {:<22} {beams:>10} paths {seconds:>8.3} s  error {:.3}%  \
                  mean Y {mean_ratio:.3}x the reference",
@@ -491,6 +497,7 @@ fn run_scene(
                 relative_rmse,
                 mean_ratio,
                 colour_rmse,
+                relmse,
             });
         }
     }
@@ -659,7 +666,7 @@ fn mean_ratio(image: &[Xyz], reference: &[Xyz]) -> f64 {
 
 /// Least-squares slope of `y` against `x` (`None` for fewer than two distinct `x` or
 /// non-finite values): the renderer's fit, also used by `spectrace estimate`.
-fn fit_slope(points: &[(f64, f64)]) -> Option<f64> {
+pub(super) fn fit_slope(points: &[(f64, f64)]) -> Option<f64> {
     spectrace_renderer::pilot::fit_line(points).map(|f| f.slope)
 }
 

@@ -38,8 +38,10 @@ pub(super) struct PlotSeries {
     points: Vec<(f64, f64)>,
 }
 
-/// Draws the log-log plot of error against time (SVG): one panel per scene, one line per
-/// configuration (colour by configuration, the same in every panel), a dashed line of slope -1/2.
+/// Draws the log-log plot of error against time (SVG): the per-pixel relative error (`relmse`,
+/// the renderer's default measure) of every sweep point, one panel per scene, one line per
+/// configuration (colour by configuration, the same in every panel, with its fitted slope), a
+/// dashed line of slope -1/2.
 ///
 /// # Errors
 /// A message if the file cannot be written.
@@ -56,7 +58,10 @@ pub fn write_plot(report: &AccuracyReport, path: &Path) -> Result<(), String> {
     let root = SVGBackend::new(path, size).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let root = root
-        .titled("Spectrace: relative RMSE of XYZ against wall time", ("sans-serif", 22))
+        .titled(
+            "Spectrace: per-pixel relative error (relmse) against wall time",
+            ("sans-serif", 22),
+        )
         .map_err(|e| err(&e))?;
     let areas = root.split_evenly((rows, cols));
     for (scene, area) in report.scenes.iter().zip(&areas) {
@@ -64,22 +69,26 @@ pub fn write_plot(report: &AccuracyReport, path: &Path) -> Result<(), String> {
             .configurations
             .iter()
             .filter(|c| !c.points.is_empty())
-            .map(|c| PlotSeries {
-                label: format!(
-                    "{} (slope {})",
-                    c.configuration.name(),
-                    slope_text(c.slope_vs_time)
-                ),
-                configuration: Configuration::ALL
-                    .iter()
-                    .position(|&k| k == c.configuration)
-                    .unwrap_or_default(),
-                points: c
+            .map(|c| {
+                let points: Vec<(f64, f64)> = c
                     .points
                     .iter()
-                    .filter(|p| p.seconds > 0.0 && p.relative_rmse > 0.0)
-                    .map(|p| (p.seconds, p.relative_rmse))
-                    .collect(),
+                    .filter(|p| p.seconds > 0.0 && p.relmse > 0.0)
+                    .map(|p| (p.seconds, p.relmse))
+                    .collect();
+                let logs: Vec<(f64, f64)> = points.iter().map(|(t, e)| (t.ln(), e.ln())).collect();
+                PlotSeries {
+                    label: format!(
+                        "{} (slope {})",
+                        c.configuration.name(),
+                        slope_text(fit_slope(&logs))
+                    ),
+                    configuration: Configuration::ALL
+                        .iter()
+                        .position(|&k| k == c.configuration)
+                        .unwrap_or_default(),
+                    points,
+                }
             })
             .collect();
         draw_panel(area, &scene.name, &series).map_err(|e| err(&e))?;

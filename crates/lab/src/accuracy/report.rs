@@ -218,6 +218,7 @@ pub fn markdown(report: &AccuracyReport) -> String {
     let _ = writeln!(md, "\nWhich knobs act on which estimator: {KNOBS_BY_ESTIMATOR}.");
     summary_markdown(&mut md, report);
     estimate_summary_markdown(&mut md, report);
+    measures_summary_markdown(&mut md, report);
     if o.configurations.iter().any(|c| c.integrator() != IntegratorChoice::Light) {
         integrators_markdown(&mut md, report);
     }
@@ -468,6 +469,55 @@ pub(super) fn estimate_summary_markdown(md: &mut String, report: &AccuracyReport
                 _ => "-".to_owned(),
             },
             check.pilot.recommended.as_deref().unwrap_or("-")
+        );
+    }
+}
+
+/// The estimate checks' renders in every error measure: estimated against true.
+pub(super) fn measures_summary_markdown(md: &mut String, report: &AccuracyReport) {
+    let checked: Vec<(&SceneResult, &EstimateCheck)> = report
+        .scenes
+        .iter()
+        .filter_map(|s| s.estimate_check.as_ref().map(|c| (s, c)))
+        .filter(|(_, c)| c.paths > 0)
+        .collect();
+    if checked.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        md,
+        "\n## The same renders in every error measure\n\n\
+         The renders of the table above (stopped by the `energy` estimate), with their own \
+         final estimate and their error against the reference in each measure the renderer \
+         reports: `relmse` (per-pixel relative error, the renderer's default), `energy` (the \
+         headline above) and `mean` (RMSE over the image's mean). The true errors here still \
+         hold the reference's own noise: for the same estimator it adds about \
+         `sqrt(paths / reference paths)` of the render's error in quadrature (the last column).\n\n\
+         | scene | estimator | paths / reference paths | relmse: estimated, true | energy: \
+         estimated, true | mean: estimated, true |\n|---|---|---|---|---|---|"
+    );
+    for (scene, check) in checked {
+        let cell = |m: ErrorMeasure| {
+            let (e, t) = (check.estimated_by_measure.get(m), check.true_by_measure.get(m));
+            format!(
+                "{}, {} ({})",
+                e.map_or("-".to_owned(), percent),
+                t.map_or("-".to_owned(), percent),
+                match (e, t) {
+                    (Some(e), Some(t)) if t > 0.0 => format!("{:.2}", e / t),
+                    _ => "-".to_owned(),
+                }
+            )
+        };
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {} | {} |",
+            scene.name,
+            check.integrator.name(),
+            sig(check.paths as f64 / scene.reference.beams.max(1) as f64),
+            cell(ErrorMeasure::RelMse),
+            cell(ErrorMeasure::Energy),
+            cell(ErrorMeasure::Mean),
         );
     }
 }

@@ -213,6 +213,19 @@ fn error_falls_with_beams_and_the_report_is_written() {
     assert!(e > 0.0 && (e / t) > 0.5 && (e / t) < 1.5, "estimate {e}, truth {t}");
     assert!(md.contains("## Does the renderer know its own error?"), "{md}");
     assert!(md.contains("### Estimate against truth"), "{md}");
+    // The same render in every measure: its energy cells are the headline's, and every sweep
+    // point records relmse, which the plot shows (larger than energy on this scene's dim
+    // floor, as the brightest pixels rule energy).
+    assert_eq!(check.true_by_measure.energy, Some(t));
+    assert_eq!(check.estimated_by_measure.energy, Some(e));
+    assert!(check.true_by_measure.relmse.is_some_and(|r| r > 0.0));
+    let row = md
+        .split("## The same renders in every error measure")
+        .nth(1)
+        .and_then(|t| t.lines().find(|l| l.starts_with("| tiny | ")))
+        .unwrap();
+    assert_eq!(row.matches('(').count(), 3, "{row}");
+    assert!(baseline.points.iter().all(|p| p.relmse > p.relative_rmse), "{baseline:?}");
     // The knobs' gains: a column per pair. Hero wavelengths cut BDPT's variance on the tiny
     // scene's white light far below half (measured 0.078 in pixels, 0.031 in colour).
     let gains = md.split("## What each variance-reduction knob buys").nth(1).unwrap();
@@ -321,6 +334,7 @@ fn a_biased_estimator_levels_off_and_is_not_extrapolated() {
         relative_rmse,
         mean_ratio: 0.5,
         colour_rmse: 0.0,
+        relmse: 2.0 * relative_rmse,
     };
     // Falls at first, then flattens at 40%: the overall slope is steep enough to
     // extrapolate, the last three points say bias.
@@ -432,6 +446,7 @@ fn slopes_and_reach() {
                 relative_rmse: 0.2,
                 mean_ratio: 1.0,
                 colour_rmse: 0.0,
+                relmse: 0.4,
             },
             AccuracyPoint {
                 beams: 4,
@@ -440,6 +455,7 @@ fn slopes_and_reach() {
                 relative_rmse: 0.1,
                 mean_ratio: 1.0,
                 colour_rmse: 0.0,
+                relmse: 0.2,
             },
         ],
         slope_vs_time: Some(-0.5),
@@ -494,6 +510,7 @@ fn a_knobs_gain_is_its_variance_over_its_peers_at_equal_paths_and_time() {
         relative_rmse,
         mean_ratio: 1.0,
         colour_rmse: relative_rmse / 2.0,
+        relmse: 2.0 * relative_rmse,
     };
     let result = |configuration, points| ConfigurationResult {
         configuration,
