@@ -11,7 +11,8 @@
 //! slopes of log error against log time and against log work are fitted to the second round's
 //! live estimates; the time slope is reported beside the expected -1/2 (start-up costs make it
 //! steeper early on), and the work slope replaces -1/2 in the prediction only when it differs by
-//! more than three standard errors. The stated uncertainty is the estimate's own (from its
+//! more than three standard errors, and not in `relmse` (whose estimate's bias from few chunks
+//! shrinks over the pilot and would pass for a slope). The stated uncertainty is the estimate's own (from its
 //! degrees of freedom), doubled because time goes as the error squared; the machine's load is
 //! not in it.
 
@@ -19,7 +20,9 @@ use std::sync::Mutex;
 
 use serde::{Deserialize, Serialize};
 use spectrace_lights::LightSource;
-use spectrace_tracer::{IntegratorChoice, MIN_BATCHES, Progress, RenderPlan, render_observed};
+use spectrace_tracer::{
+    ErrorMeasure, IntegratorChoice, MIN_BATCHES, Progress, RenderPlan, render_observed,
+};
 
 use crate::integrators::{ESTIMATORS, with_kernel};
 use crate::warnings::integrator_warnings;
@@ -240,9 +243,17 @@ fn pilot(
     let slope_vs_items =
         fit_log_slope(&live.iter().map(|&(_, n, e)| (n as f64, e)).collect::<Vec<_>>());
     // Independent chunks make the error fall as items^-1/2; a measured slope replaces it only
-    // when it is clearly different (a sign of chunks that are not independent).
+    // when it is clearly different (a sign of chunks that are not independent), and never in
+    // `relmse`, whose estimate from few chunks is biased by the noise of its denominators, a
+    // bias that shrinks as chunks come in: its slope over the pilot is that, not the error's.
     let slope_used = match slope_vs_items {
-        Some((s, se)) if s < 0.0 && (s + 0.5).abs() > 3.0 * se => s,
+        Some((s, se))
+            if first.error_measure != ErrorMeasure::RelMse
+                && s < 0.0
+                && (s + 0.5).abs() > 3.0 * se =>
+        {
+            s
+        }
         _ => -0.5,
     };
     let target = options.target_error;

@@ -76,3 +76,67 @@ pub(super) fn read_reference(path: &Path, width: u32, height: u32) -> Option<(Ve
         .collect::<Option<Vec<_>>>()?;
     Some((image, seconds))
 }
+
+/// The estimate check's reference of at least `paths` paths ([`check::CHECK_REFERENCE_FACTOR`]
+/// times the check render's): rendered by `integrator` with independent sampling at the next
+/// power of two of paths (so reruns find it in the cache), with its own error estimate in every
+/// measure kept beside it (`FILE.error`: three numbers, `-` for none). `independent` is the
+/// scene with `settings.sampler` independent, so that the reference's own estimate holds.
+///
+/// # Errors
+/// A message when the render or the cache fails.
+pub(super) fn deep_reference(
+    independent: &Scene,
+    scene_text: &str,
+    name: &str,
+    integrator: IntegratorChoice,
+    paths: u64,
+    options: &AccuracyOptions,
+    threads: usize,
+) -> Result<check::CheckReference, String> {
+    let paths = paths.max(1).checked_next_power_of_two().unwrap_or(paths);
+    let (width, height) = (independent.camera.width(), independent.camera.height());
+    let seed = options.seed ^ 0xDEE9;
+    let key = cache_key(scene_text, integrator, paths, seed, width, height);
+    let file = options.cache_dir.join(format!("{name}-check-{key:016x}.xyz"));
+    let error_file = file.with_extension("xyz.error");
+    let cached = read_reference(&file, width, height)
+        .zip(std::fs::read_to_string(&error_file).ok().and_then(|t| parse_errors(&t)));
+    if let Some(((image, _), own_error)) = cached {
+        eprintln!("accuracy: {name}: check reference {paths} paths from the cache");
+        return Ok(check::CheckReference { image, own_error, paths });
+    }
+    eprintln!(
+        "accuracy: {name}: rendering the check reference, {paths} paths by {}...",
+        integrator.name()
+    );
+    let render = spectrace_renderer::render_in_memory(
+        independent,
+        &spectrace_renderer::RenderOptions {
+            beams: Some(paths),
+            seed: Some(seed),
+            threads: Some(threads),
+            integrator: Some(integrator),
+            error_measure: Some(ErrorMeasure::RelMse),
+            ..spectrace_renderer::RenderOptions::default()
+        },
+    )
+    .map_err(|e| format!("accuracy: {name}: check reference: {e}"))?;
+    let own_error =
+        render.output.estimate(ErrorMeasure::RelMse).map(|e| e.by_measure).unwrap_or_default();
+    let paths = render.output.beams;
+    write_reference(&file, width, height, paths, render.output.seconds, &render.image)?;
+    let text = ErrorMeasure::ALL
+        .map(|m| own_error.get(m).map_or("-".to_owned(), |e| e.to_string()))
+        .join(" ");
+    std::fs::write(&error_file, text).map_err(|e| format!("{}: {e}", error_file.display()))?;
+    eprintln!("accuracy: {name}: check reference took {:.1} s", render.output.seconds);
+    Ok(check::CheckReference { image: render.image, own_error, paths })
+}
+
+/// The three numbers of a `.error` file (relmse, energy, mean; `-` for none).
+fn parse_errors(text: &str) -> Option<ByMeasure> {
+    let v: Vec<Option<f64>> = text.split_whitespace().map(|w| w.parse().ok()).collect();
+    let [relmse, energy, mean] = v.as_slice().try_into().ok()?;
+    Some(ByMeasure { relmse, energy, mean })
+}

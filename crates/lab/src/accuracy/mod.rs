@@ -73,12 +73,15 @@ use spectrace_lights::WavelengthSampling;
 use spectrace_renderer::{Scene, choose_integrator, decide_effects, render_xyz};
 use spectrace_spectrum::{SpectralPowerDistribution, Xyz};
 use spectrace_tracer::{
-    CameraRepr, EffectsMode, ErrorMeasure, IntegratorChoice, PinholeCamera, SamplerKind,
+    ByMeasure, CameraRepr, EffectsMode, ErrorMeasure, IntegratorChoice, PinholeCamera, SamplerKind,
     SceneFeatures, relative_error,
 };
 
-use cache::{cache_key, read_reference, write_reference};
-pub use check::{ESTIMATE_CAP_SECONDS, ESTIMATE_TARGET, EstimateCheck, estimate_check};
+use cache::{cache_key, deep_reference, read_reference, write_reference};
+pub use check::{
+    CHECK_REFERENCE_FACTOR, CheckReference, ESTIMATE_CAP_SECONDS, ESTIMATE_MEASURE,
+    ESTIMATE_TARGET, EstimateCheck, estimate_check,
+};
 pub use configuration::Configuration;
 pub use knobs::apply;
 use knobs::limit_resolution;
@@ -117,6 +120,13 @@ pub struct AccuracyOptions {
     /// ([`estimate_check`]; default on).
     #[serde(default)]
     pub estimate_check: bool,
+    /// The estimate check's target in `relmse` (default [`ESTIMATE_TARGET`]).
+    #[serde(default = "default_estimate_target")]
+    pub estimate_target: f64,
+}
+
+fn default_estimate_target() -> f64 {
+    ESTIMATE_TARGET
 }
 
 fn all_configurations() -> Vec<Configuration> {
@@ -141,6 +151,7 @@ impl Default for AccuracyOptions {
             max_width: Some(96),
             configurations: all_configurations(),
             estimate_check: true,
+            estimate_target: ESTIMATE_TARGET,
         }
     }
 }
@@ -501,7 +512,7 @@ fn run_scene(
             });
         }
     }
-    let configurations = prepared
+    let configurations: Vec<ConfigurationResult> = prepared
         .into_iter()
         .zip(points)
         .map(|(p, points)| {
@@ -520,16 +531,56 @@ fn run_scene(
         })
         .collect();
     let estimate_check = if options.estimate_check {
-        let check = estimate_check(&baseline, auto_picks, &reference, threads, options.seed)?;
+        let mut independent =
+            load(&text, path, options.max_width).map_err(|e| format!("accuracy: {e}"))?;
+        independent.settings.sampler = SamplerKind::Independent;
+        let sweep_reference = reference.clone();
+        let sweep_error = report::sweep_reference_error(
+            &configurations,
+            reference_integrator,
+            options.reference_beams,
+        )
+        .map(|(_, e)| e)
+        .unwrap_or_default();
+        let mut reference_for = |paths: u64| {
+            if paths <= options.reference_beams {
+                // The sweep's reference is deep enough; its own error is estimated from the
+                // sweep of its estimator.
+                return Ok(CheckReference {
+                    image: sweep_reference.clone(),
+                    own_error: sweep_error,
+                    paths: options.reference_beams,
+                });
+            }
+            deep_reference(
+                &independent,
+                &text,
+                &name,
+                reference_integrator,
+                paths,
+                options,
+                threads,
+            )
+        };
+        let check = estimate_check(
+            &baseline,
+            auto_picks,
+            options.estimate_target,
+            &mut reference_for,
+            threads,
+            options.seed,
+        )?;
         eprintln!(
             "accuracy: {name}: estimate check: {} to {}% in {:.2} s (predicted {:?} s), estimated \
-             error {:?}, true error {:.4}",
+             error {:?}, true error {:.4} against {} reference paths (its own {:?})",
             auto_picks.name(),
-            ESTIMATE_TARGET * 100.0,
+            options.estimate_target * 100.0,
             check.measured_seconds,
             check.prediction().and_then(|p| p.predicted_seconds),
             check.estimated_error,
-            check.true_error
+            check.true_error,
+            check.reference_paths,
+            check.reference_error.relmse,
         );
         Some(check)
     } else {

@@ -237,20 +237,41 @@ pub fn markdown(report: &AccuracyReport) -> String {
 }
 
 /// The reference's own relative RMSE, estimated from the configuration that renders with the
-/// reference's estimator (its last sweep point): the reference carries that estimator's noise at
-/// its own path count, which adds in quadrature to every measured error. With `e` the measured
-/// error at `n` paths and `N` the reference's paths, `e^2 = s^2 (1/n + 1/N)` gives the
-/// reference's `s / sqrt(N) = e / sqrt(1 + N / n)`. `None` when that configuration was not swept.
+/// reference's estimator (its last sweep point): see [`sweep_reference_error`]. `None` when
+/// that configuration was not swept.
 pub(super) fn reference_noise(scene: &SceneResult) -> Option<(Configuration, f64)> {
-    let same = match scene.reference.integrator {
+    let (same, error) = sweep_reference_error(
+        &scene.configurations,
+        scene.reference.integrator,
+        scene.reference.beams,
+    )?;
+    Some((same, error.energy?))
+}
+
+/// The sweep's reference's own error in `energy` (relative RMSE) and `relmse`, estimated from
+/// the configuration that renders with the reference's estimator `integrator` (its last sweep
+/// point): the reference carries that estimator's noise at its own path count `beams`, which
+/// adds in quadrature to every measured error. With `e` the measured error at `n` paths and `N`
+/// the reference's paths, `e^2 = s^2 (1/n + 1/N)` gives the reference's
+/// `s / sqrt(N) = e / sqrt(1 + N / n)`. `mean` is not swept: `None`.
+pub(super) fn sweep_reference_error(
+    configurations: &[ConfigurationResult],
+    integrator: IntegratorChoice,
+    beams: u64,
+) -> Option<(Configuration, ByMeasure)> {
+    let same = match integrator {
         IntegratorChoice::Path => Configuration::Path,
         IntegratorChoice::Bdpt => Configuration::Bdpt,
         _ => Configuration::Baseline,
     };
-    let last = scene.configurations.iter().find(|c| c.configuration == same)?.points.last()?;
-    let noise =
-        last.relative_rmse / (1.0 + scene.reference.beams as f64 / last.beams.max(1) as f64).sqrt();
-    Some((same, noise))
+    let last = configurations.iter().find(|c| c.configuration == same)?.points.last()?;
+    let factor = (1.0 + beams as f64 / last.beams.max(1) as f64).sqrt();
+    let error = ByMeasure {
+        relmse: (last.relmse > 0.0).then(|| last.relmse / factor),
+        energy: Some(last.relative_rmse / factor),
+        mean: None,
+    };
+    Some((same, error))
 }
 
 /// The fastest configuration to `target` among those that apply, and its reach (measured, or
@@ -388,6 +409,10 @@ pub(super) fn summary_markdown(md: &mut String, report: &AccuracyReport) {
 /// The true error of a check's render with the reference's own noise taken out (they add in
 /// quadrature): `sqrt(true^2 - noise^2)`, `None` when the noise is as large as the error.
 pub(super) fn corrected_truth(scene: &SceneResult, check: &EstimateCheck) -> Option<f64> {
+    if check.reference_paths > 0 {
+        // The check's own reference, with its own estimate of its error.
+        return check.corrected_truth(check.measure);
+    }
     let noise = reference_noise(scene).map_or(0.0, |(_, n)| n);
     let d = check.true_error.powi(2) - noise * noise;
     (d > 0.0).then(|| d.sqrt())
@@ -400,12 +425,15 @@ pub(super) fn estimate_vs_truth_markdown(md: &mut String, scene: &SceneResult) {
     let _ = writeln!(
         md,
         "\n### Estimate against truth\n\n\
-         `spectrace estimate` (a pilot per estimator) predicts the time to {:.0}%; then a render \
-         with `--target-error {}` by `{}` (auto's pick, capped at {ESTIMATE_CAP_SECONDS:.0} s) \
-         ends with its own error estimate, compared with its error against the reference.\n",
+         `spectrace estimate` (a pilot per estimator) predicts the time to {:.0}% `{}`; then a \
+         render with `--target-error {}` by `{}` (auto's pick, capped at \
+         {ESTIMATE_CAP_SECONDS:.0} s) ends with its own error estimate, compared with its error \
+         against the reference ({}).\n",
         check.target * 100.0,
+        check.measure.name(),
         check.target,
-        check.integrator.name()
+        check.integrator.name(),
+        reference_text(scene, check),
     );
     let _ = writeln!(md, "{}", spectrace_renderer::pilot::markdown(&check.pilot));
     let truth = corrected_truth(scene, check);
@@ -427,6 +455,20 @@ pub(super) fn estimate_vs_truth_markdown(md: &mut String, scene: &SceneResult) {
     );
 }
 
+/// Which reference a check's truth is measured against.
+fn reference_text(scene: &SceneResult, check: &EstimateCheck) -> String {
+    if check.reference_paths > scene.reference.beams {
+        format!(
+            "a deeper one for this check, {} paths, whose own estimated error {} is taken out in \
+             quadrature",
+            check.reference_paths,
+            check.reference_error.get(check.measure).map_or("-".to_owned(), percent)
+        )
+    } else {
+        format!("the sweep's, {} paths", scene.reference.beams)
+    }
+}
+
 /// The estimate check of every scene in one table.
 pub(super) fn estimate_summary_markdown(md: &mut String, report: &AccuracyReport) {
     let checked: Vec<(&SceneResult, &EstimateCheck)> =
@@ -437,24 +479,30 @@ pub(super) fn estimate_summary_markdown(md: &mut String, report: &AccuracyReport
     let _ = writeln!(
         md,
         "\n## Does the renderer know its own error?\n\n\
-         Per scene, a render with `--target-error {target}` by the estimator auto picks (capped at \
-         {ESTIMATE_CAP_SECONDS:.0} s): its own final error estimate (from the spread between its \
-         chunks) against its true error (against the reference, with the reference's own noise \
-         taken out in quadrature), and its time against the time `spectrace estimate` predicted \
-         from a pilot before it. The goals: estimate / truth within 20% and measured / \
-         predicted time within 35%. Last column: the pilot's recommendation beside auto's pick.\n\n\
-         | scene | estimator | estimated error | true error | estimate / truth | predicted time | \
-         measured time | measured / predicted | pilot recommends |\n|---|---|---|---|---|---|---|---|---|",
-        target = ESTIMATE_TARGET
+         Per scene, a render with `--target-error {target}` in `{measure}` (the renderer's default \
+         measure) by the estimator auto picks (capped at {ESTIMATE_CAP_SECONDS:.0} s): its own \
+         final error estimate (from the spread between its chunks) against its true error \
+         (against a reference of at least {CHECK_REFERENCE_FACTOR} times its paths, the sweep's \
+         or a deeper one rendered for the check, with that reference's own estimated error taken \
+         out in quadrature), and its time against the time `spectrace estimate` predicted from a \
+         pilot before it. The goals: estimate / truth within 20% and measured / predicted time \
+         within 35%. Last column: the pilot's recommendation beside auto's pick.\n\n\
+         | scene | estimator | paths | reference paths | estimated error | true error | \
+         estimate / truth | predicted time | measured time | measured / predicted | pilot \
+         recommends |\n|---|---|---:|---:|---|---|---|---|---|---|---|",
+        target = checked[0].1.target,
+        measure = checked[0].1.measure.name(),
     );
     for (scene, check) in checked {
         let truth = corrected_truth(scene, check);
         let predicted = check.prediction().and_then(|p| p.predicted_seconds);
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} | {} | {} | {} s{} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} s{} | {} | {} |",
             scene.name,
             check.integrator.name(),
+            check.paths,
+            check.reference_paths.max(scene.reference.beams),
             check.estimated_error.map_or("-".to_owned(), percent),
             truth.map_or("below the reference's noise".to_owned(), percent),
             match (check.estimated_error, truth) {
@@ -487,18 +535,24 @@ pub(super) fn measures_summary_markdown(md: &mut String, report: &AccuracyReport
     let _ = writeln!(
         md,
         "\n## The same renders in every error measure\n\n\
-         The renders of the table above (stopped by the `energy` estimate), with their own \
-         final estimate and their error against the reference in each measure the renderer \
-         reports: `relmse` (per-pixel relative error, the renderer's default), `energy` (the \
-         headline above) and `mean` (RMSE over the image's mean). The true errors here still \
-         hold the reference's own noise: for the same estimator it adds about \
-         `sqrt(paths / reference paths)` of the render's error in quadrature (the last column).\n\n\
+         The renders of the table above (stopped by the `{measure}` estimate), with their own \
+         final estimate and their true error (against the reference, its own estimated error \
+         taken out in quadrature where it was rendered for the check) in each measure the \
+         renderer reports: `relmse` (per-pixel relative error, the renderer's default), `energy` \
+         (relative RMSE weighted by energy, dominated by the brightest pixels) and `mean` (RMSE \
+         over the image's mean), with estimate / truth in brackets.\n\n\
          | scene | estimator | paths / reference paths | relmse: estimated, true | energy: \
-         estimated, true | mean: estimated, true |\n|---|---|---|---|---|---|"
+         estimated, true | mean: estimated, true |\n|---|---|---|---|---|---|",
+        measure = checked[0].1.measure.name(),
     );
     for (scene, check) in checked {
         let cell = |m: ErrorMeasure| {
-            let (e, t) = (check.estimated_by_measure.get(m), check.true_by_measure.get(m));
+            let t = if check.reference_paths > 0 {
+                check.corrected_truth(m)
+            } else {
+                check.true_by_measure.get(m)
+            };
+            let e = check.estimated_by_measure.get(m);
             format!(
                 "{}, {} ({})",
                 e.map_or("-".to_owned(), percent),
@@ -514,7 +568,7 @@ pub(super) fn measures_summary_markdown(md: &mut String, report: &AccuracyReport
             "| {} | {} | {} | {} | {} | {} |",
             scene.name,
             check.integrator.name(),
-            sig(check.paths as f64 / scene.reference.beams.max(1) as f64),
+            sig(check.paths as f64 / check.reference_paths.max(scene.reference.beams).max(1) as f64),
             cell(ErrorMeasure::RelMse),
             cell(ErrorMeasure::Energy),
             cell(ErrorMeasure::Mean),

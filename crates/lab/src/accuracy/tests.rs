@@ -185,6 +185,7 @@ fn error_falls_with_beams_and_the_report_is_written() {
         max_width: None,
         configurations: Configuration::ALL.to_vec(),
         estimate_check: true,
+        estimate_target: 0.3,
     };
     let report = run(&options).unwrap();
     let scene = &report.scenes[0];
@@ -213,12 +214,15 @@ fn error_falls_with_beams_and_the_report_is_written() {
     assert!(e > 0.0 && (e / t) > 0.5 && (e / t) < 1.5, "estimate {e}, truth {t}");
     assert!(md.contains("## Does the renderer know its own error?"), "{md}");
     assert!(md.contains("### Estimate against truth"), "{md}");
-    // The same render in every measure: its energy cells are the headline's, and every sweep
+    // The same render in every measure: its relmse cells are the headline's, and every sweep
     // point records relmse, which the plot shows (larger than energy on this scene's dim
     // floor, as the brightest pixels rule energy).
-    assert_eq!(check.true_by_measure.energy, Some(t));
-    assert_eq!(check.estimated_by_measure.energy, Some(e));
-    assert!(check.true_by_measure.relmse.is_some_and(|r| r > 0.0));
+    assert_eq!(check.measure, ErrorMeasure::RelMse);
+    assert_eq!(check.true_by_measure.relmse, Some(t));
+    assert_eq!(check.estimated_by_measure.relmse, Some(e));
+    assert!(check.true_by_measure.energy.is_some_and(|r| r > 0.0 && r < t));
+    // The check's reference has at least CHECK_REFERENCE_FACTOR times its paths.
+    assert!(check.reference_paths >= CHECK_REFERENCE_FACTOR * check.paths, "{check:?}");
     let row = md
         .split("## The same renders in every error measure")
         .nth(1)
@@ -265,6 +269,7 @@ fn the_integrator_knob_sweeps_every_estimator_against_an_unbiased_reference() {
         max_width: None,
         configurations: Configuration::INTEGRATORS.to_vec(),
         estimate_check: false,
+        estimate_target: 0.3,
     };
     let report = run(&options).unwrap();
     let result = &report.scenes[0];
