@@ -500,7 +500,11 @@ fn split_terms(
     let own = denominator(i, v);
     let square = |hi: f64, hv: f64| {
         let r = hv / (hi * hi);
-        if r < SPLIT_TRUST { (denominator(hi, hv) * (1.0 + 4.0 * r)).max(own * SPLIT_FLOOR) } else { own }
+        if r < SPLIT_TRUST {
+            (denominator(hi, hv) * (1.0 + 4.0 * r)).max(own * SPLIT_FLOOR)
+        } else {
+            own
+        }
     };
     let (da, db) = (square(ia, va * ra), square(ib, vb * rb));
     [va / (db + eps2), vb / (da + eps2)]
