@@ -6,6 +6,9 @@ pub(super) const CACHE_MAGIC: &[u8; 8] = b"SPXYZREF";
 pub(super) const CACHE_VERSION: u32 = 3;
 pub(super) const CACHE_HEADER: usize = 8 + 4 + 4 + 4 + 8 + 8;
 
+/// Largest `.error` file read: three numbers as text.
+const ERRORS_BYTES: u64 = 256;
+
 /// FNV-1a over the scene file and the reference's settings (and the crate version, so a changed
 /// tracer renders a new reference).
 pub(super) fn cache_key(
@@ -55,11 +58,26 @@ pub(super) fn write_reference(
     std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
 }
 
-/// The cached image and its render time, if the file exists and matches the size.
-pub(super) fn read_reference(path: &Path, width: u32, height: u32) -> Option<(Vec<Xyz>, f64)> {
-    let bytes = std::fs::read(path).ok()?;
+/// A cached reference: its image, render time and paths.
+pub(super) struct Cached {
+    /// The image.
+    pub image: Vec<Xyz>,
+    /// Its render time (s).
+    pub seconds: f64,
+    /// Its paths.
+    pub paths: u64,
+}
+
+/// The cached image with its render time and paths, if the file exists and matches the size
+/// (any other length, checked before reading, is not read).
+pub(super) fn read_reference(path: &Path, width: u32, height: u32) -> Option<Cached> {
     let pixels = width as usize * height as usize;
-    if bytes.len() != CACHE_HEADER + pixels * 24 || &bytes[..8] != CACHE_MAGIC {
+    let expected = CACHE_HEADER + pixels * 24;
+    if std::fs::metadata(path).ok()?.len() != expected as u64 {
+        return None;
+    }
+    let bytes = std::fs::read(path).ok()?;
+    if bytes.len() != expected || &bytes[..8] != CACHE_MAGIC {
         return None;
     }
     let u32_at = |i: usize| bytes.get(i..i + 4)?.try_into().ok().map(u32::from_le_bytes);
@@ -67,6 +85,7 @@ pub(super) fn read_reference(path: &Path, width: u32, height: u32) -> Option<(Ve
     if u32_at(8)? != CACHE_VERSION || u32_at(12)? != width || u32_at(16)? != height {
         return None;
     }
+    let paths = u64::from_le_bytes(bytes.get(20..28)?.try_into().ok()?);
     let seconds = f64_at(28)?;
     let image = (0..pixels)
         .map(|i| {
@@ -74,7 +93,7 @@ pub(super) fn read_reference(path: &Path, width: u32, height: u32) -> Option<(Ve
             Some(Xyz::new(f64_at(at)?, f64_at(at + 8)?, f64_at(at + 16)?))
         })
         .collect::<Option<Vec<_>>>()?;
-    Some((image, seconds))
+    Some(Cached { image, seconds, paths })
 }
 
 /// The estimate check's reference of at least `paths` paths ([`check::CHECK_REFERENCE_FACTOR`]
@@ -100,11 +119,10 @@ pub(super) fn deep_reference(
     let key = cache_key(scene_text, integrator, paths, seed, width, height);
     let file = options.cache_dir.join(format!("{name}-check-{key:016x}.xyz"));
     let error_file = file.with_extension("xyz.error");
-    let cached = read_reference(&file, width, height)
-        .zip(std::fs::read_to_string(&error_file).ok().and_then(|t| parse_errors(&t)));
-    if let Some(((image, _), own_error)) = cached {
-        eprintln!("accuracy: {name}: check reference {paths} paths from the cache");
-        return Ok(check::CheckReference { image, own_error, paths });
+    let cached = read_reference(&file, width, height).zip(read_errors(&error_file));
+    if let Some((cached, own_error)) = cached {
+        eprintln!("accuracy: {name}: check reference {} paths from the cache", cached.paths);
+        return Ok(check::CheckReference { image: cached.image, own_error, paths: cached.paths });
     }
     eprintln!(
         "accuracy: {name}: rendering the check reference, {paths} paths by {}...",
@@ -134,8 +152,13 @@ pub(super) fn deep_reference(
     Ok(check::CheckReference { image: render.image, own_error, paths })
 }
 
-/// The three numbers of a `.error` file (relmse, energy, mean; `-` for none).
-fn parse_errors(text: &str) -> Option<ByMeasure> {
+/// The three numbers of a `.error` file (relmse, energy, mean; `-` for none); `None` for a
+/// missing, malformed or oversized file (at most [`ERRORS_BYTES`], checked before reading).
+fn read_errors(path: &Path) -> Option<ByMeasure> {
+    if std::fs::metadata(path).ok()?.len() > ERRORS_BYTES {
+        return None;
+    }
+    let text = std::fs::read_to_string(path).ok()?;
     let v: Vec<Option<f64>> = text.split_whitespace().map(|w| w.parse().ok()).collect();
     let [relmse, energy, mean] = v.as_slice().try_into().ok()?;
     Some(ByMeasure { relmse, energy, mean })

@@ -424,13 +424,13 @@ fn run_scene(
     );
     let cache_file = options.cache_dir.join(format!("{name}-{key:016x}.xyz"));
     let (reference, reference_seconds, cached) = match read_reference(&cache_file, width, height) {
-        Some((image, seconds)) => {
+        Some(cached) => {
             eprintln!(
                 "accuracy: {name}: reference {} beams from the cache ({})",
-                options.reference_beams,
+                cached.paths,
                 cache_file.display()
             );
-            (image, seconds, true)
+            (cached.image, cached.seconds, true)
         }
         None => {
             eprintln!(

@@ -10,7 +10,7 @@
 //!
 //! The module's parts: [`ExactSum`] (`exact.rs`), the [`Splat`] trait and [`spectral_xyz`]
 //! (`splat.rs`), the [`Film`] itself (`buffer.rs`), a thread's buffered [`FilmWriter`]
-//! (`writer.rs`), the chunk [`Moments`] behind the live error estimate (`moments.rs`), the [`ErrorMeasure`]s it reports in (`measure.rs`) and the
+//! (`writer.rs`), the chunk [`Moments`] behind the live error estimate (`moments/`, its tests in `moments/tests.rs`), the [`ErrorMeasure`]s it reports in (`measure.rs`) and the
 //! pixel-count and size checks every buffer shares (`raster.rs`).
 
 mod buffer;
