@@ -220,6 +220,8 @@ fn pilot(
                 && let Some(r) = e.relative_error
                 && e.batches >= MIN_PILOT_CHUNKS
                 && let Ok(mut v) = live.lock()
+                // The live estimate is redone every few chunks: each enters the fit once.
+                && v.last().is_none_or(|&(_, n, _)| n != e.items)
             {
                 v.push((p.seconds, e.items, r));
             }

@@ -63,6 +63,7 @@ mod configuration;
 mod gains;
 mod knobs;
 mod plot;
+mod relmse;
 mod report;
 
 use std::path::{Path, PathBuf};

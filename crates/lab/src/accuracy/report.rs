@@ -221,14 +221,17 @@ pub fn markdown(report: &AccuracyReport) -> String {
     measures_summary_markdown(&mut md, report);
     if o.configurations.iter().any(|c| c.integrator() != IntegratorChoice::Light) {
         integrators_markdown(&mut md, report);
+        super::relmse::relmse_markdown(&mut md, report);
     }
     super::gains::gains_markdown(&mut md, report);
     let _ = writeln!(
         md,
-        "\n![relative RMSE against wall time, log-log](accuracy.svg)\n\n\
-         *Relative RMSE of XYZ against wall time (log-log), one panel per scene, one line per configuration; \
-         the legend gives each line's fitted slope against time; dashed: slope -1/2; dotted: the \
-         10% and 2% targets.*\n"
+        "\n![per-pixel relative error against wall time, log-log](accuracy.svg)\n\n\
+         *Per-pixel relative error (`relmse`) against the reference, against wall time (log-log), \
+         one panel per scene, one line per configuration; the legend gives each line's fitted \
+         slope against time; dashed: slope -1/2; dotted: the 10% and 2% targets. The errors \
+         include the reference's own noise (the section above gives it per scene): lines flatten \
+         as they approach it.*\n"
     );
     for scene in &report.scenes {
         scene_markdown(&mut md, scene);

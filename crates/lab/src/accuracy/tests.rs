@@ -596,3 +596,39 @@ fn scene_result(
         configurations,
     }
 }
+
+#[test]
+fn the_relmse_time_takes_the_references_noise_out_and_scales_by_the_square() {
+    use super::relmse::{RelmseReach, relmse_reach};
+    let point = |seconds: f64, relmse: f64| AccuracyPoint {
+        beams: 1,
+        seed: 0,
+        seconds,
+        relative_rmse: relmse / 4.0,
+        mean_ratio: 1.0,
+        colour_rmse: 0.0,
+        relmse,
+    };
+    let result = |configuration, last: AccuracyPoint| ConfigurationResult {
+        configuration,
+        changed: String::new(),
+        not_applicable: None,
+        known_bias: None,
+        points: vec![point(last.seconds / 4.0, 2.0 * last.relmse), last],
+        slope_vs_time: Some(-0.5),
+        slope_vs_beams: Some(-0.5),
+    };
+    // 50% against a reference of 30% own noise: 40% true at 2 s, so 10% at 2 * 16 = 32 s.
+    let path = result(Configuration::Path, point(2.0, 0.5));
+    // Within 1.5 times the reference's noise: not measurable.
+    let bdpt = result(Configuration::Bdpt, point(2.0, 0.4));
+    let mut light = result(Configuration::Baseline, point(1.0, 0.5));
+    light.known_bias = Some("black mirrors".to_owned());
+    let scene =
+        scene_result(IntegratorChoice::Path, 1, vec![path.clone(), bdpt.clone(), light.clone()]);
+    let reach = |r: &ConfigurationResult| relmse_reach(&scene, Some(r), 0.3, 0.1);
+    assert!(matches!(reach(&path), RelmseReach::Predicted(t) if (t - 32.0).abs() < 1e-9));
+    assert_eq!(reach(&bdpt), RelmseReach::AtReferenceNoise(0.4));
+    assert_eq!(reach(&light), RelmseReach::Biased);
+    assert_eq!(relmse_reach(&scene, None, 0.3, 0.1), RelmseReach::Missing);
+}

@@ -272,3 +272,35 @@ fn a_tally_lists_each_pixel_once_even_when_its_sum_returns_to_zero() {
         assert!((q - (2.0 * row[0]).powi(2) / 2.0).abs() < 1e-12);
     }
 }
+
+#[test]
+fn channels_within_their_noise_of_zero_do_not_explode_the_estimate() {
+    // 2000 pixels whose three linear-sRGB channels (a saturated colour's, which single-
+    // wavelength paths scatter on both sides of 0) have normal chunk values of deviation 1
+    // about a mean 2.5 standard errors of the image from 0: the truth is 1 / 2.5 = 0.4.
+    // Denominators that fall to `I² / 2` near 0 estimated 1.69 (4.2 times the truth); with
+    // `VARIANCE_FLOOR`, 0.61: bounded, and above the truth by what the floor is simulated to
+    // give at most on such channels (2.5 in squares, 1.6 in the relmse).
+    let (pixels, chunks, k) = (2000u32, 128u64, 2.5);
+    let to_xyz = glam::DMat3::from_cols_array_2d(&srgb_rows()).transpose().inverse();
+    let mean = k / (chunks as f64).sqrt();
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(17);
+    let mut normal = || {
+        let (u, v): (f64, f64) = (1.0 - rng.random::<f64>(), rng.random());
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    };
+    let mut m = Moments::new(pixels, 1).unwrap();
+    for c in 0..chunks {
+        let values: Vec<(usize, [f64; 3])> = (0..pixels as usize)
+            .map(|p| {
+                let rgb = glam::DVec3::new(mean + normal(), mean + normal(), mean + normal());
+                (p, (to_xyz * rgb).to_array())
+            })
+            .collect();
+        m.add_chunk(c, values, 1);
+    }
+    let e = m.estimate(ErrorMeasure::RelMse).relative_error.unwrap();
+    let truth = 1.0 / k;
+    eprintln!("estimated {e}, true {truth}");
+    assert!((truth / 1.25..truth * 1.6).contains(&e), "{e} against {truth}");
+}
