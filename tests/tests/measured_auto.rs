@@ -31,6 +31,10 @@ fn auto_measures_the_estimators_that_see_everything_when_the_render_is_open_ende
     assert_eq!(pilot_budget(&diffuse, &timed, &plan(&timed)), Some(PILOT_SHARE * 4.0));
     let target = RenderOptions { target_error: Some(0.1), ..RenderOptions::default() };
     assert_eq!(pilot_budget(&diffuse, &target, &plan(&target)), Some(PILOT_SECONDS));
+    // A time given with a target is a cap: the target's pilot time, or the share if smaller.
+    let capped = |t: f64| RenderOptions { time: Some(t), ..target.clone() };
+    assert_eq!(pilot_budget(&diffuse, &capped(300.0), &plan(&capped(300.0))), Some(PILOT_SECONDS));
+    assert_eq!(pilot_budget(&diffuse, &capped(4.0), &plan(&capped(4.0))), Some(PILOT_SHARE * 4.0));
     for (what, o) in [
         ("a fixed count", RenderOptions { spp: Some(4), ..timed.clone() }),
         ("a fixed count", RenderOptions { beams: Some(1000), ..timed.clone() }),

@@ -12,7 +12,9 @@
 //!
 //! # What it costs
 //! The pilots together take [`PILOT_SHARE`] of a `--time` budget (which the render then has that
-//! much less of), or [`PILOT_SECONDS`] when only a target error bounds the render; the time is
+//! much less of), or [`PILOT_SECONDS`] when a target error bounds the render (at most that share
+//! of a `--time` given as its cap: a render that reaches its target in a fraction of a second
+//! under a cap of minutes once waited 11 s for its pilots); the time is
 //! split evenly between the candidates. Each pilot renders at least one chunk per thread, and a
 //! camera estimator's chunk is a pass over the image, so the pilots render the scene with its
 //! camera scaled down to at most [`PILOT_PIXELS`] pixels (same view and aspect; the scene is
@@ -81,7 +83,8 @@ pub fn pilot_budget(scene: &Scene, options: &RenderOptions, plan: &RenderPlan) -
         return None;
     }
     match (options.time, plan.target_error) {
-        (Some(t), _) => Some(PILOT_SHARE * t),
+        (Some(t), None) => Some(PILOT_SHARE * t),
+        (Some(t), Some(_)) => Some((PILOT_SHARE * t).min(PILOT_SECONDS)),
         (None, Some(_)) => Some(PILOT_SECONDS),
         (None, None) => None,
     }
