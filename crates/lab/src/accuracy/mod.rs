@@ -498,9 +498,10 @@ fn run_scene(
             let relmse = relative_error(ErrorMeasure::RelMse, &xyz, &reference)?;
             eprintln!(
                 "accuracy: {name}: {:<22} {beams:>10} paths {seconds:>8.3} s  error {:.3}%  \
-                 mean Y {mean_ratio:.3}x the reference",
+                 relmse {:.3}%  mean Y {mean_ratio:.3}x the reference",
                 p.configuration.name(),
-                relative_rmse * 100.0
+                relative_rmse * 100.0,
+                relmse * 100.0
             );
             points[c].push(AccuracyPoint {
                 beams,
