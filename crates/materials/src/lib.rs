@@ -24,6 +24,11 @@
 //! Cu Ni Pt Ti W, 350-850 nm, sources in `data/metals/README.md`) or from user `eta` / `k` tables
 //! ([`ComplexIor`]).
 //!
+//! The microfacet core is [`Ggx`] (the distribution every rough material uses today) and
+//! [`Beckmann`] (Mitsuba 3's default, with the exact Smith `Lambda` and exact visible-normal
+//! sampling, chi-square tested; not yet selectable by a material), each with `d`, `lambda`,
+//! `g1`, `g`, `pdf_visible` and `sample_visible`.
+//!
 //! The key design decision is that every property is a function of wavelength, evaluated per
 //! beam: reflectances are [`Reflectance`](spectrace_spectrum::Reflectance) spectra and indices of
 //! refraction are [`Ior`] laws (constant, Sellmeier, Cauchy, tabulated, or a named glass from
@@ -48,6 +53,7 @@
 //! assert!(glass.is_specular() && glass.is_dispersive());
 //! ```
 
+mod beckmann;
 mod conductor;
 mod dielectric;
 mod diffuse;
@@ -64,6 +70,7 @@ mod plastic;
 mod rough_dielectric;
 mod vectors;
 
+pub use beckmann::Beckmann;
 pub use conductor::{Conductor, RoughConductor};
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
