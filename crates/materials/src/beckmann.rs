@@ -30,7 +30,7 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 
-use crate::microfacet::SMOOTH_ALPHA;
+use crate::microfacet::{Microfacet, SMOOTH_ALPHA};
 
 /// Beckmann microfacet distribution, anisotropic along the local axes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -55,9 +55,11 @@ impl Beckmann {
     pub fn alpha_y(&self) -> f64 {
         self.alpha_y
     }
+}
 
+impl Microfacet for Beckmann {
     /// The distribution of normals `D(m)` (sr^-1, projected so that `integral D(m) m.z dm = 1`).
-    pub fn d(&self, m: DVec3) -> f64 {
+    fn d(&self, m: DVec3) -> f64 {
         if !(m.z > 0.0) {
             return 0.0;
         }
@@ -69,7 +71,7 @@ impl Beckmann {
 
     /// Smith's `Lambda(w)` for the Beckmann distribution; 0 at normal incidence, infinite at
     /// grazing (`f64::INFINITY`, which makes `G1` and `G` exactly 0).
-    pub fn lambda(&self, w: DVec3) -> f64 {
+    fn lambda(&self, w: DVec3) -> f64 {
         let t = (self.alpha_x * self.alpha_x * w.x * w.x + self.alpha_y * self.alpha_y * w.y * w.y)
             .sqrt();
         if t == 0.0 {
@@ -83,29 +85,9 @@ impl Beckmann {
         l.max(0.0)
     }
 
-    /// Smith masking `G1(w) = 1 / (1 + Lambda(w))`, in `[0, 1]`.
-    pub fn g1(&self, w: DVec3) -> f64 {
-        1.0 / (1.0 + self.lambda(w))
-    }
-
-    /// Height-correlated masking-shadowing `G(wo, wi) = 1 / (1 + Lambda(wo) + Lambda(wi))`.
-    pub fn g(&self, wo: DVec3, wi: DVec3) -> f64 {
-        1.0 / (1.0 + self.lambda(wo) + self.lambda(wi))
-    }
-
-    /// Density of [`sample_visible`](Self::sample_visible) drawing the normal `m` as seen from
-    /// `w` (`w.z > 0`): `D_w(m) = G1(w) max(0, w.m) D(m) / w.z` (sr^-1).
-    pub fn pdf_visible(&self, w: DVec3, m: DVec3) -> f64 {
-        if !(w.z > 0.0) {
-            return 0.0;
-        }
-        let p = self.g1(w) * w.dot(m).max(0.0) * self.d(m) / w.z;
-        if p.is_finite() { p } else { 0.0 }
-    }
-
     /// A microfacet normal visible from `w` (`w.z > 0`, unit), drawn with density
     /// [`pdf_visible`](Self::pdf_visible) from two uniforms. The result has `m.z > 0`.
-    pub fn sample_visible(&self, w: DVec3, u: [f64; 2]) -> DVec3 {
+    fn sample_visible(&self, w: DVec3, u: [f64; 2]) -> DVec3 {
         // Stretch to the isotropic alpha = 1 configuration.
         let ws = DVec3::new(self.alpha_x * w.x, self.alpha_y * w.y, w.z.max(0.0)).normalize();
         let sin = (ws.x * ws.x + ws.y * ws.y).sqrt();

@@ -60,7 +60,7 @@ use spectrace_spectrum::Reflectance;
 
 use crate::fresnel::reflect;
 use crate::metals::ComplexIor;
-use crate::microfacet::{alphas_from_keys, alphas_to_keys, check_alpha};
+use crate::microfacet::{Microfacet, alphas_from_keys, alphas_to_keys, check_alpha};
 use crate::vectors::{facing, normalise};
 use crate::{
     BundleScattered, Ggx, Incoming, Material, MaterialError, ScatterKind, Scattered, Transport,

@@ -24,10 +24,10 @@
 //! Cu Ni Pt Ti W, 350-850 nm, sources in `data/metals/README.md`) or from user `eta` / `k` tables
 //! ([`ComplexIor`]).
 //!
-//! The microfacet core is [`Ggx`] (the distribution every rough material uses today) and
-//! [`Beckmann`] (Mitsuba 3's default, with the exact Smith `Lambda` and exact visible-normal
-//! sampling, chi-square tested; not yet selectable by a material), each with `d`, `lambda`,
-//! `g1`, `g`, `pdf_visible` and `sample_visible`.
+//! The microfacet core is the [`Microfacet`] trait (`d`, `lambda` and `sample_visible`, from
+//! which `g1`, `g` and `pdf_visible` follow) with [`Ggx`] (the distribution every rough material
+//! uses today) and [`Beckmann`] (Mitsuba 3's default, with the exact Smith `Lambda` and exact
+//! visible-normal sampling, chi-square tested; not yet selectable by a material).
 //!
 //! The key design decision is that every property is a function of wavelength, evaluated per
 //! beam: reflectances are [`Reflectance`](spectrace_spectrum::Reflectance) spectra and indices of
@@ -84,7 +84,7 @@ pub use material::{
     scatter_each,
 };
 pub use metals::{ComplexIor, Metal, find_metal, known_metals};
-pub use microfacet::{Ggx, SMOOTH_ALPHA, fresnel_conductor};
+pub use microfacet::{Ggx, Microfacet, SMOOTH_ALPHA, fresnel_conductor};
 pub use mirror::Mirror;
 pub use plastic::Plastic;
 pub use rough_dielectric::RoughDielectric;

@@ -30,6 +30,41 @@ use crate::MaterialError;
 /// lobe is then narrower than `1e-3` rad, where its `D` would overflow towards a delta.
 pub const SMOOTH_ALPHA: f64 = 1e-3;
 
+/// A microfacet distribution of normals with Smith shadowing: what a rough material needs of
+/// it. Implementors give `D`, `Lambda` and a visible-normal sampler; masking, shadowing and the
+/// sampler's density follow from them.
+pub trait Microfacet {
+    /// The distribution of normals `D(m)` (sr^-1, projected so that `integral D(m) m.z dm = 1`).
+    fn d(&self, m: DVec3) -> f64;
+
+    /// Smith's `Lambda(w)`; 0 at normal incidence, `f64::INFINITY` at grazing.
+    fn lambda(&self, w: DVec3) -> f64;
+
+    /// A normal visible from `w` (`w.z > 0`, unit), drawn with density
+    /// [`pdf_visible`](Self::pdf_visible) from two uniforms; `m.z >= 0`.
+    fn sample_visible(&self, w: DVec3, u: [f64; 2]) -> DVec3;
+
+    /// Smith masking `G1(w) = 1 / (1 + Lambda(w))`, in `[0, 1]`.
+    fn g1(&self, w: DVec3) -> f64 {
+        1.0 / (1.0 + self.lambda(w))
+    }
+
+    /// Height-correlated masking-shadowing `G(wo, wi) = 1 / (1 + Lambda(wo) + Lambda(wi))`.
+    fn g(&self, wo: DVec3, wi: DVec3) -> f64 {
+        1.0 / (1.0 + self.lambda(wo) + self.lambda(wi))
+    }
+
+    /// Density of [`sample_visible`](Self::sample_visible) drawing the normal `m` as seen from
+    /// `w` (`w.z > 0`): `D_w(m) = G1(w) max(0, w.m) D(m) / w.z` (sr^-1).
+    fn pdf_visible(&self, w: DVec3, m: DVec3) -> f64 {
+        if !(w.z > 0.0) {
+            return 0.0;
+        }
+        let p = self.g1(w) * w.dot(m).max(0.0) * self.d(m) / w.z;
+        if p.is_finite() { p } else { 0.0 }
+    }
+}
+
 /// Trowbridge-Reitz (GGX) microfacet distribution, anisotropic along the local axes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ggx {
@@ -59,9 +94,11 @@ impl Ggx {
     pub fn alpha_y(&self) -> f64 {
         self.alpha_y
     }
+}
 
+impl Microfacet for Ggx {
     /// The distribution of normals `D(m)` (sr^-1, projected so that `integral D(m) m.z dm = 1`).
-    pub fn d(&self, m: DVec3) -> f64 {
+    fn d(&self, m: DVec3) -> f64 {
         if !(m.z > 0.0) {
             return 0.0;
         }
@@ -73,7 +110,7 @@ impl Ggx {
 
     /// Smith's `Lambda(w)` for the GGX distribution; 0 at normal incidence, infinite at grazing
     /// (returned as `f64::INFINITY`, which makes `G1` and `G` exactly 0).
-    pub fn lambda(&self, w: DVec3) -> f64 {
+    fn lambda(&self, w: DVec3) -> f64 {
         let z2 = w.z * w.z;
         let t = self.alpha_x * self.alpha_x * w.x * w.x + self.alpha_y * self.alpha_y * w.y * w.y;
         if z2 == 0.0 {
@@ -84,31 +121,11 @@ impl Ggx {
         0.5 * a2_tan2 / ((1.0 + a2_tan2).sqrt() + 1.0)
     }
 
-    /// Smith masking `G1(w) = 1 / (1 + Lambda(w))`, in `[0, 1]`.
-    pub fn g1(&self, w: DVec3) -> f64 {
-        1.0 / (1.0 + self.lambda(w))
-    }
-
-    /// Height-correlated masking-shadowing `G(wo, wi) = 1 / (1 + Lambda(wo) + Lambda(wi))`.
-    pub fn g(&self, wo: DVec3, wi: DVec3) -> f64 {
-        1.0 / (1.0 + self.lambda(wo) + self.lambda(wi))
-    }
-
-    /// Density of [`sample_visible`](Self::sample_visible) drawing the normal `m` as seen from
-    /// `w` (`w.z > 0`): `D_w(m) = G1(w) max(0, w.m) D(m) / w.z` (sr^-1).
-    pub fn pdf_visible(&self, w: DVec3, m: DVec3) -> f64 {
-        if !(w.z > 0.0) {
-            return 0.0;
-        }
-        let p = self.g1(w) * w.dot(m).max(0.0) * self.d(m) / w.z;
-        if p.is_finite() { p } else { 0.0 }
-    }
-
     /// A microfacet normal visible from `w` (`w.z > 0`, unit), drawn with density
     /// [`pdf_visible`](Self::pdf_visible) from two uniforms (Heitz 2018: the visible
     /// hemisphere of the stretched configuration, sampled as a projected disk). The result has
     /// `m.z >= 0` and `w.m >= 0`.
-    pub fn sample_visible(&self, w: DVec3, u: [f64; 2]) -> DVec3 {
+    fn sample_visible(&self, w: DVec3, u: [f64; 2]) -> DVec3 {
         // Stretch to the configuration where the distribution is the unit hemisphere.
         let wh = DVec3::new(self.alpha_x * w.x, self.alpha_y * w.y, w.z).normalize();
         let len2 = wh.x * wh.x + wh.y * wh.y;

@@ -65,7 +65,7 @@ use spectrace_sampling::{Frame, clamp_uniform, sample_cosine_hemisphere};
 
 use crate::fresnel::fresnel_dielectric;
 use crate::ior::IorRepr;
-use crate::microfacet::check_alpha;
+use crate::microfacet::{Microfacet, check_alpha};
 use crate::vectors::normalise;
 use crate::{
     BundleScattered, Ggx, Incoming, Ior, Material, MaterialError, ScatterKind, Scattered,

@@ -64,7 +64,7 @@ use spectrace_sampling::{Frame, clamp_uniform};
 
 use crate::fresnel::{fresnel_dielectric, refract};
 use crate::ior::IorRepr;
-use crate::microfacet::{alphas_from_keys, alphas_to_keys, check_alpha};
+use crate::microfacet::{Microfacet, alphas_from_keys, alphas_to_keys, check_alpha};
 use crate::vectors::normalise;
 use crate::{
     BundleScattered, Dielectric, Ggx, Incoming, Ior, Material, MaterialError, ScatterKind,
