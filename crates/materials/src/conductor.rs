@@ -7,6 +7,7 @@
 //! | `eta`, `k` | `{"nm": [...], "values": [...]}`, each value finite and `> 0` | — | the complex index as two tables (instead of `metal`; both required) |
 //! | `roughness` | GGX alpha, finite, `>= 0` | required (RoughConductor only) | isotropic roughness; below [`SMOOTH_ALPHA`] (e.g. 0) the metal is smooth |
 //! | `roughness_u`, `roughness_v` | GGX alphas, finite, `>= 0` | — | anisotropic roughness along the first / second tangent (instead of `roughness`; both required) |
+//! | `distribution` | `"ggx"` or `"beckmann"` | `"ggx"` | the microfacet distribution (RoughConductor only; [`Distribution`]), with the roughness as its `alpha` |
 //! | `specular_reflectance` | fraction in `[0, 1]`, a number or `{"nm": [...], "values": [...]}`, or `null` | `null` (= 1) | multiplies the Fresnel reflectance (not physical; a tint or a dimmer) |
 //!
 //! Exactly one of `metal` or (`eta` and `k`) must be given; for a `RoughConductor` exactly one
@@ -25,7 +26,8 @@
 //! beam's wavelength (times `specular_reflectance`). The surrounding medium is vacuum.
 //!
 //! **Rough.** A [`RoughConductor`] is the single-scattering microfacet model (Walter et al.
-//! 2007) with the GGX distribution `D`, Smith's height-correlated masking-shadowing `G` and the
+//! 2007) with the GGX distribution `D` (or Beckmann's, [`crate::Beckmann`], with `"distribution":
+//! "beckmann"`; the albedo figures below are GGX's), Smith's height-correlated masking-shadowing `G` and the
 //! same Fresnel term: `f(wi, wo) = D(h) G(wi, wo) F(wi . h) / (4 |cos_i| |cos_o|)`, `h` the
 //! half vector. A scattered direction reflects a microfacet normal drawn from the *visible*
 //! normals seen from `wi` (Heitz 2018, [`Ggx::sample_visible`]), so the weight is
@@ -60,11 +62,11 @@ use spectrace_spectrum::Reflectance;
 
 use crate::fresnel::reflect;
 use crate::metals::ComplexIor;
-use crate::microfacet::{Microfacet, alphas_from_keys, alphas_to_keys, check_alpha};
+use crate::microfacet::{Facets, Microfacet, alphas_from_keys, alphas_to_keys, check_alpha};
 use crate::vectors::{facing, normalise};
 use crate::{
-    BundleScattered, Ggx, Incoming, Material, MaterialError, ScatterKind, Scattered, Transport,
-    scale_bundle,
+    BundleScattered, Distribution, Ggx, Incoming, Material, MaterialError, ScatterKind, Scattered,
+    Transport, scale_bundle,
 };
 
 /// The metal itself: its index and an optional reflectance factor (shared by both types).
@@ -213,7 +215,7 @@ pub struct RoughConductor {
     surface: Surface,
     alpha_u: f64,
     alpha_v: f64,
-    ggx: Ggx,
+    facets: Facets,
 }
 
 /// A direction the rough lobe sampled: where it goes, its density, the cosine the Fresnel term
@@ -305,8 +307,19 @@ impl RoughConductor {
             surface: Surface { ior, specular_reflectance },
             alpha_u,
             alpha_v,
-            ggx: Ggx::new(alpha_u, alpha_v),
+            facets: Facets::new(Distribution::Ggx, alpha_u, alpha_v),
         }
+    }
+
+    /// The same conductor with the microfacet distribution `kind` (GGX unless asked).
+    pub fn with_distribution(mut self, kind: Distribution) -> Self {
+        self.facets = Facets::new(kind, self.alpha_u, self.alpha_v);
+        self
+    }
+
+    /// The microfacet distribution.
+    pub fn distribution(&self) -> Distribution {
+        self.facets.kind()
     }
 
     /// The complex index of refraction.
@@ -348,15 +361,15 @@ impl RoughConductor {
         if !(wi.z > 0.0) {
             return None;
         }
-        let m = self.ggx.sample_visible(wi, [clamp_uniform(u[1]), clamp_uniform(u[2])]);
+        let m = self.facets.sample_visible(wi, [clamp_uniform(u[1]), clamp_uniform(u[2])]);
         let cos_m = wi.dot(m);
         let mut wo = normalise(2.0 * cos_m * m - wi);
         if !(cos_m > 0.0 && wo.z > 0.0) {
             return None;
         }
-        let (lambda_i, lambda_o) = (self.ggx.lambda(wi), self.ggx.lambda(wo));
+        let (lambda_i, lambda_o) = (self.facets.lambda(wi), self.facets.lambda(wo));
         let shadowing = (1.0 + lambda_i) / (1.0 + lambda_i + lambda_o);
-        let pdf = self.ggx.pdf_visible(wi, m) / (4.0 * cos_m);
+        let pdf = self.facets.pdf_visible(wi, m) / (4.0 * cos_m);
         if !(shadowing > 0.0 && shadowing <= 1.0 && pdf > 0.0 && pdf.is_finite()) {
             return None;
         }
@@ -371,7 +384,7 @@ impl RoughConductor {
     fn geometry(&self, wi: DVec3, wo: DVec3, normal: DVec3) -> Option<(f64, f64)> {
         let (a, b) = local_pair(wi, wo, normal)?;
         let (h, cos) = half_vector(a, b)?;
-        let value = self.ggx.d(h) * self.ggx.g(a, b) / (4.0 * a.z * b.z);
+        let value = self.facets.d(h) * self.facets.g(a, b) / (4.0 * a.z * b.z);
         (value > 0.0 && value.is_finite()).then_some((value, cos))
     }
 }
@@ -460,7 +473,7 @@ impl Material for RoughConductor {
         }
         let Some((a, b)) = local_pair(wi, wo, normal) else { return 0.0 };
         let Some((h, cos)) = half_vector(a, b) else { return 0.0 };
-        let p = self.ggx.pdf_visible(a, h) / (4.0 * cos);
+        let p = self.facets.pdf_visible(a, h) / (4.0 * cos);
         if p.is_finite() { p } else { 0.0 }
     }
 
@@ -596,6 +609,8 @@ struct RoughConductorRepr {
     roughness_v: Option<f64>,
     #[serde(default)]
     specular_reflectance: Option<Reflectance>,
+    #[serde(default)]
+    distribution: Distribution,
 }
 
 impl TryFrom<RoughConductorRepr> for RoughConductor {
@@ -610,7 +625,7 @@ impl TryFrom<RoughConductorRepr> for RoughConductor {
             r.roughness_v,
             "0 for a smooth metal",
         )?;
-        Self::new(ior, u, v, spec)
+        Ok(Self::new(ior, u, v, spec)?.with_distribution(r.distribution))
     }
 }
 
@@ -626,6 +641,7 @@ impl From<RoughConductor> for RoughConductorRepr {
             roughness_u,
             roughness_v,
             specular_reflectance: c.surface.specular_reflectance,
+            distribution: c.facets.kind(),
         }
     }
 }

@@ -27,7 +27,8 @@
 //! The microfacet core is the [`Microfacet`] trait (`d`, `lambda` and `sample_visible`, from
 //! which `g1`, `g` and `pdf_visible` follow) with [`Ggx`] (the distribution every rough material
 //! uses today) and [`Beckmann`] (Mitsuba 3's default, with the exact Smith `Lambda` and exact
-//! visible-normal sampling, chi-square tested; not yet selectable by a material).
+//! visible-normal sampling, chi-square tested; [`RoughConductor`] takes it with
+//! `"distribution": "beckmann"`, the other rough materials are GGX only so far).
 //!
 //! The key design decision is that every property is a function of wavelength, evaluated per
 //! beam: reflectances are [`Reflectance`](spectrace_spectrum::Reflectance) spectra and indices of
@@ -84,7 +85,7 @@ pub use material::{
     scatter_each,
 };
 pub use metals::{ComplexIor, Metal, find_metal, known_metals};
-pub use microfacet::{Ggx, Microfacet, SMOOTH_ALPHA, fresnel_conductor};
+pub use microfacet::{Distribution, Ggx, Microfacet, SMOOTH_ALPHA, fresnel_conductor};
 pub use mirror::Mirror;
 pub use plastic::Plastic;
 pub use rough_dielectric::RoughDielectric;

@@ -24,7 +24,9 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 
-use crate::MaterialError;
+use serde::{Deserialize, Serialize};
+
+use crate::{Beckmann, MaterialError};
 
 /// Below this alpha (in both directions) a surface is rendered as perfectly smooth: the GGX
 /// lobe is then narrower than `1e-3` rad, where its `D` would overflow towards a delta.
@@ -62,6 +64,66 @@ pub trait Microfacet {
         }
         let p = self.g1(w) * w.dot(m).max(0.0) * self.d(m) / w.z;
         if p.is_finite() { p } else { 0.0 }
+    }
+}
+
+/// Which microfacet distribution a rough material uses: `"distribution"` in a scene file,
+/// `"ggx"` (the default) or `"beckmann"` (Mitsuba 3's default), with the same `alpha`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Distribution {
+    /// Trowbridge-Reitz ([`Ggx`]).
+    #[default]
+    Ggx,
+    /// Beckmann ([`Beckmann`]).
+    Beckmann,
+}
+
+/// A distribution of either kind with its alphas: what a rough material holds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Facets {
+    Ggx(Ggx),
+    Beckmann(Beckmann),
+}
+
+impl Facets {
+    /// The `kind` of distribution with roughness `alpha_x` along `+x` and `alpha_y` along `+y`.
+    pub(crate) fn new(kind: Distribution, alpha_x: f64, alpha_y: f64) -> Self {
+        match kind {
+            Distribution::Ggx => Facets::Ggx(Ggx::new(alpha_x, alpha_y)),
+            Distribution::Beckmann => Facets::Beckmann(Beckmann::new(alpha_x, alpha_y)),
+        }
+    }
+
+    /// Which kind it is.
+    pub(crate) fn kind(&self) -> Distribution {
+        match self {
+            Facets::Ggx(_) => Distribution::Ggx,
+            Facets::Beckmann(_) => Distribution::Beckmann,
+        }
+    }
+}
+
+impl Microfacet for Facets {
+    fn d(&self, m: DVec3) -> f64 {
+        match self {
+            Facets::Ggx(f) => f.d(m),
+            Facets::Beckmann(f) => f.d(m),
+        }
+    }
+
+    fn lambda(&self, w: DVec3) -> f64 {
+        match self {
+            Facets::Ggx(f) => f.lambda(w),
+            Facets::Beckmann(f) => f.lambda(w),
+        }
+    }
+
+    fn sample_visible(&self, w: DVec3, u: [f64; 2]) -> DVec3 {
+        match self {
+            Facets::Ggx(f) => f.sample_visible(w, u),
+            Facets::Beckmann(f) => f.sample_visible(w, u),
+        }
     }
 }
 

@@ -12,8 +12,8 @@ use rand_pcg::Pcg64;
 use spectrace_materials::metals::metals;
 use spectrace_materials::spectrum::{CieIlluminant, Reflectance, SpectralPowerDistribution, cmf};
 use spectrace_materials::{
-    ComplexIor, Conductor, Incoming, Material, RoughConductor, ScatterKind, Transport,
-    fresnel_conductor,
+    ComplexIor, Conductor, Distribution, Incoming, Material, RoughConductor, ScatterKind,
+    Transport, fresnel_conductor,
 };
 
 use crate::harness::{
@@ -179,6 +179,20 @@ fn rough_conductors() -> Vec<(String, RoughConductor, Grid)> {
         (
             "Au alpha (0.1, 0.6)".into(),
             RoughConductor::new(au(), 0.1, 0.6, None).unwrap(),
+            Grid { cos_bins: 100, phi_bins: 200, sub: 6 },
+        ),
+        (
+            "Au Beckmann 0.3".into(),
+            RoughConductor::isotropic(au(), 0.3, None)
+                .unwrap()
+                .with_distribution(Distribution::Beckmann),
+            Grid::default(),
+        ),
+        (
+            "Au Beckmann (0.1, 0.6)".into(),
+            RoughConductor::new(au(), 0.1, 0.6, None)
+                .unwrap()
+                .with_distribution(Distribution::Beckmann),
             Grid { cos_bins: 100, phi_bins: 200, sub: 6 },
         ),
     ]
@@ -517,6 +531,11 @@ fn bad_input_errors_name_the_field() {
             "unknown field `roughness`",
         ),
         (
+            r#"{"type": "RoughConductor", "metal": "Au", "roughness": 0.1, "distribution": "phong"}"#
+                .into(),
+            "unknown variant `phong`, expected `ggx` or `beckmann`",
+        ),
+        (
             r#"{"type": "Conductor", "metal": "Au", "specular_reflectance": 1.5}"#.into(),
             "reflectance must lie in [0, 1]",
         ),
@@ -565,6 +584,7 @@ fn documented_forms_parse_and_round_trip_through_json_and_bincode() {
         r#"{"type": "RoughConductor", "metal": "Cu", "roughness": 0.2}"#,
         r#"{"type": "RoughConductor", "metal": "Ag", "roughness": 0}"#,
         r#"{"type": "RoughConductor", "metal": "Al", "roughness_u": 0.05, "roughness_v": 0.4}"#,
+        r#"{"type": "RoughConductor", "metal": "Au", "roughness": 0.3, "distribution": "beckmann"}"#,
         r#"{"type": "RoughConductor", "roughness": 0.1, "eta": {"nm": [400, 700], "values": [1.5, 0.2]}, "k": {"nm": [400, 700], "values": [1.9, 3.9]}}"#,
         r#"{"type": "Conductor", "eta": {"nm": [550], "values": [0.5]}, "k": {"nm": [400, 700], "values": [1.9, 3.9]}, "specular_reflectance": {"nm": [400, 700], "values": [0.2, 0.9]}}"#,
     ] {
