@@ -27,8 +27,8 @@
 //! The microfacet core is the [`Microfacet`] trait (`d`, `lambda` and `sample_visible`, from
 //! which `g1`, `g` and `pdf_visible` follow) with [`Ggx`] (the distribution every rough material
 //! uses today) and [`Beckmann`] (Mitsuba 3's default, with the exact Smith `Lambda` and exact
-//! visible-normal sampling, chi-square tested; [`RoughConductor`] takes it with
-//! `"distribution": "beckmann"`, the other rough materials are GGX only so far).
+//! visible-normal sampling, chi-square tested; [`RoughConductor`] and [`RoughDielectric`] take it
+//! with `"distribution": "beckmann"`, [`Plastic`] is GGX only so far).
 //!
 //! The key design decision is that every property is a function of wavelength, evaluated per
 //! beam: reflectances are [`Reflectance`](spectrace_spectrum::Reflectance) spectra and indices of

@@ -8,6 +8,7 @@
 //! | `ior` | number or law, see [`Ior`] | required | index of refraction of the inside, `n(lambda)`; the outside is vacuum (n = 1) |
 //! | `roughness` | GGX alpha, finite, `>= 0` | required (or the pair below) | isotropic roughness; below [`SMOOTH_ALPHA`] (e.g. 0) the boundary is exactly the smooth [`Dielectric`] |
 //! | `roughness_u`, `roughness_v` | GGX alphas, finite, `>= 0` | — | anisotropic roughness along the first / second tangent (instead of `roughness`; both required) |
+//! | `distribution` | `"ggx"` or `"beckmann"` | `"ggx"` | the microfacet distribution ([`Distribution`]), with the roughness as its `alpha` |
 //! | `transmittance` | fraction in `[0, 1]`, a number or `{"nm": [...], "values": [...]}`, or `null` | `null` (= 1) | multiplies every refraction (a surface tint), as for [`Dielectric`] |
 //!
 //! ```json
@@ -64,11 +65,11 @@ use spectrace_sampling::{Frame, clamp_uniform};
 
 use crate::fresnel::{fresnel_dielectric, refract};
 use crate::ior::IorRepr;
-use crate::microfacet::{Microfacet, alphas_from_keys, alphas_to_keys, check_alpha};
+use crate::microfacet::{Facets, Microfacet, alphas_from_keys, alphas_to_keys, check_alpha};
 use crate::vectors::normalise;
 use crate::{
-    BundleScattered, Dielectric, Ggx, Incoming, Ior, Material, MaterialError, ScatterKind,
-    Scattered, Transport, scale_bundle, scatter_each,
+    BundleScattered, Dielectric, Distribution, Ggx, Incoming, Ior, Material, MaterialError,
+    ScatterKind, Scattered, Transport, scale_bundle, scatter_each,
 };
 
 const NAME: &str = "RoughDielectric";
@@ -82,6 +83,7 @@ pub struct RoughDielectric {
     smooth: Dielectric,
     alpha_u: f64,
     alpha_v: f64,
+    distribution: Distribution,
 }
 
 /// Scene-file form of [`RoughDielectric`].
@@ -97,6 +99,8 @@ struct RoughDielectricRepr {
     roughness_v: Option<f64>,
     #[serde(default)]
     transmittance: Option<Transmittance>,
+    #[serde(default)]
+    distribution: Distribution,
 }
 
 impl TryFrom<RoughDielectricRepr> for RoughDielectric {
@@ -110,7 +114,7 @@ impl TryFrom<RoughDielectricRepr> for RoughDielectric {
             r.roughness_v,
             "0 for smooth glass",
         )?;
-        Self::new(ior, u, v, r.transmittance)
+        Ok(Self::new(ior, u, v, r.transmittance)?.with_distribution(r.distribution))
     }
 }
 
@@ -123,6 +127,7 @@ impl From<RoughDielectric> for RoughDielectricRepr {
             roughness_u,
             roughness_v,
             transmittance: d.smooth.transmittance().cloned(),
+            distribution: d.distribution,
         }
     }
 }
@@ -155,7 +160,12 @@ impl RoughDielectric {
     ) -> Result<Self, MaterialError> {
         check_alpha(NAME, "roughness_u", alpha_u)?;
         check_alpha(NAME, "roughness_v", alpha_v)?;
-        Ok(Self { smooth: Dielectric::new(ior, transmittance), alpha_u, alpha_v })
+        Ok(Self {
+            smooth: Dielectric::new(ior, transmittance),
+            alpha_u,
+            alpha_v,
+            distribution: Distribution::Ggx,
+        })
     }
 
     /// An isotropic rough dielectric (`roughness` = `alpha`).
@@ -169,6 +179,17 @@ impl RoughDielectric {
     ) -> Result<Self, MaterialError> {
         check_alpha(NAME, "roughness", alpha)?;
         Self::new(ior, alpha, alpha, transmittance)
+    }
+
+    /// The same glass with the microfacet distribution `kind` (GGX unless asked).
+    pub fn with_distribution(mut self, kind: Distribution) -> Self {
+        self.distribution = kind;
+        self
+    }
+
+    /// The microfacet distribution.
+    pub fn distribution(&self) -> Distribution {
+        self.distribution
     }
 
     /// The index of refraction of the inside.
@@ -192,8 +213,8 @@ impl RoughDielectric {
         Ggx::is_smooth_alphas(self.alpha_u, self.alpha_v)
     }
 
-    fn ggx(&self) -> Ggx {
-        Ggx::new(self.alpha_u, self.alpha_v)
+    fn facets(&self) -> Facets {
+        Facets::new(self.distribution, self.alpha_u, self.alpha_v)
     }
 
     /// `n_far / n_near` seen from the side of a local direction with `z = side_z`.
@@ -231,11 +252,11 @@ impl RoughDielectric {
             return 0.0;
         }
         let Some(m) = Self::half_vector(wi, wo, eta) else { return 0.0 };
-        let ggx = self.ggx();
+        let facets = self.facets();
         let (cos_im, cos_om) = (wi.dot(m), wo.dot(m));
         let f = fresnel_dielectric(cos_im, eta);
-        let d = ggx.d(m);
-        let g = ggx.g(wo, wi);
+        let d = facets.d(m);
+        let g = facets.g(wo, wi);
         let value = if wo.z > 0.0 {
             f * d * g / (4.0 * wi.z * wo.z)
         } else {
@@ -255,7 +276,7 @@ impl RoughDielectric {
         let Some(m) = Self::half_vector(wi, wo, eta) else { return 0.0 };
         let (cos_im, cos_om) = (wi.dot(m), wo.dot(m));
         let f = fresnel_dielectric(cos_im, eta);
-        let visible = self.ggx().pdf_visible(wi, m);
+        let visible = self.facets().pdf_visible(wi, m);
         let p = if wo.z > 0.0 {
             f * visible / (4.0 * cos_im)
         } else {
@@ -278,8 +299,8 @@ impl RoughDielectric {
                 delta: true,
             });
         }
-        let ggx = self.ggx();
-        let m = ggx.sample_visible(wi, [clamp_uniform(u[1]), clamp_uniform(u[2])]);
+        let facets = self.facets();
+        let m = facets.sample_visible(wi, [clamp_uniform(u[1]), clamp_uniform(u[2])]);
         let cos_im = wi.dot(m);
         if !(cos_im > 0.0) {
             return None;
@@ -298,7 +319,7 @@ impl RoughDielectric {
             return None; // left through the wrong side of the macro-surface: absorbed
         }
         let pdf = self.pdf_local(wi, wo, eta);
-        let ratio = ggx.g(wo, wi) / ggx.g1(wi);
+        let ratio = facets.g(wo, wi) / facets.g1(wi);
         (pdf > 0.0 && pdf.is_finite() && ratio > 0.0 && ratio.is_finite()).then_some(Sample {
             wo,
             transmission,

@@ -10,7 +10,8 @@ use rand::SeedableRng;
 use rand_pcg::Pcg64;
 use spectrace_materials::spectrum::Transmittance;
 use spectrace_materials::{
-    Dielectric, Incoming, Ior, Material, RoughDielectric, ScatterKind, Transport, scatter_each,
+    Dielectric, Distribution, Incoming, Ior, Material, RoughDielectric, ScatterKind, Transport,
+    scatter_each,
 };
 use spectrace_sampling::ONE_MINUS_EPSILON;
 
@@ -45,17 +46,20 @@ const INCIDENCES: [(f64, bool); 6] =
 
 #[test]
 fn sampled_directions_follow_pdf_for_each_roughness_and_incidence() {
-    let cases: [(f64, f64, Grid); 4] = [
-        (0.05, 0.05, Grid { cos_bins: 400, phi_bins: 400, sub: 4 }),
-        (0.3, 0.3, Grid { cos_bins: 600, phi_bins: 150, sub: 6 }),
+    let (ggx, beckmann) = (Distribution::Ggx, Distribution::Beckmann);
+    let cases: [(f64, f64, Grid, Distribution); 6] = [
+        (0.05, 0.05, Grid { cos_bins: 400, phi_bins: 400, sub: 4 }, ggx),
+        (0.3, 0.3, Grid { cos_bins: 600, phi_bins: 150, sub: 6 }, ggx),
         // Fine rings around the normal for the refracted lobe, which at normal incidence is
         // narrower than the reflected one by about (n - 1) / n.
-        (0.7, 0.7, Grid { cos_bins: 600, phi_bins: 150, sub: 6 }),
-        (0.1, 0.5, Grid { cos_bins: 600, phi_bins: 150, sub: 6 }),
+        (0.7, 0.7, Grid { cos_bins: 600, phi_bins: 150, sub: 6 }, ggx),
+        (0.1, 0.5, Grid { cos_bins: 600, phi_bins: 150, sub: 6 }, ggx),
+        (0.3, 0.3, Grid { cos_bins: 600, phi_bins: 150, sub: 6 }, beckmann),
+        (0.1, 0.5, Grid { cos_bins: 600, phi_bins: 150, sub: 6 }, beckmann),
     ];
     let mut seed = 100;
-    for (au, av, grid) in cases {
-        let material = rough(1.5, au, av);
+    for (au, av, grid, kind) in cases {
+        let material = rough(1.5, au, av).with_distribution(kind);
         for (degrees, inside) in INCIDENCES {
             seed += 1;
             let wi = away(degrees, inside, 0.7);
@@ -76,7 +80,10 @@ fn sampled_directions_follow_pdf_for_each_roughness_and_incidence() {
             };
             let r =
                 chi2_directions_around(&material, wi, normal(), axis, 550.0, 200_000, seed, grid);
-            assert!(r.p_value > ALPHA, "alpha ({au}, {av}) {degrees} deg inside {inside}: {r:?}");
+            assert!(
+                r.p_value > ALPHA,
+                "{kind:?} alpha ({au}, {av}) {degrees} deg inside {inside}: {r:?}"
+            );
             assert_eq!(r.delta_fraction, 0.0);
             // The pdf integrates to the fraction not absorbed (the chi-square compares the counts
             // with n times the integral, so this is tested there); at most 1.
@@ -329,6 +336,7 @@ fn scene_forms_round_trip_and_errors_name_the_field() {
         r#"{"type": "RoughDielectric", "ior": {"glass": "SF11"}, "roughness": 0.1}"#,
         r#"{"type": "RoughDielectric", "ior": 1.5, "roughness_u": 0.05, "roughness_v": 0.3, "transmittance": 0.95}"#,
         r#"{"type": "RoughDielectric", "ior": 1.33, "roughness": 0}"#,
+        r#"{"type": "RoughDielectric", "ior": 1.5, "roughness": 0.3, "distribution": "beckmann"}"#,
     ] {
         let m: Box<dyn Material> = serde_json::from_str(json).unwrap();
         let written = serde_json::to_string(&m).unwrap();
