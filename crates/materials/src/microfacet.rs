@@ -1,5 +1,7 @@
-//! The GGX (Trowbridge-Reitz) microfacet distribution with Smith shadowing, and sampling of its
-//! visible normals: the shared core of every rough material.
+//! The shared core of every rough material: the [`Microfacet`] trait (what a material needs of a
+//! distribution of normals: `D`, Smith's `Lambda`, visible-normal sampling, and the masking,
+//! shadowing and density that follow from them), the scene-file choice [`Distribution`], and the
+//! GGX (Trowbridge-Reitz) distribution; Beckmann's is in `beckmann.rs` ([`Beckmann`]).
 //!
 //! All vectors here are in the *local* shading frame: the macro-surface normal is `+z`, the first
 //! tangent `+x` (the direction `alpha_x` acts along), all unit. Following the conventions of

@@ -8,7 +8,7 @@
 //! noise taken out in quadrature, give the time to any smaller error by that law. The estimate
 //! check renders auto's pick to the target for real, and its measured time is shown beside.
 
-use super::report::{converges, percent, sig, sweep_reference_error};
+use super::report::{converges, percent, sig, sweep_configuration, sweep_reference_error};
 use super::*;
 use std::fmt::Write as _;
 
@@ -104,9 +104,10 @@ pub(super) fn relmse_markdown(md: &mut String, report: &AccuracyReport) {
          reference's noise. `-` where all three are; where the reference's own noise is several \
          percent, the points that enter are only a few times it and these times are rough (up \
          to a factor of 3.5 between two runs of this report on the Cornell box, whose 2^24-path \
-         reference is far from converged per pixel); `biased` where the estimator converges to another image (see the tables below). \
-         `fastest`: the fastest of light, path and bdpt (independent sampling), and auto's time \
-         (with its default sampler) over it. Last columns: the estimate check's render of auto's pick to {target} (stopped by its own \
+         reference is far from converged per pixel); `biased` where the estimator converges to \
+         another image (see the tables below). `fastest`: the fastest of light, path and bdpt \
+         (independent sampling), and auto's time (with its default sampler) over it. Last \
+         columns: the estimate check's render of auto's pick to {target} (stopped by its own \
          estimate; the section above), its measured time, and that over the time predicted here \
          for the same estimator.\n",
         target = percent(ROUND_TARGET)
@@ -131,12 +132,7 @@ pub(super) fn relmse_markdown(md: &mut String, report: &AccuracyReport) {
         let reach = |c: Configuration| relmse_reach(scene, find(c), noise, ROUND_TARGET);
         let (check, measured, ratio) = match &scene.estimate_check {
             Some(check) => {
-                let peer = match check.integrator {
-                    IntegratorChoice::Path => Configuration::Path,
-                    IntegratorChoice::Bdpt => Configuration::Bdpt,
-                    _ => Configuration::Baseline,
-                };
-                let ratio = match reach(peer) {
+                let ratio = match reach(sweep_configuration(check.integrator)) {
                     RelmseReach::Predicted(t) => format!("{:.2}", check.measured_seconds / t),
                     _ => "-".to_owned(),
                 };

@@ -262,11 +262,7 @@ pub(super) fn sweep_reference_error(
     integrator: IntegratorChoice,
     beams: u64,
 ) -> Option<(Configuration, ByMeasure)> {
-    let same = match integrator {
-        IntegratorChoice::Path => Configuration::Path,
-        IntegratorChoice::Bdpt => Configuration::Bdpt,
-        _ => Configuration::Baseline,
-    };
+    let same = sweep_configuration(integrator);
     let last = configurations.iter().find(|c| c.configuration == same)?.points.last()?;
     let factor = (1.0 + beams as f64 / last.beams.max(1) as f64).sqrt();
     let error = ByMeasure {
@@ -275,6 +271,16 @@ pub(super) fn sweep_reference_error(
         mean: None,
     };
     Some((same, error))
+}
+
+/// The swept configuration that renders with `integrator` and independent sampling: `path`,
+/// `bdpt`, or the light tracer's `baseline`.
+pub(super) fn sweep_configuration(integrator: IntegratorChoice) -> Configuration {
+    match integrator {
+        IntegratorChoice::Path => Configuration::Path,
+        IntegratorChoice::Bdpt => Configuration::Bdpt,
+        _ => Configuration::Baseline,
+    }
 }
 
 /// The fastest configuration to `target` among those that apply, and its reach (measured, or
