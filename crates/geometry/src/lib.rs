@@ -38,6 +38,7 @@ mod error;
 mod float;
 mod leaves;
 mod mesh;
+mod ply;
 mod prism;
 mod ray;
 mod rectangle;

@@ -3,6 +3,7 @@
 //! | field | unit | default | meaning |
 //! |---|---|---|---|
 //! | `obj` | path | none | OBJ file, relative to the base directory the caller passes ([`crate::World::with_base_dir`]); polygons are triangulated, normals and texture coordinates kept when present |
+//! | `ply` | path | none | PLY file (ASCII or binary), instead of `obj`, resolved the same way: `vertex` `x y z`, with `nx ny nz` and `u v` kept when present; `face` `vertex_indices` polygons triangulated (the `ply` module) |
 //! | `positions` | m, `[[x, y, z], ...]` | none | inline vertices (instead of `obj`) |
 //! | `triangles` | `[[i, j, k], ...]` | required with `positions` | 0-based vertex indices, counter-clockwise seen from the outward side |
 //! | `normals` | `[[x, y, z], ...]` | none | per-vertex shading normals (inline only; as many as `positions`) |
@@ -63,6 +64,8 @@ struct MeshRepr {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     obj: Option<PathBuf>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    ply: Option<PathBuf>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     positions: Option<Vec<DVec3>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     triangles: Option<Vec<[u32; 3]>>,
@@ -78,6 +81,25 @@ impl TryFrom<MeshRepr> for Mesh {
     type Error = GeometryError;
     fn try_from(r: MeshRepr) -> Result<Self, GeometryError> {
         const S: &str = "Mesh";
+        if let Some(ply) = &r.ply {
+            if r.obj.is_some() || r.positions.is_some() || r.triangles.is_some() {
+                return Err(GeometryError::parameter(
+                    S,
+                    "ply",
+                    ply,
+                    "give one of obj, ply, or positions and triangles",
+                ));
+            }
+            if r.normals.is_some() || r.uvs.is_some() {
+                return Err(GeometryError::parameter(
+                    S,
+                    "normals",
+                    ply,
+                    "normals/uvs are inline only; a PLY file brings its own",
+                ));
+            }
+            return Ok(Self { data: None, repr: Box::new(r) });
+        }
         match (&r.obj, &r.positions, &r.triangles) {
             (Some(path), None, None) => {
                 if r.normals.is_some() || r.uvs.is_some() {
@@ -299,6 +321,15 @@ fn read_obj_limited(
     build(positions, triangles, normals, uvs, transform)
 }
 
+/// Reads a PLY file into mesh data, at most [`MAX_OBJ_BYTES`] long (the OBJ limit).
+fn read_ply_file(path: &Path, transform: Option<&Transform>) -> Result<MeshData, GeometryError> {
+    let err = |reason: String| GeometryError::Ply { path: path.to_path_buf(), reason };
+    let bytes = crate::read_bounded(path, MAX_OBJ_BYTES, "PLY file").map_err(err)?;
+    let m = crate::ply::read_ply(&bytes).map_err(err)?;
+    drop(bytes);
+    build(m.positions, m.triangles, m.normals, m.uvs, transform)
+}
+
 impl Mesh {
     /// A mesh from world-space positions and counter-clockwise triangles.
     ///
@@ -344,6 +375,9 @@ impl Mesh {
         if let Some(obj) = &self.repr.obj {
             let path = base_dir.join(obj);
             self.data = Some(Arc::new(read_obj(&path, self.repr.transform.as_ref())?));
+        } else if let Some(ply) = &self.repr.ply {
+            let path = base_dir.join(ply);
+            self.data = Some(Arc::new(read_ply_file(&path, self.repr.transform.as_ref())?));
         }
         Ok(())
     }
@@ -353,9 +387,22 @@ impl Mesh {
         self.data.is_some()
     }
 
-    /// The OBJ path, if the mesh comes from a file.
+    /// The OBJ path, if the mesh comes from an OBJ file.
     pub fn obj_path(&self) -> Option<&Path> {
         self.repr.obj.as_deref()
+    }
+
+    /// The mesh file's path (OBJ or PLY), if the mesh comes from a file.
+    pub fn file_path(&self) -> Option<&Path> {
+        self.repr.obj.as_deref().or(self.repr.ply.as_deref())
+    }
+
+    /// A mesh to be read from the PLY file `path` (resolved as [`Mesh::from_obj`]); not loaded.
+    pub fn from_ply(path: impl Into<PathBuf>, transform: Option<Transform>) -> Self {
+        Self {
+            data: None,
+            repr: Box::new(MeshRepr { ply: Some(path.into()), transform, ..Default::default() }),
+        }
     }
 
     /// World-space vertex positions (empty until loaded).

@@ -82,7 +82,7 @@ impl World {
             if let Shape::Mesh(m) = s
                 && !m.is_loaded()
             {
-                let path = m.obj_path().map(Path::to_path_buf).unwrap_or_default();
+                let path = m.file_path().map(Path::to_path_buf).unwrap_or_default();
                 return Err(GeometryError::UnloadedMesh { index: i, path });
             }
             let shape = u32::try_from(i)

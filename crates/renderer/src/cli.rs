@@ -38,8 +38,12 @@ struct Cli {
 enum Command {
     /// Render a scene file to EXR (linear), PNG (sRGB) and a JSON sidecar.
     Render {
-        /// The scene file (JSON; see scenes/README.md).
+        /// The scene file: Spectrace's JSON (scenes/README.md) or a Mitsuba XML scene
+        /// (docs/import.md).
         scene: PathBuf,
+        /// For a Mitsuba scene: set `$NAME` to VALUE (over the file's <default>); repeatable.
+        #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_define)]
+        define: Vec<(String, String)>,
         /// Beams for the whole image (overrides settings.beams).
         #[arg(long, conflicts_with = "time", allow_negative_numbers = true, value_parser = parse_count)]
         beams: Option<u64>,
@@ -138,6 +142,17 @@ enum Command {
         #[arg(long)]
         restrict_paths: bool,
     },
+    /// Convert a Mitsuba XML scene into Spectrace's JSON scene (docs/import.md).
+    Convert {
+        /// The Mitsuba scene file (.xml).
+        scene: PathBuf,
+        /// The JSON file to write (never one of the scene's own files).
+        #[arg(long)]
+        out: PathBuf,
+        /// Set `$NAME` to VALUE (over the file's <default>); repeatable.
+        #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_define)]
+        define: Vec<(String, String)>,
+    },
     /// Merge partial films (from `render --shard`) into the final outputs.
     Merge {
         /// The partial films (.bin).
@@ -147,6 +162,18 @@ enum Command {
         #[arg(long, default_value = "out")]
         out: PathBuf,
     },
+}
+
+/// A `-D NAME=VALUE` definition.
+fn parse_define(s: &str) -> Result<(String, String), String> {
+    match s.split_once('=') {
+        Some((k, v))
+            if !k.is_empty() && k.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') =>
+        {
+            Ok((k.to_owned(), v.to_owned()))
+        }
+        _ => Err(format!("`{s}`: must be NAME=VALUE, NAME of letters, digits and _")),
+    }
 }
 
 /// An error measure's name.
@@ -364,6 +391,7 @@ where
     let result = match cli.command {
         Command::Render {
             scene,
+            define,
             beams,
             time,
             out,
@@ -397,7 +425,16 @@ where
                 verbose: !quiet,
                 restrict_paths,
             };
-            render_file(&scene, &options)
+            if define.is_empty() {
+                render_file(&scene, &options)
+            } else {
+                crate::Scene::import_with(&scene, &define, crate::LoadOptions { restrict_paths })
+                    .map_err(crate::RenderError::from)
+                    .and_then(|scene| crate::render_scene(&scene, &options))
+            }
+        }
+        Command::Convert { scene, out, define } => {
+            return crate::convert::convert_command(&scene, &out, &define);
         }
         Command::Merge { parts, out } => merge_parts(&parts, &out),
         Command::Estimate {

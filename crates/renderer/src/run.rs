@@ -52,7 +52,8 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
         &scene.inputs,
         planned_sensor_outputs(scene, &options.out_dir),
     )?;
-    let mut warnings = Vec::new();
+    let mut warnings: Vec<String> =
+        scene.notes.iter().map(|n| format!("imported with an approximation: {n}")).collect();
     let (choice, reason, plan) = match measure_choice(scene, options, &plan, &fallback) {
         Ok(Some(m)) => {
             // The pilots' time comes out of the budget.

@@ -344,6 +344,9 @@ pub enum SceneError {
         /// What is wrong.
         message: String,
     },
+    /// A scene file of another renderer (Mitsuba XML) cannot be imported.
+    #[error("{0}")]
+    Import(crate::ImportError),
     /// The scene is well-formed but cannot be rendered as it is.
     #[error("{path}: {field}: {message}")]
     Scene {
@@ -392,6 +395,9 @@ pub struct Scene {
     pub inputs: Vec<PathBuf>,
     /// The illuminance sensors.
     pub sensors: SensorSet,
+    /// The approximations made when the scene was imported from another renderer's file
+    /// (`file:line: what`); empty for a native scene.
+    pub notes: Vec<String>,
 }
 
 /// How a scene file may refer to other files.
@@ -416,6 +422,9 @@ impl Scene {
     /// # Errors
     /// As [`Scene::load`]; with `restrict_paths`, also a mesh outside the scene's folder.
     pub fn load_with(path: &Path, options: LoadOptions) -> Result<Self, SceneError> {
+        if crate::is_mitsuba_scene(path) {
+            return Self::import_with(path, &[], options);
+        }
         let bytes = read_bounded(path, MAX_SCENE_BYTES, "scene")
             .map_err(|message| SceneError::Read { path: path.to_owned(), message })?;
         let text = String::from_utf8(bytes).map_err(|e| {
@@ -431,6 +440,31 @@ impl Scene {
         })?;
         let mut scene = Self::from_json_with(&text, path, options)?;
         scene.inputs.insert(0, path.to_owned());
+        Ok(scene)
+    }
+
+    /// Reads a Mitsuba scene file (`.xml`) with `defines` (`-D name=value`) through the importer
+    /// and loads the native scene it becomes; its approximations are in [`Scene::notes`].
+    ///
+    /// # Errors
+    /// [`SceneError::Import`] with the XML file and line, or the errors of the native scene.
+    pub fn import_with(
+        path: &Path,
+        defines: &[(String, String)],
+        options: LoadOptions,
+    ) -> Result<Self, SceneError> {
+        let imported = crate::import_mitsuba(path, defines).map_err(SceneError::Import)?;
+        let text = serde_json::to_string_pretty(&imported.scene).unwrap_or_default();
+        let mut scene = Self::from_json_with(&text, path, options).map_err(|e| match e {
+            SceneError::Invalid { path, line, field, message, .. } => SceneError::Scene {
+                path,
+                field: format!("{field} (line {line} of the scene `spectrace convert` writes)"),
+                message,
+            },
+            other => other,
+        })?;
+        scene.notes = imported.notes.iter().map(ToString::to_string).collect();
+        scene.inputs.splice(0..0, imported.files);
         Ok(scene)
     }
 
@@ -488,6 +522,7 @@ impl Scene {
             output: file.output,
             inputs: parts.inputs,
             sensors,
+            notes: Vec::new(),
         })
     }
 
@@ -717,7 +752,7 @@ impl<'a> Assembly<'a> {
         mut object: Object,
     ) -> Result<Option<ObjectLight>, SceneError> {
         if let Shape::Mesh(mesh) = &object.shape
-            && let Some(obj) = mesh.obj_path()
+            && let Some(obj) = mesh.file_path()
         {
             let resolved = self.base.join(obj);
             if self.options.restrict_paths {

@@ -48,6 +48,7 @@ mod inverse;
 mod mixture;
 mod photometric;
 mod reflectance;
+pub mod rgb;
 mod spd;
 mod tabulated;
 

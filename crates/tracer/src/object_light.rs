@@ -3,8 +3,9 @@
 //!
 //! | field | unit | default | meaning |
 //! |---|---|---|---|
-//! | `power` | W | one of `power`, `lumens` | total emitted power (both sides together when two-sided) |
-//! | `lumens` | lm | one of `power`, `lumens` | total luminous flux instead: `power = lumens / luminous_efficacy(spd)` |
+//! | `power` | W | one of `power`, `lumens`, `radiance` | total emitted power (both sides together when two-sided) |
+//! | `lumens` | lm | one of `power`, `lumens`, `radiance` | total luminous flux instead: `power = lumens / luminous_efficacy(spd)` |
+//! | `radiance` | W m^-2 sr^-1 | one of `power`, `lumens`, `radiance` | the radiance of every point instead (the spectral radiance integrated over wavelength; `spd` gives its shape): `power = radiance * pi * area`, twice that when two-sided, found when the shape is known. Renderers that give emitters a radiance (Mitsuba's `area`) translate to this |
 //! | `spd` | SPD | required | spectrum |
 //! | `two_sided` | | `false` | emit from both sides of the surface (else only outwards: along the geometric normal) |
 //!
@@ -18,7 +19,7 @@
 //! ```
 //!
 //! `lumens` is converted to watts when the scene is read (`spectrace_lights::power_from_keys`);
-//! serialising an emission writes `power`.
+//! serialising an emission writes `power`, or `radiance` when it was given so.
 //!
 //! Every point of the surface emits the radiance `L = power / (pi * area)` (halved when
 //! two-sided) into the hemisphere around its outward normal; the object's material still
@@ -39,14 +40,18 @@ use spectrace_lights::{
 use spectrace_sampling::{Frame, sample_cosine_hemisphere_concentric};
 use spectrace_spectrum::SpectralPowerDistribution;
 
-/// The scene-file form of an object's emission. A scene file gives its output as `power` (W) or
-/// `lumens` (lm, converted to watts when read: `W = lm / luminous_efficacy(spd)`); it is written
-/// back as `power`.
-#[derive(Debug, Clone, Serialize, Deserialize)]
+/// The scene-file form of an object's emission. A scene file gives its output as `power` (W),
+/// `lumens` (lm, converted to watts when read: `W = lm / luminous_efficacy(spd)`) or `radiance`
+/// (W m^-2 sr^-1, converted when the light is built, since it needs the shape's area); it is
+/// written back as `power`, or as `radiance` when given so.
+#[derive(Debug, Clone, Deserialize)]
 #[serde(try_from = "EmissionRepr")]
 pub struct ObjectEmission {
-    /// Total emitted power (W).
+    /// Total emitted power (W); ignored when `radiance` is given.
     pub power: f64,
+    /// The radiance of every point (W m^-2 sr^-1, whole spectrum) instead of `power`: the
+    /// light's power is then `radiance * pi * area` (twice when two-sided).
+    pub radiance: Option<f64>,
     /// The spectrum.
     pub spd: Arc<dyn SpectralPowerDistribution>,
     /// Whether both sides emit.
@@ -61,6 +66,8 @@ struct EmissionRepr {
     power: Option<f64>,
     #[serde(default)]
     lumens: Option<f64>,
+    #[serde(default)]
+    radiance: Option<f64>,
     spd: Arc<dyn SpectralPowerDistribution>,
     #[serde(default)]
     two_sided: bool,
@@ -69,8 +76,47 @@ struct EmissionRepr {
 impl TryFrom<EmissionRepr> for ObjectEmission {
     type Error = LightError;
     fn try_from(r: EmissionRepr) -> Result<Self, LightError> {
+        if let Some(radiance) = r.radiance {
+            if r.power.is_some() || r.lumens.is_some() {
+                return Err(LightError::parameter(
+                    "emission",
+                    "radiance",
+                    radiance,
+                    "`power` or `lumens` is given too: give exactly one of `power` (W), `lumens` \
+                     (lm) or `radiance` (W m^-2 sr^-1)",
+                ));
+            }
+            if !(radiance >= 0.0 && radiance.is_finite()) {
+                return Err(LightError::parameter(
+                    "emission",
+                    "radiance",
+                    radiance,
+                    "must be a finite radiance of at least 0 W m^-2 sr^-1",
+                ));
+            }
+            return Ok(Self {
+                power: 0.0,
+                radiance: Some(radiance),
+                spd: r.spd,
+                two_sided: r.two_sided,
+            });
+        }
         let power = power_from_keys("emission", r.power, r.lumens, None, false, r.spd.as_ref())?;
-        Ok(Self { power, spd: r.spd, two_sided: r.two_sided })
+        Ok(Self { power, radiance: None, spd: r.spd, two_sided: r.two_sided })
+    }
+}
+
+impl Serialize for ObjectEmission {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let mut s = serializer.serialize_struct("ObjectEmission", 3)?;
+        match self.radiance {
+            Some(r) => s.serialize_field("radiance", &r)?,
+            None => s.serialize_field("power", &self.power)?,
+        }
+        s.serialize_field("spd", &self.spd)?;
+        s.serialize_field("two_sided", &self.two_sided)?;
+        s.end()
     }
 }
 
@@ -89,13 +135,11 @@ impl ObjectLight {
     /// # Errors
     /// [`LightError`] naming `power` (negative or not finite) or `area` (a shape without area).
     pub fn new(shape: Shape, emission: &ObjectEmission) -> Result<Self, LightError> {
-        let spd_light = SpdLight::new(
-            "emission",
-            emission.spd.clone(),
-            emission.power,
-            WavelengthSampling::Importance,
-        )?;
         let area = shape.area();
+        let sides = if emission.two_sided { 2.0 } else { 1.0 };
+        let power = emission.radiance.map_or(emission.power, |r| r * PI * area * sides);
+        let spd_light =
+            SpdLight::new("emission", emission.spd.clone(), power, WavelengthSampling::Importance)?;
         if !(area > 0.0 && area.is_finite()) {
             return Err(LightError::parameter(
                 "emission",
@@ -281,6 +325,38 @@ mod tests {
 
     fn emission(json: &str) -> Result<ObjectEmission, String> {
         serde_json::from_str(json).map_err(|e| e.to_string())
+    }
+
+    /// `radiance` becomes power once the shape is known: a unit square at radiance 2 emits
+    /// `2 pi` W one-sided and `4 pi` W two-sided; it is written back as `radiance`, and given
+    /// with `power` it is refused naming both.
+    #[test]
+    fn an_emission_given_as_radiance_takes_its_power_from_the_area() {
+        let shape: Shape = serde_json::from_str(
+            r#"{"type": "Rectangle", "corner": [0, 0, 0], "edge_u": [1, 0, 0], "edge_v": [0, 1, 0]}"#,
+        )
+        .unwrap();
+        for (two_sided, power) in [(false, 2.0 * PI), (true, 4.0 * PI)] {
+            let e = emission(&format!(
+                r#"{{"radiance": 2, "spd": {{"type": "CieIlluminant", "name": "D65"}}, "two_sided": {two_sided}}}"#
+            ))
+            .unwrap();
+            let light = ObjectLight::new(shape.clone(), &e).unwrap();
+            assert!((light.power() - power).abs() < 1e-12, "{}", light.power());
+            assert!((light.radiance() - 2.0).abs() < 1e-12);
+            let json = serde_json::to_string(&e).unwrap();
+            assert!(json.contains("\"radiance\":2.0") && !json.contains("power"), "{json}");
+            assert_eq!(emission(&json).unwrap().radiance, Some(2.0));
+        }
+        let both = emission(
+            r#"{"radiance": 2, "power": 1, "spd": {"type": "CieIlluminant", "name": "D65"}}"#,
+        )
+        .unwrap_err();
+        assert!(both.contains("radiance") && both.contains("power"), "{both}");
+        let negative =
+            emission(r#"{"radiance": -1, "spd": {"type": "CieIlluminant", "name": "D65"}}"#)
+                .unwrap_err();
+        assert!(negative.contains("radiance"), "{negative}");
     }
 
     #[test]

@@ -1,0 +1,96 @@
+//! Mitsuba's free emitters (not on a shape) as Spectrace lights, in power: `point` emits
+//! `P = 4 pi integral(I)`, `spot` (linear falloff from `beam_width` to `cutoff_angle`)
+//! `P = 2 pi integral(I) (1 - (sin c - sin b) / (c - b))`, and `2 pi integral(I) (1 - cos c)`
+//! when `beam_width >= cutoff_angle`.
+
+use std::f64::consts::PI;
+
+use glam::{DMat4, DVec3};
+use serde_json::json;
+
+use super::Importer;
+use super::params::Params;
+use super::spectra::{Role, spectrum};
+use super::values::{transform, vector};
+use super::xml::{Element, ImportError, error_at};
+
+impl Importer {
+    /// Adds a top-level `<emitter>` (an `area` one with an id is only a definition).
+    pub(super) fn emitter(&mut self, el: &Element) -> Result<(), ImportError> {
+        if el.kind() == "area" {
+            if el.attr("id").is_none() {
+                return Err(error_at(
+                    &el.loc,
+                    "an area emitter outside a shape must have an id for shapes to <ref>",
+                ));
+            }
+            return Ok(());
+        }
+        let p = Params::new(el);
+        let m = p.get("to_world").map_or(Ok(DMat4::IDENTITY), transform)?;
+        let intensity = |p: &Params<'_>| -> Result<Option<(f64, serde_json::Value)>, ImportError> {
+            let i = p.get("intensity").ok_or_else(|| error_at(&el.loc, "needs `intensity`"))?;
+            Ok(spectrum(i, Role::Emission)?.emission())
+        };
+        let light = match el.kind() {
+            "point" => {
+                let position = match p.get("position") {
+                    Some(v) => vector(v)?,
+                    None => m.transform_point3(DVec3::ZERO),
+                };
+                intensity(&p)?.map(|(i, spd)| {
+                    json!({"type": "PointLight", "position": position.to_array(), "power": 4.0 * PI * i, "spd": spd})
+                })
+            }
+            "spot" => {
+                let cutoff = p.float("cutoff_angle", 20.0)?;
+                let beam = p.float("beam_width", cutoff * 0.75)?;
+                if !(cutoff > 0.0 && cutoff < 180.0 && beam >= 0.0) {
+                    return Err(error_at(
+                        &el.loc,
+                        format!(
+                            "cutoff_angle {cutoff}, beam_width {beam}: need 0 < cutoff < 180 and beam_width >= 0"
+                        ),
+                    ));
+                }
+                if p.get("texture").is_some() {
+                    return Err(error_at(&el.loc, "a spot light's texture is not supported"));
+                }
+                let position = m.transform_point3(DVec3::ZERO);
+                let direction = m.transform_vector3(DVec3::Z).normalize_or_zero();
+                intensity(&p)?.map(|(i, spd)| {
+                    let (c, b) = (cutoff.to_radians(), beam.to_radians());
+                    if beam >= cutoff {
+                        json!({"type": "UniformSpotLight", "position": position.to_array(), "direction": direction.to_array(),
+                               "cone_angle": cutoff, "power": 2.0 * PI * i * (1.0 - c.cos()), "spd": spd})
+                    } else {
+                        let fraction = 1.0 - (c.sin() - b.sin()) / (c - b);
+                        json!({"type": "FadingSpotLight", "position": position.to_array(), "direction": direction.to_array(),
+                               "cone_angle": cutoff, "fade_per_angle": 1.0 / (cutoff - beam), "power": 2.0 * PI * i * fraction, "spd": spd})
+                    }
+                })
+            }
+            "directional" | "constant" | "envmap" | "sunsky" | "projector" => {
+                return Err(error_at(
+                    &el.loc,
+                    format!(
+                        "emitter type \"{}\" is not supported yet (area, point and spot are; docs/import.md)",
+                        el.kind()
+                    ),
+                ));
+            }
+            other => {
+                return Err(error_at(
+                    &el.loc,
+                    format!("emitter type \"{other}\" is not supported"),
+                ));
+            }
+        };
+        p.finish()?;
+        match light {
+            Some(l) => self.lights.push(l),
+            None => self.note(el, "emits nothing (zero intensity): left out"),
+        }
+        Ok(())
+    }
+}
