@@ -5,6 +5,7 @@ mod estimate;
 mod fluorescence;
 mod fuzz;
 mod hostile;
+mod import;
 mod integrators;
 mod kernels;
 mod measured_auto;

@@ -301,6 +301,8 @@ fn print_help() {
                   only the race's samples/s at equal spp beside Mitsuba's llvm and scalar variants\n  \
          peer --materials [--spp N] [--seeds K] [--cases A,B] [--no-docs]\n           \
                   the materials cross-check against Mitsuba 3 (docs/materials-peer.md)\n  \
+         peer --scene FILE.xml [--scene ...] [--spp N] [-D NAME=VALUE]\n           \
+                  a Mitsuba scene rendered by Mitsuba 3 and Spectrace, region means compared (docs/import.md)\n  \
          peer --geometry [--rays N] [--reps K] [--cpu C] [--no-docs]\n           \
                   closest-hit and shadow rays/s beside Embree 4 on one core (docs/peer.md)\n  \
          bench    run every crate's benchmarks (release)\n  \

@@ -1,7 +1,9 @@
 //! `cargo xtask peer`: the race against Mitsuba 3 (method and results in `docs/peer.md`; with
 //! `--throughput-only`, only its samples per second at equal spp, passed on to `peer.py`),
 //! `cargo xtask peer --materials`: the materials cross-check (`docs/materials-peer.md`), and
-//! `cargo xtask peer --geometry`: the geometry benchmark beside Embree 4 (`docs/peer.md`).
+//! `cargo xtask peer --geometry`: the geometry benchmark beside Embree 4 (`docs/peer.md`), and
+//! `cargo xtask peer --scene FILE.xml`: one Mitsuba scene file rendered by Mitsuba 3 and by
+//! Spectrace and compared in region means (`docs/import.md`, `xtask/peer/scene.py`).
 //!
 //! The Rust side checks the prerequisites and prepares the tools; the comparison itself (scene
 //! translation, renders or ray casts, errors, report) is a Python script in `xtask/peer/`, run in a
@@ -69,6 +71,11 @@ pub(crate) fn run(args: &[String]) -> ExitCode {
             let mut command = script(&job, &python, "--spectrace", &binary, args);
             finish(&job, command.env("DRJIT_LIBLLVM_PATH", llvm))
         }),
+        Peer::MitsubaScalar => venv(MITSUBA_PINS).and_then(|python| {
+            let binary =
+                crate::build_spectrace().map_err(|_| "building spectrace failed".to_owned())?;
+            finish(&job, &mut script(&job, &python, "--spectrace", &binary, args))
+        }),
         Peer::Embree => prepare_geometry().and_then(|(python, example)| {
             finish(&job, &mut script(&job, &python, "--ray-rate", &example, args))
         }),
@@ -89,6 +96,8 @@ enum Peer {
     Mitsuba,
     /// Embree 4 through `embreex` (needs the release `ray_rate` example only).
     Embree,
+    /// Mitsuba 3's scalar variant only (no libLLVM needed): the scene-file comparison.
+    MitsubaScalar,
 }
 
 /// What `cargo xtask peer` runs: its script in `xtask/peer`, its work folder in the target
@@ -107,6 +116,9 @@ fn job(args: &[String]) -> (Job, &[String]) {
     match args.split_first() {
         Some((first, rest)) if first == "--materials" => {
             (Job { script: "materials.py", work: "peer-materials", peer: Peer::Mitsuba }, rest)
+        }
+        Some((first, _)) if first == "--scene" => {
+            (Job { script: "scene.py", work: "peer-scene", peer: Peer::MitsubaScalar }, args)
         }
         Some((first, rest)) if first == "--geometry" => {
             (Job { script: "geometry.py", work: "peer-geometry", peer: Peer::Embree }, rest)

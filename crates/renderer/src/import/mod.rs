@@ -89,7 +89,8 @@ pub fn is_mitsuba_scene(path: &Path) -> bool {
 /// supported.
 pub fn import_mitsuba(path: &Path, defines: &[(String, String)]) -> Result<Imported, ImportError> {
     let tree = xml::read_scene(path, defines)?;
-    let mut importer = Importer::default();
+    let mut importer =
+        Importer { main_dir: path.parent().map(Path::to_path_buf), ..Importer::default() };
     importer.scene(&tree.root)?;
     let name = path
         .file_stem()
@@ -108,6 +109,8 @@ struct Importer {
     camera: Option<Value>,
     settings: serde_json::Map<String, Value>,
     notes: Vec<ImportNote>,
+    /// The main scene file's folder.
+    main_dir: Option<PathBuf>,
 }
 
 impl Importer {
@@ -181,8 +184,13 @@ impl Importer {
 
     /// A file named in `el`, resolved against the file that names it; absolute.
     fn file_path(&self, el: &Element, name: &str) -> Result<PathBuf, ImportError> {
-        let dir = el.loc.file.parent().unwrap_or_else(|| Path::new("."));
-        let path = dir.join(name);
+        // Resolved against the folder of the file that names it, or else (as Mitsuba's file
+        // resolver does for included fragments) the main scene's folder.
+        let own = el.loc.file.parent().unwrap_or_else(|| Path::new(".")).join(name);
+        let path = match &self.main_dir {
+            Some(main) if !own.exists() && main.join(name).exists() => main.join(name),
+            _ => own,
+        };
         std::path::absolute(&path)
             .map_err(|e| error_at(&el.loc, format!("{}: {e}", path.display())))
     }

@@ -1,0 +1,240 @@
+//! The Mitsuba importer: the real scenes of `../shared/realworld/scenes/` (skipped, with a
+//! message, when that folder is absent), the unit conversions of every emitter, errors with
+//! file and line for what is not supported, `-D`, `convert`, and PLY meshes.
+
+use std::f64::consts::PI;
+use std::path::{Path, PathBuf};
+
+use spectrace_lights::LightSource;
+use spectrace_renderer::{
+    LoadOptions, RenderOptions, Scene, convert, import_mitsuba, render_in_memory,
+};
+
+use crate::rendering::temp_dir;
+
+/// `../shared/realworld/scenes` beside the workspace, if present.
+fn realworld_scenes() -> Option<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/realworld/scenes");
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        eprintln!(
+            "skipped: {} is absent (the real scenes live outside the repository)",
+            dir.display()
+        );
+        None
+    }
+}
+
+/// Writes `files` (name, text) into a fresh folder and returns the first one's path.
+fn write_scene(test: &str, files: &[(&str, &str)]) -> PathBuf {
+    let dir = temp_dir(test);
+    for (name, text) in files {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
+    dir.join(files[0].0)
+}
+
+const SENSOR: &str = r#"<sensor type="perspective"><float name="fov" value="40"/>
+    <transform name="to_world"><lookat origin="0,0,5" target="0,0,0" up="0,1,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="12"/></film></sensor>"#;
+
+fn with_sensor(body: &str) -> String {
+    format!("<scene version=\"3.0.0\">\n{SENSOR}\n{body}\n</scene>\n")
+}
+
+/// Every XML scene of the real scene folder imports, loads and renders (8 spp, 32 pixels wide
+/// where the file lets `-D` set the size) to a finite, lit image; the Cornell boxes' light is the
+/// glowing luminaire or rectangle, with the power `pi A integral(L)`.
+#[test]
+fn the_real_mitsuba_scenes_import_and_render() {
+    let Some(dir) = realworld_scenes() else { return };
+    let defines: Vec<(String, String)> = [("res", "32"), ("resx", "32"), ("resy", "32")]
+        .iter()
+        .map(|(k, v)| ((*k).into(), (*v).into()))
+        .collect();
+    for file in [
+        "mitsuba3-cbox/cbox.xml",
+        "mitsuba3-cbox/cbox-spectral.xml",
+        "mitsuba3-cbox/cbox-rgb.xml",
+        "bitterli-cornell-box/scene_v3.xml",
+    ] {
+        let path = dir.join(file);
+        let scene = Scene::import_with(&path, &defines, LoadOptions::default())
+            .unwrap_or_else(|e| panic!("{file}: {e}"));
+        assert_eq!(scene.camera.width(), 32, "{file}");
+        assert_eq!(scene.lights.lights().len(), 1, "{file}");
+        assert!(
+            scene.inputs.iter().any(|p| p.ends_with(Path::new(file).file_name().unwrap())),
+            "{file}"
+        );
+        let options = RenderOptions { spp: Some(8), threads: Some(2), ..RenderOptions::default() };
+        let r = render_in_memory(&scene, &options).unwrap();
+        let mean = r.image.iter().map(|p| p.y).sum::<f64>() / r.image.len() as f64;
+        assert!(r.image.iter().all(|p| p.is_finite()), "{file}");
+        assert!(mean > 0.01, "{file}: mean Y {mean}");
+    }
+    // The spectral box's luminaire: 130 x 105 mm, radiance table 400:0, 500:8, 600:15.6, 700:18.4.
+    let scene = Scene::load(&dir.join("mitsuba3-cbox/cbox.xml")).unwrap();
+    let integral =
+        100.0 * (0.0 + 8.0) / 2.0 + 100.0 * (8.0 + 15.6) / 2.0 + 100.0 * (15.6 + 18.4) / 2.0;
+    let power = scene.lights.power();
+    let expected = PI * 130.0 * 105.0 * integral;
+    assert!((power / expected - 1.0).abs() < 1e-9, "{power} vs {expected}");
+}
+
+/// Emitters in power: an area emitter of constant radiance 2 per nm on Mitsuba's default
+/// rectangle (area 4) emits `pi * 4 * 2 * 470` W over 360-830 nm; a point light of intensity 3
+/// per nm `4 pi * 3 * 470`; a spot of cutoff 30 and beam width 20 degrees the integral of its
+/// linear falloff (checked against a midpoint sum).
+#[test]
+fn emitter_units_convert_exactly() {
+    let area = with_sensor(
+        r#"<shape type="rectangle"><emitter type="area"><spectrum name="radiance" value="2"/></emitter></shape>"#,
+    );
+    let scene = Scene::load(&write_scene("import-area", &[("a.xml", &area)])).unwrap();
+    assert!((scene.lights.power() / (PI * 4.0 * 2.0 * 470.0) - 1.0).abs() < 1e-12);
+
+    let point = with_sensor(
+        r#"<shape type="sphere"/><emitter type="point"><point name="position" value="0,2,0"/><spectrum name="intensity" value="3"/></emitter>"#,
+    );
+    let scene = Scene::load(&write_scene("import-point", &[("p.xml", &point)])).unwrap();
+    assert!((scene.lights.power() / (4.0 * PI * 3.0 * 470.0) - 1.0).abs() < 1e-12);
+
+    let spot = with_sensor(
+        r#"<shape type="sphere"/><emitter type="spot"><float name="cutoff_angle" value="30"/><float name="beam_width" value="20"/>
+        <spectrum name="intensity" value="1"/><transform name="to_world"><lookat origin="0,3,0" target="0,0,0" up="0,0,1"/></transform></emitter>"#,
+    );
+    let scene = Scene::load(&write_scene("import-spot", &[("s.xml", &spot)])).unwrap();
+    let (c, b) = (30f64.to_radians(), 20f64.to_radians());
+    let n = 100_000;
+    let solid: f64 = (0..n)
+        .map(|i| {
+            let t = c * (i as f64 + 0.5) / n as f64;
+            let f = if t <= b { 1.0 } else { (c - t) / (c - b) };
+            2.0 * PI * f * t.sin() * c / n as f64
+        })
+        .sum();
+    assert!(
+        (scene.lights.power() / (solid * 470.0) - 1.0).abs() < 1e-6,
+        "{} vs {}",
+        scene.lights.power(),
+        solid * 470.0
+    );
+}
+
+/// What the importer does not support is refused with the file and line and the cause.
+#[test]
+fn unsupported_elements_are_refused_with_file_and_line() {
+    let cases = [
+        (
+            with_sensor(r#"<shape type="sphere"><bsdf type="principled"/></shape>"#),
+            ":5:",
+            "principled",
+        ),
+        (
+            with_sensor(r#"<shape type="sphere"><float name="wobble" value="1"/></shape>"#),
+            ":5:",
+            "wobble",
+        ),
+        (
+            with_sensor(r#"<shape type="sphere"><float name="radius" value="$r"/></shape>"#),
+            ":5:",
+            "$r",
+        ),
+        (with_sensor(r#"<shape type="sphere"><ref id="nothing"/></shape>"#), ":5:", "<ref> here"),
+        (
+            with_sensor(
+                r#"<shape type="sphere"><transform name="to_world"><scale x="2"/></transform></shape>"#,
+            ),
+            ":5:",
+            "non-uniform",
+        ),
+        (with_sensor(r#"<emitter type="envmap"/>"#), ":5:", "envmap"),
+        (
+            with_sensor(
+                r#"<shape type="sphere"><bsdf type="diffuse"><rgb name="reflectance" value="1.5, 0, 0"/></bsdf></shape>"#,
+            ),
+            ":5:",
+            "[0, 1]",
+        ),
+        ("<scene version=\"3.0.0\"><shape type=\"sphere\"/></scene>".to_owned(), "", "no <sensor>"),
+        ("<scene><unclosed></scene>".to_owned(), "", "XML"),
+    ];
+    for (i, (text, line, cause)) in cases.iter().enumerate() {
+        let path = write_scene(&format!("import-bad-{i}"), &[("bad.xml", text)]);
+        let e = Scene::load(&path).unwrap_err().to_string();
+        assert!(e.contains(&format!("bad.xml{line}")) && e.contains(cause), "case {i}: {e}");
+    }
+    // An include cycle is refused, not followed forever.
+    let a = write_scene(
+        "import-cycle",
+        &[
+            ("a.xml", "<scene version=\"3.0.0\"><include filename=\"b.xml\"/></scene>"),
+            ("b.xml", "<scene version=\"3.0.0\"><include filename=\"a.xml\"/></scene>"),
+        ],
+    );
+    let e = import_mitsuba(&a, &[]).unwrap_err().to_string();
+    assert!(e.contains("cycle"), "{e}");
+}
+
+/// `-D` overrides a `<default>`, includes splice fragments, 0.6's camelCase names read, and an
+/// RGB reflectance becomes a table whose colour under D65 is the RGB.
+#[test]
+fn defaults_includes_legacy_names_and_rgb() {
+    let main = "<scene version=\"0.6.0\"><default name=\"fov\" value=\"40\"/><include filename=\"part.xml\"/>\n\
+        <sensor type=\"perspective\"><float name=\"fov\" value=\"$fov\"/><string name=\"fovAxis\" value=\"y\"/></sensor></scene>";
+    let part = "<scene version=\"0.6.0\"><shape type=\"sphere\"><bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"0.6, 0.2, 0.1\"/></bsdf>\n\
+        <emitter type=\"area\"><rgb name=\"radiance\" value=\"1\"/></emitter></shape></scene>";
+    let path = write_scene("import-defaults", &[("main.xml", main), ("part.xml", part)]);
+    let imported = import_mitsuba(&path, &[("fov".to_owned(), "25".to_owned())]).unwrap();
+    assert_eq!(imported.scene["camera"]["fov"], 25.0);
+    assert_eq!(imported.scene["camera"]["fov_axis"], "vertical");
+    assert_eq!(imported.files.len(), 2);
+    let r = &imported.scene["objects"][0]["material"]["reflectance"];
+    let nm: Vec<f64> = serde_json::from_value(r["nm"].clone()).unwrap();
+    let values: Vec<f64> = serde_json::from_value(r["values"].clone()).unwrap();
+    let table = spectrace_spectrum::Reflectance::from_table(&nm, &values).unwrap();
+    let rgb = spectrace_spectrum::rgb::srgb_under_d65(&|l| table.value(l));
+    for (c, want) in rgb.iter().zip([0.6, 0.2, 0.1]) {
+        assert!((c - want).abs() < 2e-3, "{rgb:?}");
+    }
+    let scene = Scene::load(&path).unwrap();
+    assert_eq!(scene.camera.width(), 768);
+}
+
+/// `convert` writes a native scene that loads (mesh paths relative to its folder), and never
+/// writes over the scene it reads.
+#[test]
+fn convert_writes_a_loadable_native_scene_and_never_replaces_an_input() {
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    let xml = with_sensor(
+        r#"<shape type="obj"><string name="filename" value="tri.obj"/><emitter type="area"><rgb name="radiance" value="1,1,1"/></emitter></shape>"#,
+    );
+    let path = write_scene("import-convert", &[("s.xml", &xml), ("tri.obj", obj)]);
+    let out = path.parent().unwrap().join("sub/s.json");
+    let notes = convert(&path, &out, &[]).unwrap();
+    assert!(notes.iter().all(|n| n.contains("s.xml:")), "{notes:?}");
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.contains("\"../tri.obj\""), "{text}");
+    Scene::load(&out).unwrap();
+    let e = convert(&path, &path, &[]).unwrap_err();
+    assert!(e.contains("s.xml"), "{e}");
+    assert!(std::fs::read_to_string(&path).unwrap().contains("<scene"));
+}
+
+/// The real PLY meshes of Bitterli's Veach bidirectional room load (binary little-endian, with
+/// normals and texture coordinates).
+#[test]
+fn the_real_ply_meshes_load() {
+    let Some(dir) = realworld_scenes() else { return };
+    let models = dir.join("bitterli-veach-bidir/models");
+    let mut triangles = 0;
+    for i in 0..12 {
+        let mut mesh = spectrace_geometry::Mesh::from_ply(format!("Mesh{i:03}.ply"), None);
+        mesh.load(&models).unwrap_or_else(|e| panic!("Mesh{i:03}: {e}"));
+        assert!(mesh.triangles().len() >= 10, "Mesh{i:03}");
+        triangles += mesh.triangles().len();
+    }
+    assert!(triangles > 7936, "{triangles}");
+}
