@@ -123,6 +123,30 @@ fn emitter_units_convert_exactly() {
     );
 }
 
+/// A directional emitter of irradiance 2 per nm becomes a `Sky` of 2 * 470 W per m^2 across its
+/// beams, whose rectangle, perpendicular to them, lies outside the objects and covers them.
+#[test]
+fn a_directional_emitter_becomes_a_sky_over_the_scene() {
+    let xml = with_sensor(
+        r#"<shape type="sphere"><point name="center" value="1,0,0"/><float name="radius" value="0.5"/></shape>
+        <emitter type="directional"><vector name="direction" value="0,-1,0"/><spectrum name="irradiance" value="2"/></emitter>"#,
+    );
+    let imported =
+        import_mitsuba(&write_scene("import-directional", &[("d.xml", &xml)]), &[]).unwrap();
+    let sky = &imported.scene["lights"][0];
+    assert_eq!(sky["type"], "Sky");
+    let v = |k: &str| glam::DVec3::from_array(serde_json::from_value(sky[k].clone()).unwrap());
+    let (corner, u, w, d) = (v("corner"), v("edge_u"), v("edge_v"), v("direction"));
+    let area = u.cross(w).length();
+    let power = sky["power"].as_f64().unwrap();
+    assert!((power / area / (2.0 * 470.0) - 1.0).abs() < 1e-12);
+    assert!(u.dot(d).abs() < 1e-12 && w.dot(d).abs() < 1e-12);
+    let centre = corner + (u + w) / 2.0;
+    // The rectangle is above the sphere (top at y = 0.5) and its footprint covers it.
+    assert!(centre.y > 0.5 && (centre.x - 1.0).abs() < 1e-9 && centre.z.abs() < 1e-9, "{centre}");
+    assert!(u.length() > 1.0 && w.length() > 1.0);
+}
+
 /// What the importer does not support is refused with the file and line and the cause.
 #[test]
 fn unsupported_elements_are_refused_with_file_and_line() {
@@ -151,6 +175,13 @@ fn unsupported_elements_are_refused_with_file_and_line() {
             "non-uniform",
         ),
         (with_sensor(r#"<emitter type="envmap"/>"#), ":5:", "envmap"),
+        (
+            with_sensor(
+                r#"<emitter type="directional"><spectrum name="irradiance" value="1"/></emitter>"#,
+            ),
+            ":5:",
+            "needs objects",
+        ),
         (
             with_sensor(
                 r#"<shape type="sphere"><bsdf type="diffuse"><rgb name="reflectance" value="1.5, 0, 0"/></bsdf></shape>"#,

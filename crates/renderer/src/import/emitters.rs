@@ -1,7 +1,9 @@
 //! Mitsuba's free emitters (not on a shape) as Spectrace lights, in power: `point` emits
 //! `P = 4 pi integral(I)`, `spot` (linear falloff from `beam_width` to `cutoff_angle`)
 //! `P = 2 pi integral(I) (1 - (sin c - sin b) / (c - b))`, and `2 pi integral(I) (1 - cos c)`
-//! when `beam_width >= cutoff_angle`.
+//! when `beam_width >= cutoff_angle`; `directional` of irradiance `E` becomes a `Sky` whose
+//! rectangle, perpendicular to the beams, covers the scene's bounding sphere from outside it
+//! (side `2 R`, `R` 1% beyond the sphere's radius), with `P = integral(E) (2 R)^2`.
 
 use std::f64::consts::PI;
 
@@ -70,7 +72,28 @@ impl Importer {
                     }
                 })
             }
-            "directional" | "constant" | "envmap" | "sunsky" | "projector" => {
+            "directional" => {
+                let direction = match p.get("direction") {
+                    Some(v) => vector(v)?,
+                    None => m.transform_vector3(DVec3::Z),
+                };
+                let direction = direction.normalize_or_zero();
+                if direction == DVec3::ZERO {
+                    return Err(error_at(&el.loc, "the direction is zero"));
+                }
+                let e =
+                    p.get("irradiance").ok_or_else(|| error_at(&el.loc, "needs `irradiance`"))?;
+                let spec = spectrum(e, Role::Emission)?;
+                p.finish()?;
+                match spec.emission() {
+                    Some((irradiance, spd)) => {
+                        self.directional.push((el.loc.clone(), direction, irradiance, spd))
+                    }
+                    None => self.note(el, "emits nothing (zero irradiance): left out"),
+                }
+                return Ok(());
+            }
+            "constant" | "envmap" | "sunsky" | "projector" => {
                 return Err(error_at(
                     &el.loc,
                     format!(
@@ -90,6 +113,46 @@ impl Importer {
         match light {
             Some(l) => self.lights.push(l),
             None => self.note(el, "emits nothing (zero intensity): left out"),
+        }
+        Ok(())
+    }
+}
+
+impl Importer {
+    /// The `Sky` lights of the directional emitters, placed once every object is known.
+    pub(super) fn place_directional(&mut self) -> Result<(), ImportError> {
+        if self.directional.is_empty() {
+            return Ok(());
+        }
+        let mut bounds: Option<spectrace_geometry::Bounds> = None;
+        for (i, object) in self.objects.iter().enumerate() {
+            let loc = &self.directional[0].0;
+            let mut shape: spectrace_geometry::Shape =
+                serde_json::from_value(object["shape"].clone()).map_err(|e| {
+                    error_at(loc, format!("placing the directional light: object {i}: {e}"))
+                })?;
+            shape.load(std::path::Path::new("/")).map_err(|e| {
+                error_at(loc, format!("placing the directional light: object {i}: {e}"))
+            })?;
+            let b = shape.bounds();
+            bounds = Some(bounds.map_or(b, |a| a.union(b)));
+        }
+        let Some(bounds) = bounds else {
+            return Err(error_at(
+                &self.directional[0].0,
+                "a directional light needs objects to light",
+            ));
+        };
+        let center = bounds.center();
+        let radius = ((bounds.max - bounds.min).length() / 2.0).max(1e-6) * 1.01;
+        for (_, d, irradiance, spd) in std::mem::take(&mut self.directional) {
+            let (u, v) = d.any_orthonormal_pair();
+            let corner = center - d * radius - u * radius - v * radius;
+            self.lights.push(json!({
+                "type": "Sky", "corner": corner.to_array(), "edge_u": (u * 2.0 * radius).to_array(),
+                "edge_v": (v * 2.0 * radius).to_array(), "direction": d.to_array(),
+                "power": irradiance * 4.0 * radius * radius, "spd": spd
+            }));
         }
         Ok(())
     }

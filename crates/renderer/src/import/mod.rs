@@ -111,6 +111,9 @@ struct Importer {
     notes: Vec<ImportNote>,
     /// The main scene file's folder.
     main_dir: Option<PathBuf>,
+    /// Directional emitters (place, direction, irradiance, spectrum), placed when every object
+    /// is known.
+    directional: Vec<(xml::Loc, DVec3, f64, Value)>,
 }
 
 impl Importer {
@@ -144,6 +147,7 @@ impl Importer {
 
     /// The native scene.
     fn finish(&mut self, root: &Element, name: &str) -> Result<Value, ImportError> {
+        self.place_directional()?;
         let camera =
             self.camera.take().ok_or_else(|| error_at(&root.loc, "the scene has no <sensor>"))?;
         let mut scene = json!({
