@@ -71,7 +71,7 @@ pub trait Microfacet {
 
 /// Which microfacet distribution a rough material uses: `"distribution"` in a scene file,
 /// `"ggx"` (the default) or `"beckmann"` (Mitsuba 3's default), with the same `alpha`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Distribution {
     /// Trowbridge-Reitz ([`Ggx`]).
@@ -94,6 +94,14 @@ impl Facets {
         match kind {
             Distribution::Ggx => Facets::Ggx(Ggx::new(alpha_x, alpha_y)),
             Distribution::Beckmann => Facets::Beckmann(Beckmann::new(alpha_x, alpha_y)),
+        }
+    }
+
+    /// Its alphas along `+x` and `+y`.
+    pub(crate) fn alphas(&self) -> (f64, f64) {
+        match self {
+            Facets::Ggx(g) => (g.alpha_x(), g.alpha_y()),
+            Facets::Beckmann(b) => (b.alpha_x(), b.alpha_y()),
         }
     }
 

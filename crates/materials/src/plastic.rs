@@ -1,11 +1,12 @@
-//! [`Plastic`]: a dielectric coating (smooth or GGX-rough) over a Lambertian base, the classic
+//! [`Plastic`]: a dielectric coating (smooth, or rough with GGX or Beckmann microfacets) over a Lambertian base, the classic
 //! "plastic" of Weidlich and Wilkie (2007) and Mitsuba's `plastic` / `roughplastic`.
 //!
 //! | field | unit | default | meaning |
 //! |---|---|---|---|
 //! | `reflectance` | fraction in `[0, 1]`, a number or `{"nm": [...], "values": [...]}` | required | the base's albedo `R(lambda)` (its colour) |
 //! | `ior` | number or law, see [`Ior`] | `1.5` | index of refraction of the coating, `n(lambda)`; the outside is vacuum |
-//! | `roughness` | GGX alpha, finite, `>= 0` | `0` | roughness of the coating; below [`SMOOTH_ALPHA`] (e.g. 0) it is smooth (a delta reflection) |
+//! | `roughness` | microfacet alpha, finite, `>= 0` | `0` | roughness of the coating; below [`SMOOTH_ALPHA`] (e.g. 0) it is smooth (a delta reflection) |
+//! | `distribution` | `"ggx"` or `"beckmann"` | `"ggx"` | the rough coating's microfacet distribution ([`Distribution`]; Mitsuba's `roughplastic` defaults to Beckmann) |
 //!
 //! ```json
 //! {"type": "Plastic", "reflectance": {"nm": [400, 500, 600, 700], "values": [0.05, 0.1, 0.6, 0.8]}}
@@ -65,7 +66,7 @@ use spectrace_sampling::{Frame, clamp_uniform, sample_cosine_hemisphere};
 
 use crate::fresnel::fresnel_dielectric;
 use crate::ior::IorRepr;
-use crate::microfacet::{Microfacet, check_alpha};
+use crate::microfacet::{Distribution, Facets, Microfacet, check_alpha};
 use crate::vectors::normalise;
 use crate::{
     BundleScattered, Ggx, Incoming, Ior, Material, MaterialError, ScatterKind, Scattered,
@@ -88,6 +89,8 @@ pub struct Plastic {
     reflectance: Reflectance,
     ior: Ior,
     alpha: f64,
+    /// The coating's microfacet distribution (GGX unless asked).
+    distribution: Distribution,
     /// The mean of the base's reflectance values (for the lobe choice).
     mean_reflectance: f64,
     coating: Vec<Node>,
@@ -112,6 +115,8 @@ struct PlasticRepr {
     ior: IorRepr,
     #[serde(default)]
     roughness: f64,
+    #[serde(default)]
+    distribution: Distribution,
 }
 
 fn default_ior() -> IorRepr {
@@ -122,13 +127,18 @@ impl TryFrom<PlasticRepr> for Plastic {
     type Error = MaterialError;
     fn try_from(r: PlasticRepr) -> Result<Self, MaterialError> {
         let ior = Ior::try_from(r.ior).map_err(|e| e.within(NAME, "ior"))?;
-        Self::new(r.reflectance, ior, r.roughness)
+        Self::with_facets(r.reflectance, ior, r.roughness, r.distribution)
     }
 }
 
 impl From<Plastic> for PlasticRepr {
     fn from(p: Plastic) -> Self {
-        Self { reflectance: p.reflectance, ior: p.ior.into(), roughness: p.alpha }
+        Self {
+            reflectance: p.reflectance,
+            ior: p.ior.into(),
+            roughness: p.alpha,
+            distribution: p.distribution,
+        }
     }
 }
 
@@ -149,6 +159,20 @@ impl Plastic {
     /// [`MaterialError::Parameter`] naming `roughness` unless it is finite and `>= 0`. (An
     /// [`Ior`] is valid by construction: finite and `>= 1`.)
     pub fn new(reflectance: Reflectance, ior: Ior, roughness: f64) -> Result<Self, MaterialError> {
+        Self::with_facets(reflectance, ior, roughness, Distribution::Ggx)
+    }
+
+    /// As [`Plastic::new`], with the coating's microfacet distribution `kind` (GGX or
+    /// Beckmann; the roughness is its alpha either way).
+    ///
+    /// # Errors
+    /// As [`Plastic::new`].
+    pub fn with_facets(
+        reflectance: Reflectance,
+        ior: Ior,
+        roughness: f64,
+        kind: Distribution,
+    ) -> Result<Self, MaterialError> {
         check_alpha(NAME, "roughness", roughness)?;
         let smooth = Ggx::is_smooth_alphas(roughness, roughness);
         let lambdas: Vec<f64> = if ior.is_dispersive() {
@@ -160,12 +184,23 @@ impl Plastic {
         let coating = lambdas
             .into_iter()
             .map(|lambda| {
-                Node::new(lambda, ior.n(lambda), (!smooth).then(|| Ggx::new(roughness, roughness)))
+                Node::new(
+                    lambda,
+                    ior.n(lambda),
+                    (!smooth).then(|| Facets::new(kind, roughness, roughness)),
+                )
             })
             .collect();
         let values = reflectance_values(&reflectance);
         let mean_reflectance = values.iter().sum::<f64>() / values.len().max(1) as f64;
-        Ok(Self { reflectance, ior, alpha: roughness, mean_reflectance, coating })
+        Ok(Self {
+            reflectance,
+            ior,
+            alpha: roughness,
+            distribution: kind,
+            mean_reflectance,
+            coating,
+        })
     }
 
     /// A smooth plastic of base albedo `reflectance` and the default coating (ior 1.5).
@@ -197,8 +232,13 @@ impl Plastic {
         Ggx::is_smooth_alphas(self.alpha, self.alpha)
     }
 
-    fn ggx(&self) -> Ggx {
-        Ggx::new(self.alpha, self.alpha)
+    /// The coating's microfacet distribution.
+    pub fn distribution(&self) -> Distribution {
+        self.distribution
+    }
+
+    fn facets(&self) -> Facets {
+        Facets::new(self.distribution, self.alpha, self.alpha)
     }
 
     /// The two table nodes around `lambda` and the weight of the second.
@@ -278,7 +318,7 @@ impl Plastic {
             return 0.0;
         }
         let m = h / len2.sqrt();
-        let ggx = self.ggx();
+        let ggx = self.facets();
         let v = fresnel_dielectric(wi.dot(m), eta) * ggx.d(m) * ggx.g(wo, wi) / (4.0 * wi.z * wo.z);
         if v.is_finite() { v } else { 0.0 }
     }
@@ -295,7 +335,7 @@ impl Plastic {
         if !(cos > 0.0) {
             return 0.0;
         }
-        let p = self.ggx().pdf_visible(wi, m) / (4.0 * cos);
+        let p = self.facets().pdf_visible(wi, m) / (4.0 * cos);
         if p.is_finite() { p } else { 0.0 }
     }
 
@@ -319,7 +359,7 @@ impl Plastic {
         }
         let uv = [clamp_uniform(u[1]), clamp_uniform(u[2])];
         let wo = if specular {
-            let m = self.ggx().sample_visible(wi, uv);
+            let m = self.facets().sample_visible(wi, uv);
             normalise(2.0 * wi.dot(m) * m - wi)
         } else {
             sample_cosine_hemisphere(uv)
@@ -388,7 +428,7 @@ impl Plastic {
 
 impl Node {
     /// The tables at `lambda` for index `eta`, with the rough lobe `ggx` (`None`: smooth).
-    fn new(lambda: f64, eta: f64, ggx: Option<Ggx>) -> Self {
+    fn new(lambda: f64, eta: f64, ggx: Option<Facets>) -> Self {
         match ggx {
             None => {
                 // T = 2 integral_0^1 (1 - F(c)) c dc, midpoint rule.
@@ -435,10 +475,11 @@ const ALBEDO_CACHE_MAX: usize = 1 << 16;
 /// `(alpha, eta)` in a process: a scene whose objects share a plastic (each object has its own
 /// material in a scene file) builds its table once, not once per object. The cache stops
 /// growing at [`ALBEDO_CACHE_MAX`] entries (tables are then computed each time).
-fn rough_albedo_table(ggx: &Ggx, eta: f64) -> Vec<f64> {
-    type Key = (u64, u64, u64);
+fn rough_albedo_table(ggx: &Facets, eta: f64) -> Vec<f64> {
+    type Key = (Distribution, u64, u64, u64);
     static CACHE: LazyLock<Mutex<HashMap<Key, Vec<f64>>>> = LazyLock::new(Default::default);
-    let key = (ggx.alpha_x().to_bits(), ggx.alpha_y().to_bits(), eta.to_bits());
+    let (ax, ay) = ggx.alphas();
+    let key = (ggx.kind(), ax.to_bits(), ay.to_bits(), eta.to_bits());
     if let Some(table) = CACHE.lock().ok().and_then(|c| c.get(&key).cloned()) {
         return table;
     }
@@ -456,7 +497,7 @@ fn rough_albedo_table(ggx: &Ggx, eta: f64) -> Vec<f64> {
 /// The directional albedo of a rough dielectric's reflection lobe, `integral F D G / (4 cos_i)
 /// dwo` over the upper hemisphere, for a beam at `cos_i`: the mean of `F(wi.m) G / G1(wi)` over
 /// the visible normals (a midpoint grid of the sampler's uniforms).
-fn rough_albedo(ggx: &Ggx, eta: f64, cos_i: f64) -> f64 {
+fn rough_albedo(ggx: &Facets, eta: f64, cos_i: f64) -> f64 {
     let sin_i = (1.0 - cos_i * cos_i).max(0.0).sqrt();
     let wi = DVec3::new(sin_i, 0.0, cos_i);
     let g1 = ggx.g1(wi);

@@ -113,11 +113,15 @@ impl Importer {
                 if el.kind() == "roughplastic" {
                     let alpha = p.float("alpha", 0.1)?;
                     let distribution = p.string("distribution")?.unwrap_or("beckmann");
-                    if distribution == "beckmann" {
-                        self.note(el, "Spectrace's rough Plastic has GGX microfacets only: Mitsuba's Beckmann roughplastic is rendered with GGX of the same alpha");
+                    if distribution != "beckmann" && distribution != "ggx" {
+                        return Err(error_at(
+                            &el.loc,
+                            format!("distribution \"{distribution}\": ggx or beckmann"),
+                        ));
                     }
                     p.get("sample_visible");
                     m["roughness"] = json!(alpha);
+                    m["distribution"] = json!(distribution);
                 }
                 m
             }
