@@ -147,6 +147,72 @@ fn a_directional_emitter_becomes_a_sky_over_the_scene() {
     assert!(u.length() > 1.0 && w.length() > 1.0);
 }
 
+/// A constant environment of radiance 1 per nm is seen as luminance 1 in every direction
+/// (the film's convention: `Y = integral L ybar / integral ybar`): the mean Y of an image that
+/// sees only the environment (its one object behind the camera) is 1 within three standard
+/// errors of its pixels.
+#[test]
+fn a_constant_environment_is_seen_as_its_radiance() {
+    let xml = with_sensor(
+        r#"<shape type="sphere"><point name="center" value="0,0,9"/><float name="radius" value="0.5"/></shape>
+        <emitter type="constant"><spectrum name="radiance" value="1"/></emitter>"#,
+    );
+    let scene = Scene::load(&write_scene("import-constant", &[("c.xml", &xml)])).unwrap();
+    let options = RenderOptions { spp: Some(16), threads: Some(2), ..RenderOptions::default() };
+    let r = render_in_memory(&scene, &options).unwrap();
+    let n = r.image.len() as f64;
+    let mean = r.image.iter().map(|p| p.y).sum::<f64>() / n;
+    let var = r.image.iter().map(|p| (p.y - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    let se = (var / n).sqrt();
+    assert!((mean - 1.0).abs() < 3.0 * se + 1e-9, "{mean} +- {se}");
+}
+
+/// The shipped Mitsuba scene (`scenes/mitsuba/sky_plastic_gold.xml`) imports with its sky as a
+/// glowing sphere (a fourth object) and its sun as a `Sky`, and renders to a finite, lit image.
+#[test]
+fn the_shipped_mitsuba_scene_imports_and_renders() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/mitsuba/sky_plastic_gold.xml");
+    let defines = [("width".to_owned(), "32".to_owned()), ("height".to_owned(), "24".to_owned())];
+    let imported = import_mitsuba(&path, &defines).unwrap();
+    assert_eq!(imported.scene["objects"].as_array().unwrap().len(), 4);
+    assert_eq!(imported.scene["lights"][0]["type"], "Sky");
+    assert_eq!(imported.scene["objects"][0]["material"]["distribution"], "beckmann");
+    let scene = Scene::import_with(&path, &defines, LoadOptions::default()).unwrap();
+    let options = RenderOptions { spp: Some(4), threads: Some(2), ..RenderOptions::default() };
+    let r = render_in_memory(&scene, &options).unwrap();
+    assert!(r.image.iter().all(|p| p.is_finite()));
+    assert!(r.image.iter().map(|p| p.y).sum::<f64>() / r.image.len() as f64 > 0.1);
+}
+
+/// Mitsuba's linear plastic (`nonlinear` false, its default) is imported with the base albedo
+/// `R / (1 - F_dr + R F_dr)`, which makes Spectrace's diffuse term `R' / (1 - R' F_dr)` equal
+/// Mitsuba's `R / (1 - F_dr)`; with `nonlinear` true the albedo is kept.
+#[test]
+fn a_linear_plastic_keeps_mitsubas_diffuse_term() {
+    for (nonlinear, keep) in [("false", false), ("true", true)] {
+        let xml = with_sensor(&format!(
+            r#"<shape type="sphere"><bsdf type="plastic"><float name="diffuse_reflectance" value="0.4"/>
+            <boolean name="nonlinear" value="{nonlinear}"/><float name="int_ior" value="1.5"/><float name="ext_ior" value="1"/></bsdf>
+            <emitter type="area"><spectrum name="radiance" value="1"/></emitter></shape>"#
+        ));
+        let imported = import_mitsuba(
+            &write_scene(&format!("import-plastic-{nonlinear}"), &[("p.xml", &xml)]),
+            &[],
+        )
+        .unwrap();
+        let r = imported.scene["objects"][0]["material"]["reflectance"].as_f64().unwrap();
+        if keep {
+            assert_eq!(r, 0.4);
+        } else {
+            let white: spectrace_materials::Plastic =
+                serde_json::from_str(r#"{"reflectance": 1.0, "ior": 1.5}"#).unwrap();
+            let f = white.internal_diffuse_reflectance(550.0);
+            assert!(f > 0.5 && f < 0.7, "{f}");
+            assert!((r / (1.0 - r * f) - 0.4 / (1.0 - f)).abs() < 1e-12, "{r}");
+        }
+    }
+}
+
 /// What the importer does not support is refused with the file and line and the cause.
 #[test]
 fn unsupported_elements_are_refused_with_file_and_line() {

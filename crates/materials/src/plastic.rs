@@ -418,6 +418,16 @@ impl Plastic {
         normalise(frame.to_world(wo))
     }
 
+    /// The fraction `F_dr` of diffuse light inside the coating that it reflects back to the
+    /// base at `lambda`: `1 - T / n^2`, `T` the coating's hemispherical transmission from
+    /// outside (`(1 - R F_dr)` is the internal-reflection series' denominator of the diffuse
+    /// term). Mitsuba's linear plastic (`nonlinear` false) divides by `1 - F_dr` instead: an
+    /// importer matches it with the base albedo `R / (1 - F_dr + R F_dr)`.
+    pub fn internal_diffuse_reflectance(&self, lambda: f64) -> f64 {
+        let n = self.ior.n(lambda);
+        1.0 - self.transmission(lambda) / (n * n)
+    }
+
     /// The specular lobe's directional albedo `S(cos)` of this coating at `lambda`, the
     /// quantity the diffuse transmission `1 - S` uses (the exact Fresnel `F(cos)` when smooth,
     /// the tabulated microfacet albedo when rough).

@@ -101,30 +101,7 @@ impl Importer {
                 }
                 m
             }
-            "plastic" | "roughplastic" => {
-                let r = self.reflectance(&p, "diffuse_reflectance", 0.5)?;
-                let ior = self.ior(&p, "int_ior", 1.49)? / self.ior(&p, "ext_ior", 1.000_277)?;
-                self.unit_scale(&p, "specular_reflectance")?;
-                if p.boolean("nonlinear", false)? {
-                    return Err(error_at(&el.loc, "plastic with nonlinear=true is not supported"));
-                }
-                one_sided_note(self);
-                let mut m = json!({"type": "Plastic", "reflectance": r, "ior": ior});
-                if el.kind() == "roughplastic" {
-                    let alpha = p.float("alpha", 0.1)?;
-                    let distribution = p.string("distribution")?.unwrap_or("beckmann");
-                    if distribution != "beckmann" && distribution != "ggx" {
-                        return Err(error_at(
-                            &el.loc,
-                            format!("distribution \"{distribution}\": ggx or beckmann"),
-                        ));
-                    }
-                    p.get("sample_visible");
-                    m["roughness"] = json!(alpha);
-                    m["distribution"] = json!(distribution);
-                }
-                m
-            }
+            "plastic" | "roughplastic" => self.plastic(el, &p, two_sided)?,
             other => {
                 return Err(error_at(
                     &el.loc,
@@ -137,6 +114,60 @@ impl Importer {
         };
         p.finish()?;
         Ok(material)
+    }
+
+    /// A smooth or rough plastic. Mitsuba's default `nonlinear` false divides the diffuse
+    /// term by `1 - F_dr` whatever the base albedo `R`; Spectrace's, physically, by
+    /// `1 - R F_dr` (Mitsuba's `nonlinear` true). The linear look is kept exactly (for the
+    /// coating's own `F_dr`) by the base albedo `R / (1 - F_dr + R F_dr)`, noted.
+    fn plastic(
+        &mut self,
+        el: &Element,
+        p: &Params<'_>,
+        two_sided: bool,
+    ) -> Result<Value, ImportError> {
+        let base = match p.get("diffuse_reflectance") {
+            Some(e) => spectrum(e, Role::Reflectance)?,
+            None => super::spectra::Spec::Constant(0.5),
+        };
+        let ior = self.ior(p, "int_ior", 1.49)? / self.ior(p, "ext_ior", 1.000_277)?;
+        self.unit_scale(p, "specular_reflectance")?;
+        let mut m = json!({"type": "Plastic", "ior": ior});
+        if el.kind() == "roughplastic" {
+            let alpha = p.float("alpha", 0.1)?;
+            let distribution = p.string("distribution")?.unwrap_or("beckmann");
+            if distribution != "beckmann" && distribution != "ggx" {
+                return Err(error_at(
+                    &el.loc,
+                    format!("distribution \"{distribution}\": ggx or beckmann"),
+                ));
+            }
+            p.get("sample_visible");
+            m["roughness"] = json!(alpha);
+            m["distribution"] = json!(distribution);
+            self.note(el, "rough plastic: Spectrace's rough coating transmits up to 8% differently from Mitsuba's tables (docs/materials-peer.md)");
+        }
+        let base = if p.boolean("nonlinear", false)? {
+            base
+        } else {
+            let mut white = m.clone();
+            white["reflectance"] = json!(1.0);
+            if let Some(o) = white.as_object_mut() {
+                o.remove("type");
+            }
+            let white: spectrace_materials::Plastic = serde_json::from_value(white)
+                .map_err(|e| error_at(&el.loc, format!("{}: {e}", el.describe())))?;
+            self.note(el, "nonlinear=false (Mitsuba's default): rendered with the base albedo R / (1 - F_dr + R F_dr), which gives Mitsuba's linear diffuse term for Spectrace's coating");
+            base.map(|lambda, r| {
+                let f = white.internal_diffuse_reflectance(lambda);
+                r / (1.0 - f + r * f)
+            })
+        };
+        m["reflectance"] = base.reflectance_json();
+        if !two_sided {
+            self.note(el, "one-sided in Mitsuba; Spectrace's material reflects on both sides (the same image unless light reaches its back)");
+        }
+        Ok(m)
     }
 
     /// A smooth or rough conductor.

@@ -3,7 +3,11 @@
 //! `P = 2 pi integral(I) (1 - (sin c - sin b) / (c - b))`, and `2 pi integral(I) (1 - cos c)`
 //! when `beam_width >= cutoff_angle`; `directional` of irradiance `E` becomes a `Sky` whose
 //! rectangle, perpendicular to the beams, covers the scene's bounding sphere from outside it
-//! (side `2 R`, `R` 1% beyond the sphere's radius), with `P = integral(E) (2 R)^2`.
+//! (side `2 R`, `R` 1% beyond the sphere's radius), with `P = integral(E) (2 R)^2`; `constant`
+//! of radiance `L` becomes a black sphere around the objects and the camera (1.5 times their
+//! bounding sphere) glowing on both sides with radiance `L`: every point inside receives `L` from
+//! every direction, exactly a constant environment (the outward half of its power is wasted by
+//! the light tracer).
 
 use std::f64::consts::PI;
 
@@ -93,7 +97,17 @@ impl Importer {
                 }
                 return Ok(());
             }
-            "constant" | "envmap" | "sunsky" | "projector" => {
+            "constant" => {
+                let r = p.get("radiance").ok_or_else(|| error_at(&el.loc, "needs `radiance`"))?;
+                let spec = spectrum(r, Role::Emission)?;
+                p.finish()?;
+                match spec.emission() {
+                    Some((radiance, spd)) => self.constant.push((el.loc.clone(), radiance, spd)),
+                    None => self.note(el, "emits nothing (zero radiance): left out"),
+                }
+                return Ok(());
+            }
+            "envmap" | "sunsky" | "projector" => {
                 return Err(error_at(
                     &el.loc,
                     format!(
@@ -119,14 +133,20 @@ impl Importer {
 }
 
 impl Importer {
-    /// The `Sky` lights of the directional emitters, placed once every object is known.
-    pub(super) fn place_directional(&mut self) -> Result<(), ImportError> {
-        if self.directional.is_empty() {
+    /// The lights placed around the scene once every object is known: the `Sky` of each
+    /// directional emitter, and for a constant environment a glowing sphere around everything.
+    pub(super) fn place_around(&mut self, camera: glam::DVec3) -> Result<(), ImportError> {
+        let Some(loc) = self
+            .directional
+            .first()
+            .map(|d| d.0.clone())
+            .or_else(|| self.constant.first().map(|c| c.0.clone()))
+        else {
             return Ok(());
-        }
+        };
         let mut bounds: Option<spectrace_geometry::Bounds> = None;
         for (i, object) in self.objects.iter().enumerate() {
-            let loc = &self.directional[0].0;
+            let loc = &loc;
             let mut shape: spectrace_geometry::Shape =
                 serde_json::from_value(object["shape"].clone()).map_err(|e| {
                     error_at(loc, format!("placing the directional light: object {i}: {e}"))
@@ -152,6 +172,19 @@ impl Importer {
                 "type": "Sky", "corner": corner.to_array(), "edge_u": (u * 2.0 * radius).to_array(),
                 "edge_v": (v * 2.0 * radius).to_array(), "direction": d.to_array(),
                 "power": irradiance * 4.0 * radius * radius, "spd": spd
+            }));
+        }
+        // A constant environment: a sphere of uniform radiance around the objects and the camera
+        // sends the same radiance from every direction to every point inside it, exactly.
+        let around = bounds.with_point(camera);
+        let (centre, sphere_radius) =
+            (around.center(), ((around.max - around.min).length() / 2.0).max(1e-6) * 1.5);
+        for (_, radiance, spd) in std::mem::take(&mut self.constant) {
+            self.objects.push(json!({
+                "name": "constant environment",
+                "shape": {"type": "Sphere", "center": centre.to_array(), "radius": sphere_radius},
+                "material": {"type": "Diffuse", "reflectance": 0.0},
+                "emission": {"radiance": radiance, "spd": spd, "two_sided": true}
             }));
         }
         Ok(())

@@ -114,6 +114,8 @@ struct Importer {
     /// Directional emitters (place, direction, irradiance, spectrum), placed when every object
     /// is known.
     directional: Vec<(xml::Loc, DVec3, f64, Value)>,
+    /// Constant environments (place, radiance, spectrum), placed around the objects.
+    constant: Vec<(xml::Loc, f64, Value)>,
 }
 
 impl Importer {
@@ -147,9 +149,10 @@ impl Importer {
 
     /// The native scene.
     fn finish(&mut self, root: &Element, name: &str) -> Result<Value, ImportError> {
-        self.place_directional()?;
         let camera =
             self.camera.take().ok_or_else(|| error_at(&root.loc, "the scene has no <sensor>"))?;
+        let eye: [f64; 3] = serde_json::from_value(camera["position"].clone()).unwrap_or_default();
+        self.place_around(DVec3::from_array(eye))?;
         let mut scene = json!({
             "camera": camera,
             "objects": std::mem::take(&mut self.objects),

@@ -90,6 +90,16 @@ impl Spec {
         })
     }
 
+    /// The spectrum with `f(lambda, value)` applied to its values (a constant at 550 nm).
+    pub(crate) fn map(&self, f: impl Fn(f64, f64) -> f64) -> Spec {
+        match self {
+            Spec::Constant(v) => Spec::Constant(f(550.0, *v)),
+            Spec::Table(nm, values) => {
+                Spec::Table(nm.clone(), nm.iter().zip(values).map(|(&l, &v)| f(l, v)).collect())
+            }
+        }
+    }
+
     /// The value when constant.
     pub(crate) fn constant(&self) -> Option<f64> {
         match self {
