@@ -21,8 +21,10 @@
 //! [`integrator_benchmark`]). Nothing but `spectrace-lab`, `xtask` and the tests depend on this
 //! crate.
 //!
-//! The modules follow the jobs, in the order a render meets them: `scene` (the file and its
-//! assembly; [`Scene::features`], the one place its features are found), `options` (overrides,
+//! The modules follow the jobs, in the order a render meets them: `import` (Mitsuba XML scenes
+//! into the native scene, [`import_mitsuba`]) and `convert`, `scene` (the typed scene both front
+//! ends produce in `scene::model`, the JSON reader in `scene::json`, the assembly in
+//! `scene::assembly`; [`Scene::features`], the one place its features are found), `options` (overrides,
 //! errors), `plan` (estimator, effects, plan, normalisation), `integrators` (the estimators, from
 //! the tracer's registry), `probe`, `warnings`, `run`
 //! ([`render_scene`] in named steps), `progress`, `write` and `output` (the files and their
