@@ -320,6 +320,35 @@ fn convert_writes_a_loadable_native_scene_and_never_replaces_an_input() {
     assert!(std::fs::read_to_string(&path).unwrap().contains("<scene"));
 }
 
+/// A `serialized` shape reads mesh `shape_index` of its file, with smooth vertex normals
+/// computed where the file has none (as Mitsuba does) unless `face_normals` is set; an index
+/// past the file's meshes is refused naming the count.
+#[test]
+fn serialized_meshes_import_by_index_with_mitsubas_normals() {
+    let tri = |z: f32| (vec![[0.0, 0.0, z], [1.0, 0.0, z], [0.0, 1.0, z]], vec![[0, 1, 2]]);
+    let bytes = spectrace_geometry::write_serialized(&[tri(0.0), tri(-1.0)]);
+    let dir = temp_dir("import-serialized");
+    std::fs::write(dir.join("m.serialized"), bytes).unwrap();
+    let shape = |index: u32, face: bool| {
+        with_sensor(&format!(
+            r#"<shape type="serialized"><string name="filename" value="m.serialized"/><integer name="shape_index" value="{index}"/>
+            <boolean name="face_normals" value="{face}"/><emitter type="area"><spectrum name="radiance" value="1"/></emitter></shape>"#
+        ))
+    };
+    std::fs::write(dir.join("s.xml"), shape(1, false)).unwrap();
+    let imported = import_mitsuba(&dir.join("s.xml"), &[]).unwrap();
+    assert_eq!(imported.scene["objects"][0]["shape"]["shape_index"], 1);
+    assert_eq!(imported.scene["objects"][0]["shape"]["vertex_normals"], "computed");
+    let scene = Scene::load(&dir.join("s.xml")).unwrap();
+    assert!((scene.lights.power() / (PI * 0.5 * 470.0) - 1.0).abs() < 1e-9);
+    std::fs::write(dir.join("f.xml"), shape(0, true)).unwrap();
+    let imported = import_mitsuba(&dir.join("f.xml"), &[]).unwrap();
+    assert_eq!(imported.scene["objects"][0]["shape"]["vertex_normals"], "none");
+    std::fs::write(dir.join("bad.xml"), shape(2, false)).unwrap();
+    let e = Scene::load(&dir.join("bad.xml")).unwrap_err().to_string();
+    assert!(e.contains("2 meshes"), "{e}");
+}
+
 /// The real PLY meshes of Bitterli's Veach bidirectional room load (binary little-endian, with
 /// normals and texture coordinates).
 #[test]

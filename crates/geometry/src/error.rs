@@ -45,6 +45,14 @@ pub enum GeometryError {
         /// What went wrong.
         reason: String,
     },
+    /// A Mitsuba serialized mesh file could not be read or is not a usable triangle mesh.
+    #[error("Mesh.serialized = {path:?}: {reason}")]
+    Serialized {
+        /// The path as resolved against the base directory.
+        path: PathBuf,
+        /// What went wrong.
+        reason: String,
+    },
     /// A mesh given by an OBJ path was passed to [`crate::World::new`] before being loaded.
     #[error(
         "shape {index}: Mesh.obj = {path:?} is not loaded; use World::with_base_dir or Shape::load"

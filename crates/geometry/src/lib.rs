@@ -42,6 +42,7 @@ mod ply;
 mod prism;
 mod ray;
 mod rectangle;
+mod serialized;
 mod shape;
 mod sphere;
 mod torus;
@@ -52,10 +53,11 @@ pub use bounds::Bounds;
 pub use cylinder::Cylinder;
 pub use disk::Disk;
 pub use error::GeometryError;
-pub use mesh::{MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_OBJ_BYTES, Mesh};
+pub use mesh::{MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_OBJ_BYTES, Mesh, VertexNormals};
 pub use prism::Prism;
 pub use ray::{Hit, Ray};
 pub use rectangle::Rectangle;
+pub use serialized::{SerializedMesh, write_serialized};
 pub use shape::{Shape, SurfacePoint};
 /// Bounded file reading, shared with every crate that reads input files (it lives in the lowest
 /// one, `spectrace-sampling`).

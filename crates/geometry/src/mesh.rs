@@ -4,6 +4,8 @@
 //! |---|---|---|---|
 //! | `obj` | path | none | OBJ file, relative to the base directory the caller passes ([`crate::World::with_base_dir`]); polygons are triangulated, normals and texture coordinates kept when present |
 //! | `ply` | path | none | PLY file (ASCII or binary), instead of `obj`, resolved the same way: `vertex` `x y z`, with `nx ny nz` and `u v` kept when present; `face` `vertex_indices` polygons triangulated (the `ply` module) |
+//! | `serialized`, `shape_index` | path, index | none, `0` | a Mitsuba serialized mesh file instead, and which of its meshes (the `serialized` module) |
+//! | `vertex_normals` | | `"file"` | for a mesh file: `"file"` (its normals; flat where it has none), `"computed"` (its normals, or angle-weighted averages of the faces where it has none, as Mitsuba computes) or `"none"` (flat shading) |
 //! | `positions` | m, `[[x, y, z], ...]` | none | inline vertices (instead of `obj`) |
 //! | `triangles` | `[[i, j, k], ...]` | required with `positions` | 0-based vertex indices, counter-clockwise seen from the outward side |
 //! | `normals` | `[[x, y, z], ...]` | none | per-vertex shading normals (inline only; as many as `positions`) |
@@ -57,6 +59,44 @@ pub struct Mesh {
     repr: Box<MeshRepr>,
 }
 
+/// Where a mesh file's shading normals come from (`vertex_normals`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum VertexNormals {
+    /// The file's own normals; flat shading where it has none (the default).
+    #[default]
+    File,
+    /// The file's normals, or where it has none the angle-weighted average of the faces around
+    /// each vertex (Thuermer and Wuethrich 1998; what Mitsuba computes for such files).
+    Computed,
+    /// Flat shading: the file's normals are not used (Mitsuba's `face_normals`).
+    None,
+}
+
+impl VertexNormals {
+    fn is_file(&self) -> bool {
+        *self == VertexNormals::File
+    }
+}
+
+/// Angle-weighted vertex normals of a triangle mesh: each face's unit normal weighted by its
+/// angle at the vertex; zero for a vertex of degenerate faces only (shading then falls back to
+/// the face's own normal).
+fn angle_weighted_normals(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<DVec3> {
+    let mut normals = vec![DVec3::ZERO; positions.len()];
+    for t in triangles {
+        let p = t.map(|i| positions[i as usize]);
+        let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+        for k in 0..3 {
+            let a = (p[(k + 1) % 3] - p[k]).normalize_or_zero();
+            let b = (p[(k + 2) % 3] - p[k]).normalize_or_zero();
+            let angle = a.dot(b).clamp(-1.0, 1.0).acos();
+            normals[t[k] as usize] += n * angle;
+        }
+    }
+    normals.into_iter().map(DVec3::normalize_or_zero).collect()
+}
+
 /// Scene-file form of [`Mesh`].
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -65,6 +105,12 @@ struct MeshRepr {
     obj: Option<PathBuf>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     ply: Option<PathBuf>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    serialized: Option<PathBuf>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    shape_index: Option<usize>,
+    #[serde(default, skip_serializing_if = "VertexNormals::is_file")]
+    vertex_normals: VertexNormals,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     positions: Option<Vec<DVec3>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -81,24 +127,43 @@ impl TryFrom<MeshRepr> for Mesh {
     type Error = GeometryError;
     fn try_from(r: MeshRepr) -> Result<Self, GeometryError> {
         const S: &str = "Mesh";
-        if let Some(ply) = &r.ply {
-            if r.obj.is_some() || r.positions.is_some() || r.triangles.is_some() {
+        let files = [("ply", &r.ply), ("serialized", &r.serialized)];
+        if let Some((key, Some(path))) = files.iter().find(|(_, p)| p.is_some()) {
+            let sources =
+                [r.obj.is_some(), r.ply.is_some(), r.serialized.is_some(), r.positions.is_some()];
+            if sources.iter().filter(|&&s| s).count() > 1 || r.triangles.is_some() {
                 return Err(GeometryError::parameter(
                     S,
-                    "ply",
-                    ply,
-                    "give one of obj, ply, or positions and triangles",
+                    key,
+                    path,
+                    "give one of obj, ply, serialized, or positions and triangles",
                 ));
             }
             if r.normals.is_some() || r.uvs.is_some() {
                 return Err(GeometryError::parameter(
                     S,
                     "normals",
-                    ply,
-                    "normals/uvs are inline only; a PLY file brings its own",
+                    path,
+                    "normals/uvs are inline only; a mesh file brings its own",
+                ));
+            }
+            if r.shape_index.is_some() && r.serialized.is_none() {
+                return Err(GeometryError::parameter(
+                    S,
+                    "shape_index",
+                    path,
+                    "only with serialized",
                 ));
             }
             return Ok(Self { data: None, repr: Box::new(r) });
+        }
+        if r.shape_index.is_some() {
+            return Err(GeometryError::parameter(
+                S,
+                "shape_index",
+                "given",
+                "only with serialized",
+            ));
         }
         match (&r.obj, &r.positions, &r.triangles) {
             (Some(path), None, None) => {
@@ -330,6 +395,19 @@ fn read_ply_file(path: &Path, transform: Option<&Transform>) -> Result<MeshData,
     build(m.positions, m.triangles, m.normals, m.uvs, transform)
 }
 
+/// Reads mesh `index` of a Mitsuba serialized file, at most [`MAX_OBJ_BYTES`] long.
+fn read_serialized_file(
+    path: &Path,
+    index: usize,
+    transform: Option<&Transform>,
+) -> Result<MeshData, GeometryError> {
+    let err = |reason: String| GeometryError::Serialized { path: path.to_path_buf(), reason };
+    let bytes = crate::read_bounded(path, MAX_OBJ_BYTES, "serialized mesh file").map_err(err)?;
+    let m = crate::serialized::read_serialized(&bytes, index).map_err(err)?;
+    drop(bytes);
+    build(m.positions, m.triangles, m.normals, m.uvs, transform)
+}
+
 impl Mesh {
     /// A mesh from world-space positions and counter-clockwise triangles.
     ///
@@ -372,13 +450,27 @@ impl Mesh {
         if self.data.is_some() {
             return Ok(());
         }
-        if let Some(obj) = &self.repr.obj {
-            let path = base_dir.join(obj);
-            self.data = Some(Arc::new(read_obj(&path, self.repr.transform.as_ref())?));
+        let transform = self.repr.transform.as_ref();
+        let mut data = if let Some(obj) = &self.repr.obj {
+            read_obj(&base_dir.join(obj), transform)?
         } else if let Some(ply) = &self.repr.ply {
-            let path = base_dir.join(ply);
-            self.data = Some(Arc::new(read_ply_file(&path, self.repr.transform.as_ref())?));
+            read_ply_file(&base_dir.join(ply), transform)?
+        } else if let Some(file) = &self.repr.serialized {
+            let index = self.repr.shape_index.unwrap_or(0);
+            read_serialized_file(&base_dir.join(file), index, transform)?
+        } else {
+            return Ok(());
+        };
+        match self.repr.vertex_normals {
+            VertexNormals::File => {}
+            VertexNormals::Computed => {
+                if data.normals.is_none() {
+                    data.normals = Some(angle_weighted_normals(&data.positions, &data.triangles));
+                }
+            }
+            VertexNormals::None => data.normals = None,
         }
+        self.data = Some(Arc::new(data));
         Ok(())
     }
 
@@ -392,9 +484,9 @@ impl Mesh {
         self.repr.obj.as_deref()
     }
 
-    /// The mesh file's path (OBJ or PLY), if the mesh comes from a file.
+    /// The mesh file's path (OBJ, PLY or serialized), if the mesh comes from a file.
     pub fn file_path(&self) -> Option<&Path> {
-        self.repr.obj.as_deref().or(self.repr.ply.as_deref())
+        self.repr.obj.as_deref().or(self.repr.ply.as_deref()).or(self.repr.serialized.as_deref())
     }
 
     /// A mesh to be read from the PLY file `path` (resolved as [`Mesh::from_obj`]); not loaded.
@@ -698,5 +790,32 @@ mod tests {
         assert!(e.contains(&format!("larger than the {} bytes limit", len - 1)), "{e}");
         assert!(e.contains("Mesh.obj"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// At a cube's corner the three faces meet at right angles: the angle-weighted normal is
+    /// the diagonal, whatever the triangulation (two triangles of one face share the angle).
+    #[test]
+    fn angle_weighted_normals_of_a_cube_corner_are_its_diagonal() {
+        let p: Vec<DVec3> = (0..8)
+            .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
+            .collect();
+        let t = vec![
+            [0, 2, 3],
+            [0, 3, 1],
+            [4, 5, 7],
+            [4, 7, 6],
+            [0, 1, 5],
+            [0, 5, 4],
+            [2, 6, 7],
+            [2, 7, 3],
+            [0, 4, 6],
+            [0, 6, 2],
+            [1, 3, 7],
+            [1, 7, 5],
+        ];
+        let n = super::angle_weighted_normals(&p, &t);
+        let d = 1.0 / 3f64.sqrt();
+        assert!((n[0] - DVec3::splat(-d)).length() < 1e-12, "{}", n[0]);
+        assert!((n[7] - DVec3::splat(d)).length() < 1e-12, "{}", n[7]);
     }
 }

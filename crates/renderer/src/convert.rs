@@ -52,11 +52,11 @@ pub fn convert(
     Ok(imported.notes.iter().map(ToString::to_string).collect())
 }
 
-/// Rewrites every mesh path (`obj`, `ply`) relative to `dir` and collects them in `inputs`.
+/// Rewrites every mesh path (`obj`, `ply`, `serialized`) relative to `dir` and collects them in `inputs`.
 fn relativise_meshes(scene: &mut Value, dir: &Path, inputs: &mut Vec<PathBuf>) {
     let Some(objects) = scene.get_mut("objects").and_then(Value::as_array_mut) else { return };
     for object in objects {
-        for key in ["obj", "ply"] {
+        for key in ["obj", "ply", "serialized"] {
             if let Some(Value::String(p)) = object.get_mut("shape").and_then(|s| s.get_mut(key)) {
                 let path = PathBuf::from(&*p);
                 inputs.push(path.clone());

@@ -88,20 +88,27 @@ impl Importer {
     fn geometry(&mut self, el: &Element, p: &Params<'_>, m: DMat4) -> Result<Value, ImportError> {
         let matrix = |m: DMat4| json!({"matrix": [m.row(0).to_array(), m.row(1).to_array(), m.row(2).to_array(), m.row(3).to_array()]});
         Ok(match el.kind() {
-            "obj" | "ply" => {
+            "obj" | "ply" | "serialized" => {
                 let name = p
                     .string("filename")?
                     .ok_or_else(|| error_at(&el.loc, "needs <string name=\"filename\">"))?;
                 let path = self.file_path(el, name)?;
-                let mut s = json!({"type": "Mesh", "transform": matrix(m)});
+                let face_normals = p.boolean("face_normals", false)?;
+                let normals = if face_normals { "none" } else { "computed" };
+                let mut s =
+                    json!({"type": "Mesh", "transform": matrix(m), "vertex_normals": normals});
                 s[el.kind()] = json!(path);
+                if el.kind() == "serialized" {
+                    let index = p.float("shape_index", 0.0)?;
+                    if !(index >= 0.0 && index.fract() == 0.0) {
+                        return Err(error_at(
+                            &el.loc,
+                            format!("shape_index {index}: a whole number >= 0"),
+                        ));
+                    }
+                    s["shape_index"] = json!(index as u64);
+                }
                 s
-            }
-            "serialized" => {
-                return Err(error_at(
-                    &el.loc,
-                    "serialized meshes (Mitsuba's own format) are not read yet; convert them to PLY or OBJ",
-                ));
             }
             "rectangle" => {
                 let corner = m.transform_point3(DVec3::new(-1.0, -1.0, 0.0));
