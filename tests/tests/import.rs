@@ -349,6 +349,19 @@ fn serialized_meshes_import_by_index_with_mitsubas_normals() {
     assert!(e.contains("2 meshes"), "{e}");
 }
 
+/// A `thindielectric` becomes a `ThinDielectric` of index `int_ior / ext_ior` (air by default).
+#[test]
+fn a_thin_dielectric_keeps_its_relative_index() {
+    let xml = with_sensor(
+        r#"<shape type="rectangle"><bsdf type="thindielectric"><float name="int_ior" value="1.7"/></bsdf></shape>
+        <emitter type="point"><point name="position" value="0,0,1"/><spectrum name="intensity" value="1"/></emitter>"#,
+    );
+    let imported = import_mitsuba(&write_scene("import-thin", &[("t.xml", &xml)]), &[]).unwrap();
+    let m = &imported.scene["objects"][0]["material"];
+    assert_eq!(m["type"], "ThinDielectric");
+    assert!((m["ior"].as_f64().unwrap() - 1.7 / 1.000_277).abs() < 1e-12);
+}
+
 /// The real PLY meshes of Bitterli's Veach bidirectional room load (binary little-endian, with
 /// normals and texture coordinates).
 #[test]

@@ -14,9 +14,10 @@
 //! | [`Diffuse`] | Lambertian, spectral reflectance, two-sided | one, cosine-sampled |
 //! | [`Mirror`] | perfect reflection, spectral reflectance, two-sided | one delta |
 //! | [`Dielectric`] | Fresnel reflection + Snell refraction, total internal reflection, dispersion | two deltas |
+//! | [`ThinDielectric`] | a thin sheet: both faces' Fresnel reflection with every internal bounce, straight transmission | two deltas |
 //! | [`Fluorescent`] | absorbs and re-emits at other wavelengths (bispectral) over a Lambertian base | elastic Lambertian + re-emission ([`Material::fluorescence`]) |
 //! | [`RoughDielectric`] | frosted glass: GGX microfacet reflection + refraction (Walter 2007), dispersion, anisotropy | two with densities (roughness 0: `Dielectric`'s deltas) |
-//! | [`Plastic`] | a smooth or GGX-rough dielectric coating over a Lambertian base, two-sided | a delta (smooth) or GGX reflection, plus a cosine-sampled diffuse |
+//! | [`Plastic`] | a smooth or rough (GGX or Beckmann) dielectric coating over a Lambertian base, two-sided | a delta (smooth) or GGX reflection, plus a cosine-sampled diffuse |
 //! | [`Conductor`] | smooth metal: exact Fresnel reflectance of a complex index `eta + i k` per wavelength, two-sided | one delta |
 //! | [`RoughConductor`] | rough metal: GGX microfacets, visible-normal sampling, Smith height-correlated shadowing, isotropic or anisotropic; roughness 0 is the [`Conductor`] | one with a density |
 //!
@@ -69,6 +70,7 @@ mod microfacet;
 mod mirror;
 mod plastic;
 mod rough_dielectric;
+mod thin_dielectric;
 mod vectors;
 
 pub use beckmann::Beckmann;
@@ -89,6 +91,7 @@ pub use microfacet::{Distribution, Ggx, Microfacet, SMOOTH_ALPHA, fresnel_conduc
 pub use mirror::Mirror;
 pub use plastic::Plastic;
 pub use rough_dielectric::RoughDielectric;
+pub use thin_dielectric::ThinDielectric;
 
 /// Vectors (`DVec3`), re-exported so users need no direct dependency.
 pub use glam;

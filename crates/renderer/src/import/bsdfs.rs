@@ -88,6 +88,15 @@ impl Importer {
                 json!({"type": "Diffuse", "reflectance": r})
             }
             "conductor" | "roughconductor" => self.conductor(el, &p, two_sided)?,
+            "thindielectric" => {
+                let ior = self.ior(&p, "int_ior", 1.5046)? / self.ior(&p, "ext_ior", 1.000_277)?;
+                self.unit_scale(&p, "specular_reflectance")?;
+                let mut m = json!({"type": "ThinDielectric", "ior": ior});
+                if let Some(t) = p.get("specular_transmittance") {
+                    m["transmittance"] = spectrum(t, Role::Reflectance)?.reflectance_json();
+                }
+                m
+            }
             "dielectric" | "roughdielectric" => {
                 let ior = self.ior(&p, "int_ior", 1.5046)? / self.ior(&p, "ext_ior", 1.000_277)?;
                 self.unit_scale(&p, "specular_reflectance")?;
@@ -107,7 +116,7 @@ impl Importer {
                     &el.loc,
                     format!(
                         "BSDF type \"{other}\" is not supported (diffuse, conductor, roughconductor, dielectric, \
-                     roughdielectric, plastic, roughplastic and twosided are; docs/import.md)"
+                     roughdielectric, thindielectric, plastic, roughplastic and twosided are; docs/import.md)"
                     ),
                 ));
             }
