@@ -70,17 +70,23 @@ enum Reached {
 fn exercise_scene(text: &str) -> Reached {
     let path = workspace().join("scenes").join("fuzz.json");
     let Ok(scene) = Scene::from_json(text, &path) else { return Reached::Refused };
+    exercise_loaded(&scene)
+}
+
+/// Renders a loaded scene (a few beams, when small) and checks every image is finite.
+fn exercise_loaded(scene: &Scene) -> Reached {
+    let scene = scene;
     let pixels = u64::from(scene.camera.width()) * u64::from(scene.camera.height());
     if pixels > RENDER_PIXELS || scene.settings.max_depth > 256 {
         return Reached::Loaded;
     }
     let options =
         RenderOptions { beams: Some(RENDER_BEAMS), threads: Some(1), ..RenderOptions::default() };
-    let Ok(plan) = plan_with(&scene, &options, IntegratorChoice::Light) else {
+    let Ok(plan) = plan_with(scene, &options, IntegratorChoice::Light) else {
         return Reached::Loaded;
     };
-    let effects = spectrace_renderer::decide_effects(&scene, None);
-    let tracer = spectrace_renderer::tracer_scene(&scene);
+    let effects = spectrace_renderer::decide_effects(scene, None);
+    let tracer = spectrace_renderer::tracer_scene(scene);
     let tracer = spectrace_tracer::LightTracer::new(&tracer, scene.tracer_settings(), effects);
     let Ok(output) = render(&tracer, &plan, &|_| {}) else { return Reached::Loaded };
     let image =
@@ -90,7 +96,7 @@ fn exercise_scene(text: &str) -> Reached {
         "non-finite value in the encoded image"
     );
     // The estimator the effects analysis picks (the path tracer for most scenes) as well.
-    if let Ok(r) = render_in_memory(&scene, &RenderOptions { integrator: None, ..options }) {
+    if let Ok(r) = render_in_memory(scene, &RenderOptions { integrator: None, ..options }) {
         let image =
             encode_image(&r.output, normalisation(r.integrator, scene.lights.power(), pixels));
         assert!(
@@ -373,4 +379,117 @@ fn fuzz_part_files() {
         failures.extend(guarded(&what, &bytes, || exercise_part(&bytes)).err());
     }
     report(failures);
+}
+
+/// Mitsuba scene files from others go through the importer: mutants of our own Mitsuba scene and
+/// of a scene of many features (an include, a PLY and a serialized mesh, every emitter and BSDF
+/// the importer maps) are refused with an error or imported, loaded and rendered to finite
+/// images; never a panic or a hang. One mutation a case: a byte (as for JSON scenes) or, twice
+/// as often, an attribute value replaced by an extreme or an ordinary number.
+#[test]
+fn fuzz_mitsuba_files() {
+    let dir = std::env::temp_dir().join(format!("spectrace-fuzz-xml-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("part.xml"), "<scene version=\"3.0.0\"><bsdf type=\"diffuse\" id=\"grey\"><rgb name=\"reflectance\" value=\"0.5\"/></bsdf></scene>").unwrap();
+    std::fs::write(
+        dir.join("tri.ply"),
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+         element face 1\nproperty list uchar int vertex_indices\nend_header\n-1 0 -1\n1 0 -1\n0 0 1\n3 0 1 2\n",
+    )
+    .unwrap();
+    let cube = (
+        vec![[-0.2, 0.0, -0.2], [0.2, 0.0, -0.2], [-0.2, 0.4, -0.2], [0.2, 0.4, -0.2]],
+        vec![[0, 1, 3], [0, 3, 2]],
+    );
+    std::fs::write(dir.join("m.serialized"), spectrace_geometry::write_serialized(&[cube]))
+        .unwrap();
+    let many = r#"<scene version="3.0.0"><default name="w" value="24"/><include filename="part.xml"/>
+  <integrator type="path"><integer name="max_depth" value="6"/></integrator>
+  <sensor type="thinlens"><float name="fov" value="45"/><float name="aperture_radius" value="0.01"/><float name="focus_distance" value="3"/>
+    <transform name="to_world"><lookat origin="0,1,3" target="0,0.3,0" up="0,1,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="$w"/><integer name="height" value="16"/></film></sensor>
+  <shape type="ply"><string name="filename" value="tri.ply"/><ref id="grey"/></shape>
+  <shape type="serialized"><string name="filename" value="m.serialized"/><bsdf type="roughconductor"><string name="material" value="Cu"/><float name="alpha" value="0.2"/></bsdf></shape>
+  <shape type="sphere"><point name="center" value="0.5,0.3,0"/><float name="radius" value="0.2"/><bsdf type="roughdielectric"><float name="alpha" value="0.1"/></bsdf></shape>
+  <shape type="cube"><transform name="to_world"><scale value="0.1"/><translate x="-0.5" y="0.1"/></transform><bsdf type="plastic"><srgb name="diffuse_reflectance" value="0.2,0.6,0.3"/></bsdf></shape>
+  <shape type="disk"><transform name="to_world"><rotate x="1" angle="90"/><translate y="2"/></transform><emitter type="area"><spectrum name="radiance" value="400:1, 700:3"/></emitter></shape>
+  <emitter type="spot"><transform name="to_world"><lookat origin="1,2,1" target="0,0,0"/></transform><spectrum name="intensity" type="blackbody"><float name="temperature" value="3000"/></spectrum></emitter>
+  <emitter type="point"><point name="position" value="-1,1,1"/><rgb name="intensity" value="2,1,0.5"/></emitter>
+  <emitter type="directional"><vector name="direction" value="0,-1,-1"/><spectrum name="irradiance" type="d65"/></emitter>
+  <emitter type="constant"><float name="radiance" value="0.1"/></emitter>
+</scene>"#;
+    let own = std::fs::read_to_string(workspace().join("scenes/mitsuba/sky_plastic_gold.xml"))
+        .unwrap()
+        .replace("value=\"128\"", "value=\"24\"")
+        .replace("value=\"96\"", "value=\"16\"");
+    let seeds = [many.to_owned(), own];
+    let extremes = [
+        "nan",
+        "-1",
+        "0",
+        "1e308",
+        "-1e-320",
+        "",
+        "1,2",
+        "$undefined",
+        "inf",
+        "1e6",
+        "0.5",
+        "2",
+        "3",
+        "0.01",
+        "1, 1, 1",
+        "0, 0, 0",
+        "100",
+    ];
+    let cases = env_or("SPECTRACE_FUZZ_CASES", 150);
+    let mut rng = Pcg64::seed_from_u64(env_or("SPECTRACE_FUZZ_SEED", 1));
+    let mut failures = Vec::new();
+    let mut reached = Vec::new();
+    for case in 0..cases {
+        let mut text = seeds[rng.random_range(0..seeds.len())].clone();
+        {
+            let values: Vec<usize> = text.match_indices("value=\"").map(|(i, _)| i + 7).collect();
+            if rng.random_range(0..3) != 0 && !values.is_empty() {
+                let start = values[rng.random_range(0..values.len())];
+                let end = start + text[start..].find('"').unwrap_or(0);
+                text.replace_range(start..end, extremes[rng.random_range(0..extremes.len())]);
+            } else {
+                let mut bytes = text.into_bytes();
+                mutate_bytes(&mut bytes, &mut rng);
+                text = String::from_utf8_lossy(&bytes).into_owned();
+            }
+        }
+        let path = dir.join("fuzz.xml");
+        std::fs::write(&path, &text).unwrap();
+        let what = format!("mitsuba case {case}");
+        if std::env::var_os("SPECTRACE_FUZZ_TRACE").is_some() {
+            eprintln!("{what}: {}", text.replace('\n', " "));
+        }
+        let outcome = guarded(&what, text.as_bytes(), || match Scene::load(&path) {
+            Ok(scene) => exercise_loaded(&scene),
+            Err(e) => {
+                let e = e.to_string();
+                assert!(
+                    e.contains("fuzz.xml") || e.contains(".ply") || e.contains(".serialized"),
+                    "an error without its file: {e}"
+                );
+                Reached::Refused
+            }
+        });
+        match outcome {
+            Ok(r) => reached.push(r),
+            Err(f) => failures.push(f),
+        }
+    }
+    report(failures);
+    let rendered = reached.iter().filter(|&&r| r == Reached::Rendered).count();
+    let refused = reached.iter().filter(|&&r| r == Reached::Refused).count();
+    eprintln!("mitsuba mutants: {refused} refused, {rendered} rendered of {}", reached.len());
+    // Most XML byte mutants are not well-formed, and most extreme values are refused: the
+    // fuzzer must still get a tenth of its mutants through to a render.
+    assert!(
+        rendered * 10 >= reached.len() && refused * 10 >= reached.len(),
+        "{refused} refused, {rendered} rendered"
+    );
 }
