@@ -75,7 +75,6 @@ fn exercise_scene(text: &str) -> Reached {
 
 /// Renders a loaded scene (a few beams, when small) and checks every image is finite.
 fn exercise_loaded(scene: &Scene) -> Reached {
-    let scene = scene;
     let pixels = u64::from(scene.camera.width()) * u64::from(scene.camera.height());
     if pixels > RENDER_PIXELS || scene.settings.max_depth > 256 {
         return Reached::Loaded;
