@@ -362,6 +362,29 @@ fn a_thin_dielectric_keeps_its_relative_index() {
     assert!((m["ior"].as_f64().unwrap() - 1.7 / 1.000_277).abs() < 1e-12);
 }
 
+/// `<spectrum filename>` reads `wavelength value` lines (comments skipped) as a table, zero
+/// outside it; a malformed line is refused with its number; a `-D` the scene never uses is
+/// noted.
+#[test]
+fn spectrum_files_and_unused_defines() {
+    let xml = with_sensor(
+        r#"<shape type="sphere"><bsdf type="diffuse"><spectrum name="reflectance" filename="r.spd"/></bsdf></shape>
+        <emitter type="point"><point name="position" value="0,2,0"/><spectrum name="intensity" value="1"/></emitter>"#,
+    );
+    let path = write_scene(
+        "import-spd",
+        &[("s.xml", &xml), ("r.spd", "# measured\n400 0.2\n500 0.4 # peak\n\n700 0.3\n")],
+    );
+    let imported = import_mitsuba(&path, &[("unused".to_owned(), "1".to_owned())]).unwrap();
+    let r = &imported.scene["objects"][0]["material"]["reflectance"];
+    assert_eq!(r["nm"], serde_json::json!([399.999, 400.0, 500.0, 700.0, 700.001]));
+    assert_eq!(r["values"], serde_json::json!([0.0, 0.2, 0.4, 0.3, 0.0]));
+    assert!(imported.notes.iter().any(|n| n.message.contains("-D unused")), "{:?}", imported.notes);
+    std::fs::write(path.parent().unwrap().join("r.spd"), "400 0.2\n500\n").unwrap();
+    let e = import_mitsuba(&path, &[]).unwrap_err().to_string();
+    assert!(e.contains("r.spd") && e.contains("line 2"), "{e}");
+}
+
 /// The real PLY meshes of Bitterli's Veach bidirectional room load (binary little-endian, with
 /// normals and texture coordinates).
 #[test]

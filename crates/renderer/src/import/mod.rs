@@ -97,6 +97,12 @@ pub fn import_mitsuba(path: &Path, defines: &[(String, String)]) -> Result<Impor
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "image".to_owned());
     let scene = importer.finish(&tree.root, &name)?;
+    for name in &tree.unused_defines {
+        importer.notes.push(ImportNote {
+            at: path.display().to_string(),
+            message: format!("-D {name}: the scene never uses ${name}"),
+        });
+    }
     Ok(Imported { scene, notes: importer.notes, files: tree.files })
 }
 

@@ -136,9 +136,7 @@ pub(crate) fn spectrum(el: &Element, role: Role) -> Result<Spec, ImportError> {
         "spectrum" => match el.attr("type") {
             None => match el.attr("value") {
                 Some(text) => value_spectrum(el, text),
-                None if el.attr("filename").is_some() => {
-                    Err(fail("spectra from files (`filename`) are not read yet; give the values inline".to_owned()))
-                }
+                None if el.attr("filename").is_some() => spectrum_file(el),
                 None => Err(fail("needs `value`".to_owned())),
             },
             Some(kind) => typed_spectrum(el, kind, role),
@@ -179,6 +177,42 @@ fn value_spectrum(el: &Element, text: &str) -> Result<Spec, ImportError> {
                     &el.loc,
                     format!("{}: `{pair}` is not two numbers", el.describe()),
                 ));
+            }
+        }
+    }
+    table(el, nm, values)
+}
+
+/// `<spectrum filename="...">`: a text file of `wavelength value` lines (`#` comments), resolved
+/// against the folder of the file that names it, at most `MAX_SCENE_BYTES` long.
+fn spectrum_file(el: &Element) -> Result<Spec, ImportError> {
+    let name = el.required("filename")?;
+    let path = el.loc.file.parent().unwrap_or_else(|| std::path::Path::new(".")).join(name);
+    let fail = |m: String| error_at(&el.loc, format!("{}: {m}", path.display()));
+    let bytes = crate::files::read_bounded(&path, crate::files::MAX_SCENE_BYTES, "spectrum")
+        .map_err(fail)?;
+    let text = String::from_utf8(bytes).map_err(|_| fail("not UTF-8 text".to_owned()))?;
+    let (mut nm, mut values) = (Vec::new(), Vec::new());
+    for (i, line) in text.lines().enumerate() {
+        let line = line.split('#').next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        let parsed: Vec<f64> = line
+            .split_whitespace()
+            .filter_map(|t| t.parse().ok())
+            .filter(|v: &f64| v.is_finite())
+            .collect();
+        match parsed.as_slice() {
+            [l, v] => {
+                nm.push(*l);
+                values.push(*v);
+            }
+            _ => {
+                return Err(fail(format!(
+                    "line {}: `{line}` is not two numbers (wavelength value)",
+                    i + 1
+                )));
             }
         }
     }

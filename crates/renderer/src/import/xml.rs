@@ -89,6 +89,8 @@ const MAX_INCLUDE_DEPTH: usize = 16;
 pub(crate) struct SceneTree {
     pub(crate) root: Element,
     pub(crate) files: Vec<PathBuf>,
+    /// The command line's definitions no `$name` in the files used.
+    pub(crate) unused_defines: Vec<String>,
 }
 
 /// Reads the scene file `path` with the command line's `defines` (`-D name=value`), which take
@@ -103,9 +105,13 @@ pub(crate) fn read_scene(
         files: Vec::new(),
         stack: Vec::new(),
         legacy: false,
+        used: std::cell::RefCell::new(Vec::new()),
     };
     let (root, _) = reader.file(path, None)?;
-    Ok(SceneTree { root, files: reader.files })
+    let used = reader.used.into_inner();
+    let unused_defines =
+        reader.from_command_line.into_iter().filter(|k| !used.contains(k)).collect();
+    Ok(SceneTree { root, files: reader.files, unused_defines })
 }
 
 struct Reader {
@@ -115,6 +121,8 @@ struct Reader {
     stack: Vec<PathBuf>,
     /// Mitsuba 0.6 names (camelCase) are being read.
     legacy: bool,
+    /// The variables substituted so far.
+    used: std::cell::RefCell<Vec<String>>,
 }
 
 impl Reader {
@@ -261,6 +269,7 @@ impl Reader {
                 )
             })?;
             out.push_str(value);
+            self.used.borrow_mut().push(name.to_owned());
             rest = &after[len..];
         }
         out.push_str(rest);
