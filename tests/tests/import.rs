@@ -184,6 +184,28 @@ fn the_shipped_mitsuba_scene_imports_and_renders() {
     assert!(r.image.iter().map(|p| p.y).sum::<f64>() / r.image.len() as f64 > 0.1);
 }
 
+/// Every shipped Mitsuba scene (`scenes/mitsuba/*.xml`) imports without an error, loads and
+/// renders (2 spp) to a finite, lit image.
+#[test]
+fn every_shipped_mitsuba_scene_renders() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/mitsuba");
+    let mut count = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "xml") {
+            continue;
+        }
+        let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let options = RenderOptions { spp: Some(2), threads: Some(2), ..RenderOptions::default() };
+        let r = render_in_memory(&scene, &options).unwrap();
+        assert!(r.image.iter().all(|p| p.is_finite()), "{}", path.display());
+        let mean = r.image.iter().map(|p| p.y).sum::<f64>() / r.image.len() as f64;
+        assert!(mean > 0.01, "{}: {mean}", path.display());
+        count += 1;
+    }
+    assert!(count >= 3, "the shipped Mitsuba scenes are missing");
+}
+
 /// Mitsuba's linear plastic (`nonlinear` false, its default) is imported with the base albedo
 /// `R / (1 - F_dr + R F_dr)`, which makes Spectrace's diffuse term `R' / (1 - R' F_dr)` equal
 /// Mitsuba's `R / (1 - F_dr)`; with `nonlinear` true the albedo is kept.
