@@ -407,6 +407,42 @@ fn spectrum_files_and_unused_defines() {
     assert!(e.contains("r.spd") && e.contains("line 2"), "{e}");
 }
 
+/// Every file a Mitsuba scene names goes through the scene's path policy: with
+/// `--restrict-paths` an include outside its folder is refused; without it the include and a
+/// spectrum file are inputs that `convert` never writes over; whole-number parameters are
+/// refused, not rounded, when they are fractions or too small.
+#[test]
+fn included_files_follow_the_path_policy_and_counts_are_whole() {
+    let outside = temp_dir("import-policy-outside");
+    std::fs::write(outside.join("part.xml"), "<scene version=\"3.0.0\"></scene>").unwrap();
+    std::fs::write(outside.join("r.spd"), "400 0.5\n700 0.5\n").unwrap();
+    let xml = with_sensor(&format!(
+        r#"<include filename="{}"/><shape type="sphere"><bsdf type="diffuse"><spectrum name="reflectance" filename="{}"/></bsdf>
+        <emitter type="area"><spectrum name="radiance" value="1"/></emitter></shape>"#,
+        outside.join("part.xml").display(),
+        outside.join("r.spd").display()
+    ));
+    let path = write_scene("import-policy", &[("s.xml", &xml)]);
+    let e = Scene::import_with(&path, &[], LoadOptions { restrict_paths: true })
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("restrict-paths") && e.contains("s.xml:"), "{e}");
+    let imported = import_mitsuba(&path, &[]).unwrap();
+    assert!(imported.files.iter().any(|f| f.ends_with("r.spd")), "{:?}", imported.files);
+    let e = convert(&path, &outside.join("r.spd"), &[]).unwrap_err();
+    assert!(e.contains("r.spd"), "{e}");
+    assert_eq!(std::fs::read_to_string(outside.join("r.spd")).unwrap(), "400 0.5\n700 0.5\n");
+    for (param, bad) in [("sample_count", "2.5"), ("sample_count", "0"), ("seed", "-1")] {
+        let xml = with_sensor(
+            r#"<integrator type="path"/><shape type="sphere"><emitter type="area"><spectrum name="radiance" value="1"/></emitter></shape>"#
+        )
+        .replace("</film></sensor>", &format!("</film><sampler type=\"independent\"><integer name=\"{param}\" value=\"{bad}\"/></sampler></sensor>"));
+        let path = write_scene(&format!("import-whole-{param}-{bad}"), &[("w.xml", &xml)]);
+        let e = import_mitsuba(&path, &[]).unwrap_err().to_string();
+        assert!(e.contains(param) && e.contains("whole number"), "{e}");
+    }
+}
+
 /// The real PLY meshes of Bitterli's Veach bidirectional room load (binary little-endian, with
 /// normals and texture coordinates).
 #[test]

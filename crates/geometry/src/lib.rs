@@ -53,7 +53,9 @@ pub use bounds::Bounds;
 pub use cylinder::Cylinder;
 pub use disk::Disk;
 pub use error::GeometryError;
-pub use mesh::{MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_OBJ_BYTES, Mesh, VertexNormals};
+pub use mesh::{
+    CUBE_TRIANGLES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_OBJ_BYTES, Mesh, VertexNormals,
+};
 pub use prism::Prism;
 pub use ray::{Hit, Ray};
 pub use rectangle::Rectangle;

@@ -59,6 +59,23 @@ pub struct Mesh {
     repr: Box<MeshRepr>,
 }
 
+/// The 12 triangles of a cube whose corner `i` has `x`, `y`, `z` from bits 0, 1, 2 of `i` (0 the
+/// low side, 1 the high), counter-clockwise seen from outside.
+pub const CUBE_TRIANGLES: [[u32; 3]; 12] = [
+    [0, 2, 3],
+    [0, 3, 1],
+    [4, 5, 7],
+    [4, 7, 6],
+    [0, 1, 5],
+    [0, 5, 4],
+    [2, 6, 7],
+    [2, 7, 3],
+    [0, 4, 6],
+    [0, 6, 2],
+    [1, 3, 7],
+    [1, 7, 5],
+];
+
 /// Where a mesh file's shading normals come from (`vertex_normals`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -799,20 +816,7 @@ mod tests {
         let p: Vec<DVec3> = (0..8)
             .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
             .collect();
-        let t = vec![
-            [0, 2, 3],
-            [0, 3, 1],
-            [4, 5, 7],
-            [4, 7, 6],
-            [0, 1, 5],
-            [0, 5, 4],
-            [2, 6, 7],
-            [2, 7, 3],
-            [0, 4, 6],
-            [0, 6, 2],
-            [1, 3, 7],
-            [1, 7, 5],
-        ];
+        let t = CUBE_TRIANGLES.to_vec();
         let n = super::angle_weighted_normals(&p, &t);
         let d = 1.0 / 3f64.sqrt();
         assert!((n[0] - DVec3::splat(-d)).length() < 1e-12, "{}", n[0]);

@@ -66,7 +66,9 @@ pub use files::{
     MAX_OUTPUT_NAME_BYTES, MAX_PART_BYTES, MAX_SCENE_BYTES, check_no_input_replaced,
     check_output_name, prepare_out_dir, read_bounded, same_file, write_atomically,
 };
-pub use import::{ImportError, ImportNote, Imported, import_mitsuba, is_mitsuba_scene};
+pub use import::{
+    ImportError, ImportNote, Imported, import_mitsuba, import_mitsuba_with, is_mitsuba_scene,
+};
 pub use integrators::{tracer_scene, with_integrator, with_integrator_filling};
 pub use options::{RenderError, RenderOptions};
 pub use output::{EncodedImage, OUTPUT_BYTES_PER_PIXEL, encode_image, write_exr, write_png};

@@ -26,6 +26,7 @@ use serde_json::{Value, json};
 use params::Params;
 use values::transform;
 pub use xml::ImportError;
+
 use xml::{Element, error_at};
 
 /// `el` itself, or the plugin a `<ref id>` names in `ids`, which must be a `tag`.
@@ -88,9 +89,45 @@ pub fn is_mitsuba_scene(path: &Path) -> bool {
 /// [`ImportError`] with the file and line of the first element that cannot be read or is not
 /// supported.
 pub fn import_mitsuba(path: &Path, defines: &[(String, String)]) -> Result<Imported, ImportError> {
+    import_mitsuba_with(path, defines, false)
+}
+
+/// As [`import_mitsuba`]; with `restrict_paths` (`--restrict-paths`), every file the scene names
+/// (includes, meshes, spectra) must lie inside the scene file's folder, symlinks resolved.
+///
+/// # Errors
+/// As [`import_mitsuba`], and a file outside the folder.
+pub fn import_mitsuba_with(
+    path: &Path,
+    defines: &[(String, String)],
+    restrict_paths: bool,
+) -> Result<Imported, ImportError> {
+    let main_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let (imported, read) =
+        spectrace_sampling::files::with_scene_folder(&main_dir, restrict_paths, || {
+            import_in_folder(path, defines, restrict_paths)
+        });
+    let mut imported = imported?;
+    for file in read {
+        if !imported.files.contains(&file) {
+            imported.files.push(file);
+        }
+    }
+    Ok(imported)
+}
+
+/// The import itself, inside the scene folder's path policy.
+fn import_in_folder(
+    path: &Path,
+    defines: &[(String, String)],
+    restrict: bool,
+) -> Result<Imported, ImportError> {
     let tree = xml::read_scene(path, defines)?;
-    let mut importer =
-        Importer { main_dir: path.parent().map(Path::to_path_buf), ..Importer::default() };
+    let mut importer = Importer {
+        main_dir: path.parent().map(Path::to_path_buf),
+        restrict,
+        ..Importer::default()
+    };
     importer.scene(&tree.root)?;
     let name = path
         .file_stem()
@@ -117,6 +154,8 @@ struct Importer {
     notes: Vec<ImportNote>,
     /// The main scene file's folder.
     main_dir: Option<PathBuf>,
+    /// Refuse files outside `main_dir` (`--restrict-paths`).
+    restrict: bool,
     /// Directional emitters (place, direction, irradiance, spectrum), placed when every object
     /// is known.
     directional: Vec<(xml::Loc, DVec3, f64, Value)>,
@@ -204,6 +243,11 @@ impl Importer {
             Some(main) if !own.exists() && main.join(name).exists() => main.join(name),
             _ => own,
         };
+        if self.restrict {
+            let main = self.main_dir.clone().unwrap_or_default();
+            spectrace_sampling::files::check_inside(&main, &path)
+                .map_err(|e| error_at(&el.loc, e))?;
+        }
         std::path::absolute(&path)
             .map_err(|e| error_at(&el.loc, format!("{}: {e}", path.display())))
     }
@@ -229,25 +273,27 @@ impl Importer {
             }
         };
         self.settings.insert("integrator".to_owned(), json!(native));
-        let depth = p.float("max_depth", -1.0)?;
+        // Mitsuba counts path vertices (1: emitters seen directly, 2: direct light; -1 unlimited),
+        // Spectrace bounces (0: direct light).
+        let depth = p.get("max_depth").map_or(Ok(-1), |d| values::whole(d, -1))?;
         if el.kind() != "direct" {
-            let bounces = if depth < 0.0 {
-                f64::from(spectrace_tracer::MAX_DEPTH)
-            } else if depth < 2.0 {
-                return Err(error_at(
-                    &el.loc,
-                    format!(
-                        "max_depth {depth}: Spectrace renders at least direct light (Mitsuba's max_depth 2)"
-                    ),
-                ));
-            } else {
-                depth - 2.0
+            let bounces = match depth {
+                -1 => i64::from(spectrace_tracer::MAX_DEPTH),
+                0 | 1 => {
+                    return Err(error_at(
+                        &el.loc,
+                        format!(
+                            "max_depth {depth}: Spectrace renders at least direct light (Mitsuba's max_depth 2)"
+                        ),
+                    ));
+                }
+                d => (d - 2).min(i64::from(spectrace_tracer::MAX_DEPTH)),
             };
-            self.settings.insert("max_depth".to_owned(), json!(bounces as u32));
+            self.settings.insert("max_depth".to_owned(), json!(bounces));
         }
         if let Some(rr) = p.get("rr_depth") {
-            let rr = values::number(rr)?;
-            self.settings.insert("rr_depth".to_owned(), json!((rr - 1.0).max(1.0) as u32));
+            let rr = values::whole(rr, 1)?;
+            self.settings.insert("rr_depth".to_owned(), json!(rr - 1));
         }
         for harmless in ["hide_emitters", "samples_per_pass", "timeout"] {
             if p.get(harmless).is_some() {
@@ -336,11 +382,10 @@ impl Importer {
         for s in p.nested("sampler") {
             let sp = Params::new(s);
             if let Some(n) = sp.get("sample_count") {
-                self.settings.insert("spp".to_owned(), json!(values::number(n)?.max(1.0) as u64));
+                self.settings.insert("spp".to_owned(), json!(values::whole(n, 1)?));
             }
             if let Some(seed) = sp.get("seed") {
-                self.settings
-                    .insert("seed".to_owned(), json!(values::number(seed)?.max(0.0) as u64));
+                self.settings.insert("seed".to_owned(), json!(values::whole(seed, 0)?));
             }
             for ignored in ["jitter", "scramble_seed", "dimension"] {
                 sp.get(ignored);
@@ -366,9 +411,9 @@ impl Importer {
         let films = p.nested("film");
         let Some(film) = films.first() else { return Ok((768, 576)) };
         let f = Params::new(film);
-        let w = f.float("width", 768.0)?;
-        let h = f.float("height", 576.0)?;
-        if !(w >= 1.0 && h >= 1.0 && w <= 65536.0 && h <= 65536.0) {
+        let w = f.get("width").map_or(Ok(768), |e| values::whole(e, 1))?;
+        let h = f.get("height").map_or(Ok(576), |e| values::whole(e, 1))?;
+        if w > 65536 || h > 65536 {
             return Err(error_at(&film.loc, format!("film size {w} x {h}: each from 1 to 65536")));
         }
         for r in f.nested("rfilter") {

@@ -99,14 +99,9 @@ impl Importer {
                     json!({"type": "Mesh", "transform": matrix(m), "vertex_normals": normals});
                 s[el.kind()] = json!(path);
                 if el.kind() == "serialized" {
-                    let index = p.float("shape_index", 0.0)?;
-                    if !(index >= 0.0 && index.fract() == 0.0) {
-                        return Err(error_at(
-                            &el.loc,
-                            format!("shape_index {index}: a whole number >= 0"),
-                        ));
-                    }
-                    s["shape_index"] = json!(index as u64);
+                    let index =
+                        p.get("shape_index").map_or(Ok(0), |e| super::values::whole(e, 0))?;
+                    s["shape_index"] = json!(index);
                 }
                 s
             }
@@ -131,20 +126,7 @@ impl Importer {
                     })
                     .collect();
                 // Counter-clockwise seen from outside (for a map keeping orientation).
-                let mut faces = vec![
-                    [0, 2, 3],
-                    [0, 3, 1],
-                    [4, 5, 7],
-                    [4, 7, 6],
-                    [0, 1, 5],
-                    [0, 5, 4],
-                    [2, 6, 7],
-                    [2, 7, 3],
-                    [0, 4, 6],
-                    [0, 6, 2],
-                    [1, 3, 7],
-                    [1, 7, 5],
-                ];
+                let mut faces = spectrace_geometry::CUBE_TRIANGLES;
                 if m.determinant() < 0.0 {
                     for f in &mut faces {
                         f.swap(1, 2);

@@ -184,14 +184,18 @@ fn value_spectrum(el: &Element, text: &str) -> Result<Spec, ImportError> {
 }
 
 /// `<spectrum filename="...">`: a text file of `wavelength value` lines (`#` comments), resolved
-/// against the folder of the file that names it, at most `MAX_SCENE_BYTES` long.
+/// against the folder of the file that names it, at most `MAX_SCENE_BYTES` long, under the scene
+/// folder's path policy.
 fn spectrum_file(el: &Element) -> Result<Spec, ImportError> {
     let name = el.required("filename")?;
     let path = el.loc.file.parent().unwrap_or_else(|| std::path::Path::new(".")).join(name);
     let fail = |m: String| error_at(&el.loc, format!("{}: {m}", path.display()));
-    let bytes = crate::files::read_bounded(&path, crate::files::MAX_SCENE_BYTES, "spectrum")
-        .map_err(fail)?;
-    let text = String::from_utf8(bytes).map_err(|_| fail("not UTF-8 text".to_owned()))?;
+    let (_, text) = spectrace_sampling::files::read_scene_input(
+        &path,
+        crate::files::MAX_SCENE_BYTES,
+        "spectrum file",
+    )
+    .map_err(|e| error_at(&el.loc, e))?;
     let (mut nm, mut values) = (Vec::new(), Vec::new());
     for (i, line) in text.lines().enumerate() {
         let line = line.split('#').next().unwrap_or("").trim();

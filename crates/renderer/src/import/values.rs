@@ -24,6 +24,19 @@ pub(crate) fn number(el: &Element) -> Result<f64, ImportError> {
     }
 }
 
+/// The whole number of a `<float>` or `<integer>`, at least `min`: an error naming the
+/// parameter for a fraction or a smaller value (never rounded or clamped).
+pub(crate) fn whole(el: &Element, min: i64) -> Result<i64, ImportError> {
+    let v = number(el)?;
+    if v.fract() != 0.0 || v < min as f64 || v > 2f64.powi(53) {
+        return Err(error_at(
+            &el.loc,
+            format!("{}: {v} must be a whole number of at least {min}", el.describe()),
+        ));
+    }
+    Ok(v as i64)
+}
+
 /// A `<point>` or `<vector>`: `value="x, y, z"` or attributes `x`, `y`, `z` (missing ones 0).
 pub(crate) fn vector(el: &Element) -> Result<DVec3, ImportError> {
     if let Some(v) = el.attr("value") {

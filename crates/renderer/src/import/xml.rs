@@ -7,7 +7,8 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use crate::files::{MAX_SCENE_BYTES, read_bounded};
+use crate::files::MAX_SCENE_BYTES;
+use spectrace_sampling::files::read_scene_input;
 
 /// Where an element was written: its file and line.
 #[derive(Debug, Clone)]
@@ -132,6 +133,9 @@ impl Reader {
             Some(l) => error_at(l, m),
             None => ImportError { at: path.display().to_string(), message: m },
         };
+        // Absolute, so that files named inside resolve the same whatever the current folder.
+        let path = &std::path::absolute(path)
+            .map_err(|e| at(format!("cannot open {}: {e}", path.display())))?;
         let canonical =
             path.canonicalize().map_err(|e| at(format!("cannot open {}: {e}", path.display())))?;
         if self.stack.contains(&canonical) {
@@ -140,9 +144,9 @@ impl Reader {
         if self.stack.len() >= MAX_INCLUDE_DEPTH {
             return Err(at(format!("includes nested more than {MAX_INCLUDE_DEPTH} deep")));
         }
-        let bytes = read_bounded(path, MAX_SCENE_BYTES, "scene").map_err(at)?;
-        let text = String::from_utf8(bytes)
-            .map_err(|_| at(format!("{} is not UTF-8 text", path.display())))?;
+        // Through the scene folder's policy (bounded; refused outside it with
+        // --restrict-paths; recorded as an input that outputs may never replace).
+        let (_, text) = read_scene_input(path, MAX_SCENE_BYTES, "scene").map_err(at)?;
         let doc = roxmltree::Document::parse(&text).map_err(|e| ImportError {
             at: path.display().to_string(),
             message: format!("not well-formed XML: {e}"),

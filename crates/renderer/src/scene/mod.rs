@@ -172,7 +172,8 @@ impl Scene {
         defines: &[(String, String)],
         options: LoadOptions,
     ) -> Result<Self, SceneError> {
-        let imported = crate::import_mitsuba(path, defines).map_err(SceneError::Import)?;
+        let imported = crate::import::import_mitsuba_with(path, defines, options.restrict_paths)
+            .map_err(SceneError::Import)?;
         let text = serde_json::to_string_pretty(&imported.scene).unwrap_or_default();
         let mut scene = Self::from_json_with(&text, path, options).map_err(|e| match e {
             SceneError::Invalid { path, line, field, message, .. } => SceneError::Scene {
