@@ -12,6 +12,7 @@ mod measured_auto;
 mod photometry;
 mod rendering;
 mod rough_materials;
+mod textures;
 mod time_budget;
 mod variance;
 

@@ -18,7 +18,9 @@
 //! ```
 //!
 //! Geometric normal: `normalize((p1 - p0) x (p2 - p0))`. `uv`: interpolated `uvs` when present,
-//! else the barycentric coordinates `(b1, b2)`. Each triangle is one BVH primitive.
+//! else the barycentric coordinates `(b1, b2)`. Texture coordinates are read as textures use them
+//! (`v = 0` at the image's top row, as in Mitsuba 3): inline `uvs`, PLY and serialized files as
+//! stored, OBJ's `vt` as `(u, 1 - v)` (OBJ counts `v` up from the bottom). Each triangle is one BVH primitive.
 //!
 //! Robustness: the watertight ray/triangle test of Woop, Benthin and Wald (2013) in f64 —
 //! vertices are translated to the ray origin, permuted so the ray's largest direction component
@@ -390,7 +392,10 @@ fn read_obj_limited(
         });
         uvs = uvs.filter(|_| m.texcoords.len() == 2 * n).map(|mut v| {
             v.extend(
-                m.texcoords.chunks_exact(2).map(|c| DVec2::new(f64::from(c[0]), f64::from(c[1]))),
+                // OBJ's `v` points up the image; textures read `v` down from the top row.
+                m.texcoords
+                    .chunks_exact(2)
+                    .map(|c| DVec2::new(f64::from(c[0]), 1.0 - f64::from(c[1]))),
             );
             v
         });

@@ -55,6 +55,8 @@
 //! not depend on the wavelength, so it is sampled once and only the Fresnel term is evaluated
 //! per wavelength (bit for bit what scattering each wavelength gives).
 
+use std::sync::Arc;
+
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use spectrace_sampling::{Frame, clamp_uniform};
@@ -212,7 +214,7 @@ impl Material for Conductor {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "RoughConductorRepr", into = "RoughConductorRepr")]
 pub struct RoughConductor {
-    surface: Surface,
+    surface: Arc<Surface>,
     alpha_u: f64,
     alpha_v: f64,
     facets: Facets,
@@ -304,10 +306,21 @@ impl RoughConductor {
         specular_reflectance: Option<Reflectance>,
     ) -> Self {
         Self {
-            surface: Surface { ior, specular_reflectance },
+            surface: Arc::new(Surface { ior, specular_reflectance }),
             alpha_u,
             alpha_v,
             facets: Facets::new(Distribution::Ggx, alpha_u, alpha_v),
+        }
+    }
+
+    /// The same metal with the isotropic roughness `alpha` (a texel's; finite, `>= 0`). Shares
+    /// the index tables, so it allocates nothing.
+    pub(crate) fn with_alpha(&self, alpha: f64) -> Self {
+        Self {
+            surface: Arc::clone(&self.surface),
+            alpha_u: alpha,
+            alpha_v: alpha,
+            facets: Facets::new(self.facets.kind(), alpha, alpha),
         }
     }
 
@@ -640,7 +653,7 @@ impl From<RoughConductor> for RoughConductorRepr {
             roughness,
             roughness_u,
             roughness_v,
-            specular_reflectance: c.surface.specular_reflectance,
+            specular_reflectance: c.surface.specular_reflectance.clone(),
             distribution: c.facets.kind(),
         }
     }

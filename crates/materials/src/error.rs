@@ -42,6 +42,14 @@ pub enum MaterialError {
         /// The catalog's symbols, comma-separated.
         known: String,
     },
+    /// A texture that could not be built: its file unreadable or undecodable, or a field bad.
+    #[error("texture.{field}: {reason}")]
+    Texture {
+        /// The texture's field, e.g. `"file"`.
+        field: &'static str,
+        /// What is wrong, naming the file where there is one.
+        reason: String,
+    },
 }
 
 /// `material.field`, or `material` alone for an empty field.
@@ -81,6 +89,7 @@ impl MaterialError {
             Self::UnknownMetal { field: inner, name, known, .. } => {
                 Self::UnknownMetal { material, field: nest(inner), name, known }
             }
+            texture @ Self::Texture { .. } => texture,
         }
     }
 
@@ -98,6 +107,7 @@ impl MaterialError {
             Self::UnknownMetal { field, name, known, .. } => {
                 Self::UnknownMetal { material, field, name, known }
             }
+            texture @ Self::Texture { .. } => texture,
         }
     }
 
@@ -107,6 +117,7 @@ impl MaterialError {
             Self::Parameter { material, field, .. }
             | Self::UnknownGlass { material, field, .. }
             | Self::UnknownMetal { material, field, .. } => path(material, field),
+            Self::Texture { field, .. } => format!("texture.{field}"),
         }
     }
 }

@@ -20,6 +20,7 @@
 //! | [`Plastic`] | a smooth or rough (GGX or Beckmann) dielectric coating over a Lambertian base, two-sided | a delta (smooth) or GGX reflection, plus a cosine-sampled diffuse |
 //! | [`Conductor`] | smooth metal: exact Fresnel reflectance of a complex index `eta + i k` per wavelength, two-sided | one delta |
 //! | [`RoughConductor`] | rough metal: GGX microfacets, visible-normal sampling, Smith height-correlated shadowing, isotropic or anisotropic; roughness 0 is the [`Conductor`] | one with a density |
+//! | [`Textured`] | a `Diffuse` or `Plastic` with a colour [`Texture`], a rough conductor or dielectric with a roughness texture, resolved per hit ([`Material::texel`], [`MaterialAt`]) | the textured material's |
 //!
 //! Metals come from the [`metals`] catalog of measured `n, k` tables (`"metal": "Au"`; Ag Al Au Cr
 //! Cu Ni Pt Ti W, 350-850 nm, sources in `data/metals/README.md`) or from user `eta` / `k` tables
@@ -70,6 +71,8 @@ mod microfacet;
 mod mirror;
 mod plastic;
 mod rough_dielectric;
+pub mod texture;
+mod textured;
 mod thin_dielectric;
 mod vectors;
 
@@ -91,6 +94,8 @@ pub use microfacet::{Distribution, Ggx, Microfacet, SMOOTH_ALPHA, fresnel_conduc
 pub use mirror::Mirror;
 pub use plastic::Plastic;
 pub use rough_dielectric::RoughDielectric;
+pub use texture::Texture;
+pub use textured::{MaterialAt, Texel, Textured};
 pub use thin_dielectric::ThinDielectric;
 
 /// Vectors (`DVec3`), re-exported so users need no direct dependency.

@@ -205,6 +205,14 @@ pub trait Material: Send + Sync + Debug {
     fn fluorescence(&self) -> Option<&Fluorescent> {
         None
     }
+
+    /// The material at the surface point with texture coordinates `uv`, for a material that
+    /// varies over its surface (a [`crate::Textured`] one); `None` (the default) for one that is
+    /// the same everywhere. Renderers resolve it once per hit with [`crate::MaterialAt::new`].
+    fn texel(&self, uv: glam::DVec2) -> Option<crate::Texel> {
+        let _ = uv;
+        None
+    }
 }
 
 /// [`Material::scatter_bundle`] done the general way: [`Material::scatter_with`] once per live

@@ -58,6 +58,8 @@ use std::collections::HashMap;
 use std::f64::consts::FRAC_1_PI;
 use std::sync::{LazyLock, Mutex};
 
+use std::sync::Arc;
+
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use spectrace_spectrum::Reflectance;
@@ -93,7 +95,7 @@ pub struct Plastic {
     distribution: Distribution,
     /// The mean of the base's reflectance values (for the lobe choice).
     mean_reflectance: f64,
-    coating: Vec<Node>,
+    coating: Arc<[Node]>,
 }
 
 /// The coating's precomputed quantities at one wavelength.
@@ -181,7 +183,7 @@ impl Plastic {
         } else {
             vec![0.5 * (VALID_MIN_NM + VALID_MAX_NM)]
         };
-        let coating = lambdas
+        let coating: Vec<Node> = lambdas
             .into_iter()
             .map(|lambda| {
                 Node::new(
@@ -199,8 +201,22 @@ impl Plastic {
             alpha: roughness,
             distribution: kind,
             mean_reflectance,
-            coating,
+            coating: coating.into(),
         })
+    }
+
+    /// The same coating over the base albedo `reflectance` (a texel's), choosing the diffuse
+    /// lobe by `mean` (any value in `(0, 1]` keeps the estimate exact; the base's mean is best).
+    /// Shares the coating's tables, so it allocates nothing.
+    pub(crate) fn with_base(&self, reflectance: Reflectance, mean: f64) -> Self {
+        Self {
+            reflectance,
+            ior: self.ior.clone(),
+            alpha: self.alpha,
+            distribution: self.distribution,
+            mean_reflectance: mean,
+            coating: Arc::clone(&self.coating),
+        }
     }
 
     /// A smooth plastic of base albedo `reflectance` and the default coating (ior 1.5).

@@ -57,6 +57,8 @@
 //! An index of exactly 1 makes the boundary invisible: the beam passes straight through (a delta
 //! lobe, [`ScatterKind::Specular`]) and there is no reflection.
 
+use std::sync::Arc;
+
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use spectrace_spectrum::Transmittance;
@@ -80,7 +82,7 @@ const NAME: &str = "RoughDielectric";
 #[serde(try_from = "RoughDielectricRepr", into = "RoughDielectricRepr")]
 pub struct RoughDielectric {
     /// The index and transmittance, and the smooth limit used below [`SMOOTH_ALPHA`].
-    smooth: Dielectric,
+    smooth: Arc<Dielectric>,
     alpha_u: f64,
     alpha_v: f64,
     distribution: Distribution,
@@ -161,7 +163,7 @@ impl RoughDielectric {
         check_alpha(NAME, "roughness_u", alpha_u)?;
         check_alpha(NAME, "roughness_v", alpha_v)?;
         Ok(Self {
-            smooth: Dielectric::new(ior, transmittance),
+            smooth: Arc::new(Dielectric::new(ior, transmittance)),
             alpha_u,
             alpha_v,
             distribution: Distribution::Ggx,
@@ -179,6 +181,17 @@ impl RoughDielectric {
     ) -> Result<Self, MaterialError> {
         check_alpha(NAME, "roughness", alpha)?;
         Self::new(ior, alpha, alpha, transmittance)
+    }
+
+    /// The same glass with the isotropic roughness `alpha` (a texel's; finite, `>= 0`). Shares
+    /// the index, so it allocates nothing.
+    pub(crate) fn with_alpha(&self, alpha: f64) -> Self {
+        Self {
+            smooth: Arc::clone(&self.smooth),
+            alpha_u: alpha,
+            alpha_v: alpha,
+            distribution: self.distribution,
+        }
     }
 
     /// The same glass with the microfacet distribution `kind` (GGX unless asked).

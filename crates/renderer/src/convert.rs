@@ -52,17 +52,27 @@ pub fn convert(
     Ok(imported.notes.iter().map(ToString::to_string).collect())
 }
 
-/// Rewrites every mesh path (`obj`, `ply`, `serialized`) relative to `dir` and collects them in `inputs`.
+/// Rewrites every mesh path (`obj`, `ply`, `serialized`) and texture file relative to `dir` and
+/// collects them in `inputs`.
 fn relativise_meshes(scene: &mut Value, dir: &Path, inputs: &mut Vec<PathBuf>) {
     let Some(objects) = scene.get_mut("objects").and_then(Value::as_array_mut) else { return };
+    let mut rebase = |p: &mut String| {
+        let path = PathBuf::from(&*p);
+        inputs.push(path.clone());
+        if let Some(rel) = relative(&path, dir) {
+            *p = rel.to_string_lossy().into_owned();
+        }
+    };
     for object in objects {
         for key in ["obj", "ply", "serialized"] {
             if let Some(Value::String(p)) = object.get_mut("shape").and_then(|s| s.get_mut(key)) {
-                let path = PathBuf::from(&*p);
-                inputs.push(path.clone());
-                if let Some(rel) = relative(&path, dir) {
-                    *p = rel.to_string_lossy().into_owned();
-                }
+                rebase(p);
+            }
+        }
+        for key in ["reflectance", "roughness"] {
+            let texture = object.get_mut("material").and_then(|m| m.get_mut(key));
+            if let Some(Value::String(p)) = texture.and_then(|t| t.get_mut("file")) {
+                rebase(p);
             }
         }
     }

@@ -139,6 +139,24 @@ pub fn with_scene_folder<R>(
 /// Why, as text, naming the resolved path: cannot be read, not a regular file, larger than
 /// `limit`, not UTF-8, or outside the folder.
 pub fn read_scene_input(name: &Path, limit: u64, what: &str) -> Result<(PathBuf, String), String> {
+    let (path, bytes) = read_scene_input_bytes(name, limit, what)?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+        let line = valid.iter().filter(|&&b| b == b'\n').count() + 1;
+        format!("{}:{line}: the {what} is not UTF-8 text", path.display())
+    })?;
+    Ok((path, text))
+}
+
+/// [`read_scene_input`] for a binary file (an image): the resolved path and the bytes.
+///
+/// # Errors
+/// As [`read_scene_input`], but for the UTF-8 check.
+pub fn read_scene_input_bytes(
+    name: &Path,
+    limit: u64,
+    what: &str,
+) -> Result<(PathBuf, Vec<u8>), String> {
     let (base, restrict) = SCENE_FOLDER
         .with(|s| s.borrow().last().map(|f| (f.base.clone(), f.restrict)))
         .unwrap_or_default();
@@ -147,17 +165,12 @@ pub fn read_scene_input(name: &Path, limit: u64, what: &str) -> Result<(PathBuf,
         check_inside(&base, &path)?;
     }
     let bytes = read_bounded(&path, limit, what).map_err(|e| format!("{}: {e}", path.display()))?;
-    let text = String::from_utf8(bytes).map_err(|e| {
-        let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
-        let line = valid.iter().filter(|&&b| b == b'\n').count() + 1;
-        format!("{}:{line}: the {what} is not UTF-8 text", path.display())
-    })?;
     SCENE_FOLDER.with(|s| {
         if let Some(f) = s.borrow_mut().last_mut() {
             f.read.push(path.clone());
         }
     });
-    Ok((path, text))
+    Ok((path, bytes))
 }
 
 #[cfg(test)]

@@ -49,6 +49,7 @@ mod mixture;
 mod photometric;
 mod reflectance;
 pub mod rgb;
+mod rgb_table;
 mod spd;
 mod tabulated;
 
@@ -65,6 +66,7 @@ pub use photometric::{
     PEAK_LUMINOUS_EFFICACY, lumens_per_watt, luminous_efficacy, watts_from_lumens,
 };
 pub use reflectance::{Reflectance, Transmittance};
+pub use rgb_table::RgbTable;
 pub use spd::{MAX_NM_PANELS, SpectralPowerDistribution, integrate_panels};
 pub use tabulated::{Binned, Tabulated};
 

@@ -18,6 +18,7 @@ use serde::de::{self, DeserializeSeed, MapAccess, SeqAccess, Unexpected, Visitor
 use serde::{Deserialize, Serialize};
 
 use crate::error::SpectrumError;
+use crate::rgb::SigmoidSpectrum;
 use spectrace_sampling::{GridLocator, SamplingError};
 
 /// A spectral reflectance: a fraction in `[0, 1]` at each wavelength, linear between tabulated
@@ -28,6 +29,9 @@ pub struct Reflectance {
     values: Vec<f64>,
     /// Finds the segment of a wavelength (in `O(1)` on evenly spaced tables).
     locator: GridLocator,
+    /// A smooth spectrum from a colour instead of the table (a texel: built without
+    /// allocating, see [`Reflectance::from_sigmoid`]).
+    sigmoid: Option<SigmoidSpectrum>,
 }
 
 /// A spectral transmittance: the same representation and rules as a [`Reflectance`], but its
@@ -62,7 +66,10 @@ enum ReflectanceBinary {
 
 impl From<&Reflectance> for FractionRepr {
     fn from(r: &Reflectance) -> Self {
-        if r.nm.is_empty() {
+        if let Some(s) = &r.sigmoid {
+            let (nm, values) = s.table();
+            FractionRepr::Table { nm, values }
+        } else if r.nm.is_empty() {
             FractionRepr::Constant(r.values.first().copied().unwrap_or(0.0))
         } else {
             FractionRepr::Table { nm: r.nm.clone(), values: r.values.clone() }
@@ -445,12 +452,28 @@ impl Reflectance {
     /// [`Reflectance::constant`] with messages for `kind`.
     /// The fraction 1 at every wavelength (a white, lossless surface).
     pub fn white() -> Self {
-        Self { nm: Vec::new(), values: vec![1.0], locator: GridLocator::default() }
+        Self { nm: Vec::new(), values: vec![1.0], locator: GridLocator::default(), sigmoid: None }
     }
 
     fn constant_of(kind: Kind, value: f64) -> Result<Self, SpectrumError> {
         check_fraction(kind, "constant", 0, value)?;
-        Ok(Self { nm: Vec::new(), values: vec![value], locator: GridLocator::default() })
+        Ok(Self {
+            nm: Vec::new(),
+            values: vec![value],
+            locator: GridLocator::default(),
+            sigmoid: None,
+        })
+    }
+
+    /// The smooth reflectance `s` (a colour's spectrum, e.g. a texel's from
+    /// [`crate::RgbTable`]); allocates nothing, so a renderer may build one per surface hit.
+    pub fn from_sigmoid(s: SigmoidSpectrum) -> Self {
+        Self {
+            nm: Vec::new(),
+            values: Vec::new(),
+            locator: GridLocator::default(),
+            sigmoid: Some(s),
+        }
     }
 
     /// A table of fractions at strictly increasing wavelengths.
@@ -497,12 +520,20 @@ impl Reflectance {
         for (index, &value) in values.iter().enumerate() {
             check_fraction(kind, "values", index, value)?;
         }
-        Ok(Self { nm: nm.to_vec(), values: values.to_vec(), locator: GridLocator::new(nm) })
+        Ok(Self {
+            nm: nm.to_vec(),
+            values: values.to_vec(),
+            locator: GridLocator::new(nm),
+            sigmoid: None,
+        })
     }
 
     /// The fraction at `lambda` (nm); in `[0, 1]` for every input (NaN gives the first value).
     #[inline]
     pub fn value(&self, lambda: f64) -> f64 {
+        if let Some(s) = &self.sigmoid {
+            return s.value(lambda);
+        }
         let n = self.nm.len();
         if n <= 1 {
             return self.values[0];
@@ -520,12 +551,18 @@ impl Reflectance {
 
     /// `true` if the fraction is the same at every wavelength.
     pub fn is_constant(&self) -> bool {
-        self.values.iter().all(|&v| v == self.values[0])
+        match &self.sigmoid {
+            Some(s) => s.value(400.0) == s.value(700.0) && s.value(400.0) == s.value(550.0),
+            None => self.values.iter().all(|&v| v == self.values[0]),
+        }
     }
 
-    /// The largest fraction at any wavelength.
+    /// The largest fraction at any wavelength (for a smooth spectrum: over its 5 nm table).
     pub fn max_value(&self) -> f64 {
-        self.values.iter().copied().fold(0.0, f64::max)
+        match &self.sigmoid {
+            Some(s) => s.table().1.into_iter().fold(0.0, f64::max),
+            None => self.values.iter().copied().fold(0.0, f64::max),
+        }
     }
 }
 

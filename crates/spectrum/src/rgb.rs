@@ -134,14 +134,8 @@ impl SigmoidSpectrum {
         if rgb[0] == rgb[1] && rgb[1] == rgb[2] {
             return Ok(Self { coefficients: [0.0; 3], constant: Some(rgb[0]) });
         }
-        let mut a = [0.0; 3];
-        const STEPS: usize = 8;
-        let mut residual = f64::INFINITY;
-        for step in 1..=STEPS {
-            let f = step as f64 / STEPS as f64;
-            let target = rgb.map(|v| 0.5 + (v - 0.5) * f);
-            residual = newton(&mut a, target);
-        }
+        let mut a = Self::continuation(rgb, &FINE, 64);
+        let residual = newton(&mut a, rgb, &FINE);
         if !(residual <= ACCEPT) {
             return Err(rgb_error(
                 residual,
@@ -149,6 +143,29 @@ impl SigmoidSpectrum {
             ));
         }
         Ok(Self { coefficients: a, constant: None })
+    }
+
+    /// The coefficients fitted to `rgb` by walking from mid grey in eight straight steps, solving
+    /// at each (the solver's best finite coefficients where the colour needs infinite ones).
+    pub(crate) fn continuation(rgb: [f64; 3], q: &[(f64, [f64; 3])], steps: usize) -> [f64; 3] {
+        let mut a = [0.0; 3];
+        const STEPS: usize = 8;
+        for step in 1..=STEPS {
+            let f = step as f64 / STEPS as f64;
+            newton_steps(&mut a, rgb.map(|v| 0.5 + (v - 0.5) * f), q, steps);
+        }
+        a
+    }
+
+    /// The spectrum `S(a0 t^2 + a1 t + a2)` of given coefficients (see the module's essay).
+    pub fn from_coefficients(coefficients: [f64; 3]) -> Self {
+        Self { coefficients, constant: None }
+    }
+
+    /// The constant spectrum `value` (a grey; clamped to `[0, 1]`, NaN read as 0).
+    pub fn constant(value: f64) -> Self {
+        let v = if value >= 0.0 { value.min(1.0) } else { 0.0 };
+        Self { coefficients: [0.0; 3], constant: Some(v) }
     }
 
     /// The reflectance at `lambda` (nm), in `[0, 1]`; the quadratic is evaluated at every
@@ -178,10 +195,20 @@ pub fn visible_grid() -> Vec<f64> {
 
 /// Newton's method on `srgb(S(quadratic a)) = target` from `a`; returns the largest component
 /// of the remaining error.
-fn newton(a: &mut [f64; 3], target: [f64; 3]) -> f64 {
-    let (mut r, mut jac) = residual(a, target);
+pub(crate) fn newton(a: &mut [f64; 3], target: [f64; 3], q: &[(f64, [f64; 3])]) -> f64 {
+    newton_steps(a, target, q, 64)
+}
+
+/// [`newton`] with at most `steps` steps.
+pub(crate) fn newton_steps(
+    a: &mut [f64; 3],
+    target: [f64; 3],
+    q: &[(f64, [f64; 3])],
+    steps: usize,
+) -> f64 {
+    let (mut r, mut jac) = residual(a, target, q);
     let norm = |r: &[f64; 3]| r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    for _ in 0..64 {
+    for _ in 0..steps {
         if norm(&r) < 1e-10 {
             break;
         }
@@ -190,7 +217,7 @@ fn newton(a: &mut [f64; 3], target: [f64; 3]) -> f64 {
         let mut improved = false;
         for _ in 0..30 {
             let trial = [0, 1, 2].map(|k| a[k] + scale * delta[k]);
-            let (tr, tj) = residual(&trial, target);
+            let (tr, tj) = residual(&trial, target, q);
             if norm(&tr) < norm(&r) {
                 *a = trial;
                 r = tr;
@@ -207,13 +234,12 @@ fn newton(a: &mut [f64; 3], target: [f64; 3]) -> f64 {
     norm(&r)
 }
 
-/// The error `srgb(a) - target` and its Jacobian `d srgb / d a` (rows: channels).
-fn residual(a: &[f64; 3], target: [f64; 3]) -> ([f64; 3], [[f64; 3]; 3]) {
+/// The error `srgb(a) - target` and its Jacobian `d srgb / d a` (rows: channels), by the
+/// quadrature `q`: pairs of `t = (lambda - 360) / 470` and the response there.
+fn residual(a: &[f64; 3], target: [f64; 3], q: &[(f64, [f64; 3])]) -> ([f64; 3], [[f64; 3]; 3]) {
     let mut rgb = [0.0; 3];
     let mut jac = [[0.0; 3]; 3];
-    let span = VISIBLE_MAX_NM - VISIBLE_MIN_NM;
-    for (i, w) in RESPONSE.iter().enumerate() {
-        let t = i as f64 / span;
+    for &(t, w) in q {
         let x = a[0].mul_add(t, a[1]).mul_add(t, a[2]);
         let (s, ds) = (sigmoid(x), sigmoid_slope(x));
         let basis = [t * t, t, 1.0];
@@ -226,6 +252,33 @@ fn residual(a: &[f64; 3], target: [f64; 3]) -> ([f64; 3], [[f64; 3]; 3]) {
     }
     ([0, 1, 2].map(|c| rgb[c] - target[c]), jac)
 }
+
+/// [`RESPONSE`] as a quadrature for [`residual`]: every 1 nm.
+pub(crate) static FINE: LazyLock<Vec<(f64, [f64; 3])>> = LazyLock::new(|| {
+    let span = VISIBLE_MAX_NM - VISIBLE_MIN_NM;
+    RESPONSE.iter().enumerate().map(|(i, &w)| (i as f64 / span, w)).collect()
+});
+
+/// [`RESPONSE`] gathered onto the [`TABLE_STEP_NM`] grid with hat weights: exact for a spectrum
+/// linear between the grid's points (a sigmoid departs from that by under 1e-4), five times
+/// cheaper; the coefficient table is fitted with it.
+pub(crate) static COARSE: LazyLock<Vec<(f64, [f64; 3])>> = LazyLock::new(|| {
+    let span = VISIBLE_MAX_NM - VISIBLE_MIN_NM;
+    let step = TABLE_STEP_NM as usize;
+    let nodes = (span as usize) / step + 1;
+    let mut q: Vec<(f64, [f64; 3])> =
+        (0..nodes).map(|j| ((j * step) as f64 / span, [0.0; 3])).collect();
+    for (i, w) in RESPONSE.iter().enumerate() {
+        let (j, r) = (i / step, (i % step) as f64 / step as f64);
+        for (c, &wc) in w.iter().enumerate() {
+            q[j].1[c] += (1.0 - r) * wc;
+            if r > 0.0 {
+                q[j + 1].1[c] += r * wc;
+            }
+        }
+    }
+    q
+});
 
 /// `x` with `m x = b` (Cramer's rule); `None` when `m` is singular.
 fn solve3(m: &[[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {

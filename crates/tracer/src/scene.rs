@@ -9,7 +9,7 @@ use std::sync::Arc;
 use glam::DVec3;
 use spectrace_geometry::{Hit, Ray, World};
 use spectrace_lights::{LightId, LightSet, LightSource};
-use spectrace_materials::Material;
+use spectrace_materials::{Material, MaterialAt};
 use spectrace_spectrum::SpectralPowerDistribution;
 
 use crate::light_sampler::{LightSampler, PowerLightSampler};
@@ -254,6 +254,13 @@ impl<'a> LightTracerScene<'a> {
     #[inline]
     pub fn light_spd(&self, id: LightId) -> Option<&Arc<dyn SpectralPowerDistribution>> {
         self.spds.get(id.0 as usize)
+    }
+
+    /// The material at `hit`, resolved at its `uv` when textured; `None` for a shape without
+    /// one.
+    #[inline]
+    pub fn material_at(&self, hit: &Hit) -> Option<MaterialAt<'a>> {
+        self.materials.get(hit.primitive as usize).map(|m| MaterialAt::new(m.as_ref(), hit.uv))
     }
 
     /// Radiance (whole spectrum; times the light's SPD) leaving `hit` towards the unit

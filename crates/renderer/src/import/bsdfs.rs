@@ -9,6 +9,7 @@ use serde_json::{Value, json};
 use super::Importer;
 use super::params::Params;
 use super::spectra::{Role, spectrum};
+use super::textures::{Use, textured};
 use super::xml::{Element, ImportError, error_at};
 
 /// Mitsuba 3's named indices of refraction (its `ior.h`, from the CRC handbook).
@@ -83,9 +84,20 @@ impl Importer {
                 return Ok(m);
             }
             "diffuse" => {
-                let r = self.reflectance(&p, "reflectance", 0.5)?;
                 one_sided_note(self);
-                json!({"type": "Diffuse", "reflectance": r})
+                let texture = match p.get("reflectance") {
+                    Some(e) => self.texture(e, Use::Reflectance)?,
+                    None => None,
+                };
+                match texture {
+                    Some(t) => {
+                        textured(json!({"type": "Diffuse", "reflectance": 0.5}), "reflectance", t)
+                    }
+                    None => {
+                        let r = self.reflectance(&p, "reflectance", 0.5)?;
+                        json!({"type": "Diffuse", "reflectance": r})
+                    }
+                }
             }
             "conductor" | "roughconductor" => self.conductor(el, &p, two_sided)?,
             "thindielectric" => {
@@ -106,9 +118,13 @@ impl Importer {
                 }
                 if el.kind() == "roughdielectric" {
                     m["type"] = json!("RoughDielectric");
-                    self.roughness(&p, &mut m)?;
+                    match self.roughness(&p, &mut m)? {
+                        Some(t) => textured(m, "roughness", t),
+                        None => m,
+                    }
+                } else {
+                    m
                 }
-                m
             }
             "plastic" | "roughplastic" => self.plastic(el, &p, two_sided)?,
             other => {
@@ -135,9 +151,13 @@ impl Importer {
         p: &Params<'_>,
         two_sided: bool,
     ) -> Result<Value, ImportError> {
+        let texture = match p.get("diffuse_reflectance") {
+            Some(e) => self.texture(e, Use::Reflectance)?,
+            None => None,
+        };
         let base = match p.get("diffuse_reflectance") {
-            Some(e) => spectrum(e, Role::Reflectance)?,
-            None => super::spectra::Spec::Constant(0.5),
+            Some(e) if texture.is_none() => spectrum(e, Role::Reflectance)?,
+            _ => super::spectra::Spec::Constant(0.5),
         };
         let ior = self.ior(p, "int_ior", 1.49)? / self.ior(p, "ext_ior", 1.000_277)?;
         self.unit_scale(p, "specular_reflectance")?;
@@ -156,7 +176,18 @@ impl Importer {
             m["distribution"] = json!(distribution);
             self.note(el, "rough plastic: Spectrace's rough coating transmits up to 8% differently from Mitsuba's tables (docs/materials-peer.md)");
         }
-        let base = if p.boolean("nonlinear", false)? {
+        let nonlinear = p.boolean("nonlinear", false)?;
+        if let Some(t) = texture {
+            if !nonlinear {
+                self.note(el, "nonlinear=false (Mitsuba's default) with a textured base: rendered with Spectrace's physical diffuse term (Mitsuba's nonlinear=true), whose colours are darker where the base is bright");
+            }
+            m["reflectance"] = json!(0.5);
+            if !two_sided {
+                self.note(el, "one-sided in Mitsuba; Spectrace's material reflects on both sides (the same image unless light reaches its back)");
+            }
+            return Ok(textured(m, "reflectance", t));
+        }
+        let base = if nonlinear {
             base
         } else {
             let mut white = m.clone();
@@ -222,6 +253,7 @@ impl Importer {
                 "conductors inside a medium other than air (ext_eta) are not supported",
             ));
         }
+        let mut texture = None;
         if el.kind() == "roughconductor" {
             if m["type"] == "Mirror" {
                 return Err(error_at(
@@ -230,22 +262,42 @@ impl Importer {
                 ));
             }
             m["type"] = json!("RoughConductor");
-            self.roughness(p, &mut m)?;
+            texture = self.roughness(p, &mut m)?;
         }
         if !two_sided {
             self.note(el, "one-sided in Mitsuba; Spectrace's material reflects on both sides (the same image unless light reaches its back)");
         }
-        Ok(m)
+        Ok(match texture {
+            Some(t) => textured(m, "roughness", t),
+            None => m,
+        })
     }
 
-    /// `alpha` or `alpha_u`/`alpha_v` and `distribution` (default beckmann, Mitsuba's).
-    fn roughness(&mut self, p: &Params<'_>, m: &mut Value) -> Result<(), ImportError> {
+    /// `alpha` or `alpha_u`/`alpha_v` and `distribution` (default beckmann, Mitsuba's); the
+    /// texture when `alpha` is one.
+    fn roughness(&mut self, p: &Params<'_>, m: &mut Value) -> Result<Option<Value>, ImportError> {
+        let mut texture = None;
         match (p.get("alpha_u"), p.get("alpha_v")) {
             (Some(u), Some(v)) => {
+                for e in [u, v] {
+                    if self.texture(e, Use::Roughness)?.is_some() {
+                        return Err(error_at(
+                            &e.loc,
+                            "anisotropic roughness textures (alpha_u, alpha_v) are not supported; give one alpha texture",
+                        ));
+                    }
+                }
                 m["roughness_u"] = json!(super::values::number(u)?);
                 m["roughness_v"] = json!(super::values::number(v)?);
             }
-            (None, None) => m["roughness"] = json!(p.float("alpha", 0.1)?),
+            (None, None) => match p.get("alpha") {
+                Some(e) => {
+                    texture = self.texture(e, Use::Roughness)?;
+                    m["roughness"] =
+                        json!(if texture.is_some() { 0.1 } else { super::values::number(e)? });
+                }
+                None => m["roughness"] = json!(0.1),
+            },
             _ => return Err(error_at(&p.el.loc, "give both alpha_u and alpha_v")),
         }
         let distribution = p.string("distribution")?.unwrap_or("beckmann");
@@ -259,7 +311,7 @@ impl Importer {
         if !p.boolean("sample_visible", true)? {
             self.note(p.el, "sample_visible=false only changes Mitsuba's sampling, not the image; Spectrace samples visible normals");
         }
-        Ok(())
+        Ok(texture)
     }
 
     /// A reflectance parameter, or the default.

@@ -14,6 +14,7 @@ mod emitters;
 mod params;
 mod shapes;
 mod spectra;
+mod textures;
 mod values;
 mod xml;
 

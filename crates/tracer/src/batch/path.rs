@@ -106,8 +106,8 @@ impl<'a> Lanes<'a> {
                 stats,
             );
             self.vertices[i] = vertex;
-            let Some(vertex) = vertex.filter(|v| v.next_event) else { continue };
-            let at = Shading { hit, wo: -path.state.ray.direction, material: vertex.material };
+            let Some(vertex) = self.vertices[i].as_ref().filter(|v| v.next_event) else { continue };
+            let at = Shading { hit, wo: -path.state.ray.direction, material: &*vertex.material };
             let queue = &mut self.queue;
             tracer.for_each_light(vertex.light, |light| {
                 if let Some(c) = tracer.connection(&path.state, &at, light) {
@@ -122,9 +122,9 @@ impl<'a> Lanes<'a> {
         let scene = tracer.scene();
         self.queue.retain(|(_, c)| c.shadow.visible(scene));
         for (i, c) in &self.queue {
-            let (Some(hit), Some(vertex)) = (&self.hits[*i], self.vertices[*i]) else { continue };
+            let (Some(hit), Some(vertex)) = (&self.hits[*i], &self.vertices[*i]) else { continue };
             let path = &mut self.paths[*i];
-            let at = Shading { hit, wo: -path.state.ray.direction, material: vertex.material };
+            let at = Shading { hit, wo: -path.state.ray.direction, material: &*vertex.material };
             tracer.connect(&mut path.state, &at, c, stats);
         }
     }
@@ -138,7 +138,7 @@ impl<'a> Lanes<'a> {
         stats: &mut TraceStats,
     ) {
         for i in (0..self.paths.len()).rev() {
-            let alive = match (&self.hits[i], self.vertices[i]) {
+            let alive = match (&self.hits[i], self.vertices[i].take()) {
                 (Some(hit), Some(vertex)) => {
                     tracer.go_on(&mut self.paths[i].state, hit, vertex, &mut self.rngs[i], stats)
                 }

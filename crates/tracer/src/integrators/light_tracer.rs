@@ -261,11 +261,11 @@ impl BeamTracer<'_, '_> {
         let mut depth = 0u32;
         while let Some(hit) = next_hit.take() {
             stats.hits += 1;
-            let Some(material) = scene.materials.get(hit.primitive as usize) else { break };
+            let Some(material) = scene.material_at(&hit) else { break };
             let u = VertexSamples::draw(&self.layout, rng);
             let (lambdas, weights) = (&mut b.lambdas[..b.len], &mut b.weights[..b.len]);
             let Some(lobe) = choose_lobe(
-                material.as_ref(),
+                &*material,
                 Direction::Forward,
                 lambdas,
                 weights,

@@ -55,10 +55,12 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use spectrace_geometry::{Hit, Ray};
 use spectrace_lights::{LightId, LightSource};
-use spectrace_materials::{ExcitationSampler, Material, ScatterKind, Transport};
+use spectrace_materials::{
+    ExcitationSampler, Material, MaterialAt, ScatterKind, Transport, reemission_lobe,
+};
 
 use super::common::{
-    CameraSamples, Direction, End, SampleLayout, ScatterSamples, ShadowRay, VertexSamples,
+    CameraSamples, Direction, End, Lobe, SampleLayout, ScatterSamples, ShadowRay, VertexSamples,
     choose_lobe, connect_light_to_camera, power_heuristic, relative_throughput, roulette,
     sample_light,
 };
@@ -122,10 +124,10 @@ pub(crate) struct Shading<'h> {
 
 /// A scattering vertex a path has reached ([`PathTracer::arrive`]): its lobe, its light
 /// uniforms and whether next-event estimation runs there.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 pub(crate) struct Vertex<'m> {
-    /// The lobe that scatters (the material, or the re-emission lobe).
-    pub material: &'m dyn Material,
+    /// The lobe that scatters (the material there, or the re-emission lobe).
+    pub material: MaterialAt<'m>,
     /// The uniforms of next-event estimation's light choice.
     pub light: [f64; 2],
     /// The lobe is not specular: next-event estimation samples lights here.
@@ -352,7 +354,7 @@ impl<'a> PathTracer<'a> {
                 break;
             };
             if vertex.next_event {
-                let at = Shading { hit: &hit, wo: -p.ray.direction, material: vertex.material };
+                let at = Shading { hit: &hit, wo: -p.ray.direction, material: &*vertex.material };
                 self.for_each_light(vertex.light, |light| {
                     if let Some(c) = self.connection(p, &at, light)
                         && c.shadow.visible(self.scene)
@@ -392,22 +394,24 @@ impl<'a> PathTracer<'a> {
         if p.last_bounce {
             return None;
         }
-        let material = scene.materials.get(hit.primitive as usize)?;
+        let material = scene.material_at(hit)?;
         let u = VertexSamples::draw(&self.layout, rng);
         let guide = self.excitation.get(hit.primitive as usize).and_then(Option::as_ref);
         let lobe = choose_lobe(
-            material.as_ref(),
+            &*material,
             Direction::Adjoint(guide),
             &mut p.transport,
             &mut p.beta,
             u.fluorescence,
             stats,
         )?;
-        let material = lobe.material();
+        let reemitted = matches!(lobe, Lobe::Reemitted(_));
+        let material = if reemitted { MaterialAt::Shared(reemission_lobe()) } else { material };
         if material.is_dispersive() && !p.collapsed {
             p.collapse(lambda_weights);
         }
-        Some(Vertex { material, light: u.light, next_event: !material.is_specular() })
+        let next_event = !material.is_specular();
+        Some(Vertex { material, light: u.light, next_event })
     }
 
     /// Calls `f` with every light next-event estimation samples at a vertex whose light
@@ -496,7 +500,7 @@ impl<'a> PathTracer<'a> {
             }
         }
         let go = ScatterSamples::draw(rng, p.depth >= self.settings.rr_depth);
-        self.bounce(p, hit, vertex.material, &go, stats)
+        self.bounce(p, hit, &*vertex.material, &go, stats)
     }
 
     /// The BSDF sample and Russian roulette at a vertex (after its next-event estimation);

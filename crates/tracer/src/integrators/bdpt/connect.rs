@@ -135,7 +135,7 @@ impl Bdpt<'_> {
                 let mut f = [0.0; crate::HERO];
                 let lambdas = wl.at(qs);
                 let seen = connect_surface_to_camera(
-                    self.scene, &hit, material, wi, lambdas, qs.u, &mut f,
+                    self.scene, &hit, &*material, wi, lambdas, qs.u, &mut f,
                 )?;
                 ((seen.x, seen.y), seen.lens, times(qs.beta, f), qs.lambda)
             }

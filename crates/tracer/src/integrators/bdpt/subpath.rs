@@ -162,11 +162,11 @@ impl Bdpt<'_> {
             let mut v = Vertex::at(kind, hit.point, hit.geometric_normal, beta, lambda, connect);
             v.fluoresced = prev.fluoresced;
             v.pdf_fwd = Self::to_area(pdf_dir, prev.point, &v);
-            let Some(material) = self.scene.materials.get(hit.primitive as usize) else {
+            let Some(resolved) = self.scene.material_at(&hit) else {
                 path.push(v);
                 return;
             };
-            let mut material = material.as_ref();
+            let mut material = &*resolved;
             if walk.reemit && !wl.is_hero() {
                 // Elastic or re-emitted (light subpaths only), decided before any connection to
                 // this vertex; the branch's factor belongs to the vertex's scattering, so it

@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 use glam::DVec3;
 use spectrace_geometry::Hit;
 use spectrace_lights::{LightFlags, LightId, LightSource, LightSurface};
-use spectrace_materials::{Material, Transport, reemission_lobe};
+use spectrace_materials::{MaterialAt, Transport, reemission_lobe};
 
 use super::Bdpt;
 use crate::HERO;
@@ -276,11 +276,11 @@ impl Bdpt<'_> {
 
     /// What scatters at surface vertex `v` (on `hit`): its material, or the white Lambertian
     /// lobe of a fluorescent re-emission.
-    pub(super) fn lobe(&self, v: &Vertex, hit: &Hit) -> Option<&dyn Material> {
+    pub(super) fn lobe(&self, v: &Vertex, hit: &Hit) -> Option<MaterialAt<'_>> {
         if v.reemitted {
-            return Some(reemission_lobe());
+            return Some(MaterialAt::Shared(reemission_lobe()));
         }
-        self.scene.materials.get(hit.primitive as usize).map(|m| m.as_ref())
+        self.scene.material_at(hit)
     }
 
     /// The BSDF at surface vertex `v` for light arriving from `from` and leaving towards `to`,
