@@ -139,3 +139,52 @@ fn image_png(width: u32, height: u32, rgb: [u8; 3]) -> Vec<u8> {
     img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png).unwrap();
     bytes
 }
+
+/// A Mitsuba sphere keeps Mitsuba's `uv` (pole on its local `+z`, azimuth from `+x` towards
+/// `+y`), and a checkerboard read as a roughness has its values swapped as Mitsuba 3 reads them.
+#[test]
+fn spheres_keep_mitsubas_uv_and_a_roughness_board_is_read_as_mitsuba_reads_it() {
+    use glam::DVec3;
+    use spectrace_geometry::{Ray, Shape};
+    let dir = temp_dir("texture-sphere");
+    let xml = format!(
+        r#"<scene version="3.0.0">{SENSOR}
+        <shape type="sphere"><point name="center" value="1,2,3"/><float name="radius" value="0.5"/>
+          <transform name="to_world"><rotate y="1" angle="90"/></transform>
+          <bsdf type="roughconductor"><string name="material" value="Au"/>
+            <texture type="checkerboard" name="alpha"><float name="color0" value="0.1"/><float name="color1" value="0.3"/></texture></bsdf></shape>
+        <emitter type="point"><point name="position" value="0,0,3"/><spectrum name="intensity" value="5"/></emitter>
+        </scene>"#
+    );
+    let path = dir.join("scene.xml");
+    std::fs::write(&path, xml).unwrap();
+    let imported = import_mitsuba(&path, &[]).unwrap();
+    let object = &imported.scene["objects"][0];
+    assert_eq!(object["material"]["roughness"]["color0"], 0.3);
+    assert_eq!(object["material"]["roughness"]["color1"], 0.1);
+    let shape: Shape = serde_json::from_value(object["shape"].clone()).unwrap();
+    // to_world turns the sphere's local axes: +z to +x, +x to -z, +y stays.
+    let m = glam::DMat4::from_rotation_y(std::f64::consts::FRAC_PI_2);
+    let centre = m.transform_point3(DVec3::new(1.0, 2.0, 3.0));
+    for (local, uv) in [
+        (DVec3::Z, None),              // the pole: v = 0
+        (DVec3::X, Some((0.0, 0.5))),  // azimuth 0 on the equator
+        (DVec3::Y, Some((0.25, 0.5))), // a quarter turn
+        (DVec3::new(-1.0, 0.0, 0.0), Some((0.5, 0.5))),
+    ] {
+        let towards = m.transform_vector3(local);
+        let ray = Ray { origin: centre + towards * 5.0, direction: -towards };
+        let hit = shape.intersect(&ray, f64::INFINITY).unwrap();
+        match uv {
+            None => assert!(hit.uv.y < 1e-6, "pole: {}", hit.uv),
+            Some((u, v)) => {
+                let du = (hit.uv.x - u).abs().min((hit.uv.x - u - 1.0).abs());
+                assert!(
+                    du < 1e-6 && (hit.uv.y - v).abs() < 1e-6,
+                    "{local}: {} not {u}, {v}",
+                    hit.uv
+                );
+            }
+        }
+    }
+}

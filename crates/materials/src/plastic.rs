@@ -207,7 +207,7 @@ impl Plastic {
 
     /// The same coating over the base albedo `reflectance` (a texel's), choosing the diffuse
     /// lobe by `mean` (any value in `(0, 1]` keeps the estimate exact; the base's mean is best).
-    /// Shares the coating's tables, so it allocates nothing.
+    /// Shares the coating's tables (only the index law is copied).
     pub(crate) fn with_base(&self, reflectance: Reflectance, mean: f64) -> Self {
         Self {
             reflectance,

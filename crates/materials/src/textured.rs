@@ -17,8 +17,8 @@
 //! A texel's colour becomes a spectrum through [`RgbTable`] (Jakob and Hanika's sigmoid of a
 //! quadratic, the table fitted by the project's own solver), so a textured surface is as
 //! spectral as any other. At a hit the renderer asks [`Material::texel`] for the material there:
-//! a [`Texel`], built on the stack (the coating or index tables are shared, nothing is
-//! allocated), which it then samples and evaluates like any material ([`MaterialAt`]).
+//! a [`Texel`] (the coating or index tables shared, not copied; one small box per textured hit),
+//! which it then samples and evaluates like any material ([`MaterialAt`]).
 
 use std::ops::Deref;
 
@@ -172,8 +172,8 @@ impl Texel {
 pub enum MaterialAt<'a> {
     /// The same material everywhere.
     Shared(&'a (dyn Material + 'static)),
-    /// A textured material, resolved here.
-    Texel(Texel),
+    /// A textured material, resolved here (boxed: the common, untextured case stays two words).
+    Texel(Box<Texel>),
 }
 
 impl<'a> MaterialAt<'a> {
@@ -181,7 +181,7 @@ impl<'a> MaterialAt<'a> {
     #[inline]
     pub fn new(material: &'a (dyn Material + 'static), uv: DVec2) -> Self {
         match material.texel(uv) {
-            Some(t) => MaterialAt::Texel(t),
+            Some(t) => MaterialAt::Texel(Box::new(t)),
             None => MaterialAt::Shared(material),
         }
     }

@@ -531,12 +531,12 @@ impl Reflectance {
     /// The fraction at `lambda` (nm); in `[0, 1]` for every input (NaN gives the first value).
     #[inline]
     pub fn value(&self, lambda: f64) -> f64 {
-        if let Some(s) = &self.sigmoid {
-            return s.value(lambda);
-        }
         let n = self.nm.len();
         if n <= 1 {
-            return self.values[0];
+            return match &self.sigmoid {
+                Some(s) => s.value(lambda),
+                None => self.values[0],
+            };
         }
         if !(lambda > self.nm[0]) {
             return self.values[0];

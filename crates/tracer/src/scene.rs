@@ -22,6 +22,9 @@ pub struct LightTracerScene<'a> {
     pub world: &'a World,
     /// The material of each shape, indexed like the shapes given to the world.
     pub materials: &'a [Arc<dyn Material>],
+    /// Per material: whether it varies over its surface ([`Material::texel`]), so that the
+    /// others are fetched without asking.
+    textured: Vec<bool>,
     /// The lights the beams come from.
     pub lights: &'a LightSet,
     /// The camera that receives the connections.
@@ -124,6 +127,7 @@ impl<'a> LightTracerScene<'a> {
         Self {
             world,
             materials,
+            textured: materials.iter().map(|m| m.texel(glam::DVec2::ZERO).is_some()).collect(),
             lights,
             camera,
             spds,
@@ -260,7 +264,9 @@ impl<'a> LightTracerScene<'a> {
     /// one.
     #[inline]
     pub fn material_at(&self, hit: &Hit) -> Option<MaterialAt<'a>> {
-        self.materials.get(hit.primitive as usize).map(|m| MaterialAt::new(m.as_ref(), hit.uv))
+        let i = hit.primitive as usize;
+        let m = self.materials.get(i)?.as_ref();
+        Some(if self.textured[i] { MaterialAt::new(m, hit.uv) } else { MaterialAt::Shared(m) })
     }
 
     /// Radiance (whole spectrum; times the light's SPD) leaving `hit` towards the unit

@@ -137,8 +137,13 @@ impl Importer {
             "sphere" => {
                 let center = p.get("center").map_or(Ok(DVec3::ZERO), vector)?;
                 let radius = p.float("radius", 1.0)?;
-                let s = similarity(el, m)?;
-                json!({"type": "Sphere", "center": m.transform_point3(center).to_array(), "radius": radius * s})
+                similarity(el, m)?;
+                // Mitsuba's sphere has its pole on local +z, Spectrace's on +y; a quarter turn
+                // about x gives the same uv (azimuth from +x, polar angle from the pole).
+                let placed = m
+                    * DMat4::from_translation(center)
+                    * DMat4::from_rotation_x(std::f64::consts::FRAC_PI_2);
+                json!({"type": "Sphere", "center": [0.0, 0.0, 0.0], "radius": radius, "transform": matrix(placed)})
             }
             "disk" => {
                 let s = similarity(el, m)?;

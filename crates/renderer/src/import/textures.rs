@@ -81,7 +81,15 @@ impl Importer {
                         Some(c) => colour(c),
                     }
                 };
-                json!({"type": "Checkerboard", "color0": colour("color0", 0.4)?, "color1": colour("color1", 0.2)?})
+                let (c0, c1) = (colour("color0", 0.4)?, colour("color1", 0.2)?);
+                if role == Use::Roughness {
+                    // Mitsuba 3's checkerboard, read as a number (`eval_1`), gives `color0` where
+                    // its colour lookup gives `color1`: the image it renders is kept.
+                    self.note(&el, "a checkerboard read as a number: Mitsuba 3 swaps its two values there (its eval_1), and so does the import");
+                    json!({"type": "Checkerboard", "color0": c1, "color1": c0})
+                } else {
+                    json!({"type": "Checkerboard", "color0": c0, "color1": c1})
+                }
             }
             other => {
                 return Err(error_at(
