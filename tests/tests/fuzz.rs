@@ -402,6 +402,9 @@ fn fuzz_mitsuba_files() {
     );
     std::fs::write(dir.join("m.serialized"), spectrace_geometry::write_serialized(&[cube]))
         .unwrap();
+    image::RgbImage::from_fn(3, 2, |x, y| image::Rgb([40 * x as u8, 90 * y as u8, 200]))
+        .save(dir.join("t.png"))
+        .unwrap();
     let many = r#"<scene version="3.0.0"><default name="w" value="24"/><include filename="part.xml"/>
   <integrator type="path"><integer name="max_depth" value="6"/></integrator>
   <sensor type="thinlens"><float name="fov" value="45"/><float name="aperture_radius" value="0.01"/><float name="focus_distance" value="3"/>
@@ -416,12 +419,19 @@ fn fuzz_mitsuba_files() {
   <emitter type="point"><point name="position" value="-1,1,1"/><rgb name="intensity" value="2,1,0.5"/></emitter>
   <emitter type="directional"><vector name="direction" value="0,-1,-1"/><spectrum name="irradiance" type="d65"/></emitter>
   <emitter type="constant"><float name="radiance" value="0.1"/></emitter>
+  <shape type="rectangle"><transform name="to_world"><rotate x="1" angle="-90"/><scale value="2"/></transform>
+    <bsdf type="diffuse"><texture type="bitmap" name="reflectance"><string name="filename" value="t.png"/>
+      <string name="wrap_mode" value="mirror"/><transform name="to_uv"><scale x="3" y="2"/></transform></texture></bsdf></shape>
 </scene>"#;
     let own = std::fs::read_to_string(workspace().join("scenes/mitsuba/sky_plastic_gold.xml"))
         .unwrap()
         .replace("value=\"128\"", "value=\"24\"")
         .replace("value=\"96\"", "value=\"16\"");
-    let seeds = [many.to_owned(), own];
+    let textured = std::fs::read_to_string(workspace().join("scenes/mitsuba/textured.xml"))
+        .unwrap()
+        .replace("value=\"96\"", "value=\"24\"")
+        .replace("value=\"72\"", "value=\"16\"");
+    let seeds = [many.to_owned(), own, textured];
     let extremes = [
         "nan",
         "-1",

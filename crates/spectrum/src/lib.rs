@@ -28,6 +28,11 @@
 //! normalised. The CIE 1931 2-degree observer is embedded from the official 1 nm table
 //! ([`data::cie1931`], source named there).
 //!
+//! Colours given in RGB become spectra through Jakob and Hanika's sigmoid model: [`rgb`] fits one
+//! colour exactly (scene colours), [`RgbTable`] interpolates a coefficient table the project's own
+//! solver fits on first use (texture texels), and [`Reflectance::from_sigmoid`] carries either
+//! without allocating.
+//!
 //! # Example
 //! ```
 //! use spectrace_spectrum::{Blackbody, SpectralPowerDistribution, xyz_of};

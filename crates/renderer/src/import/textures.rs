@@ -49,48 +49,8 @@ impl Importer {
             None => None,
         };
         let mut t = match el.kind() {
-            "bitmap" => {
-                let name = p
-                    .string("filename")?
-                    .ok_or_else(|| error_at(&el.loc, "needs <string name=\"filename\">"))?;
-                let path = self.file_path(&el, name)?;
-                let filter = p.string("filter_type")?.unwrap_or("bilinear");
-                let wrap = p.string("wrap_mode")?.unwrap_or("repeat");
-                if !matches!(filter, "bilinear" | "nearest") {
-                    return Err(error_at(
-                        &el.loc,
-                        format!("filter_type \"{filter}\": bilinear or nearest"),
-                    ));
-                }
-                if !matches!(wrap, "repeat" | "mirror" | "clamp") {
-                    return Err(error_at(
-                        &el.loc,
-                        format!("wrap_mode \"{wrap}\": repeat, mirror or clamp"),
-                    ));
-                }
-                let raw = p.boolean("raw", false)?;
-                // Storage precision and Mitsuba's lookup acceleration leave the image as it is.
-                p.get("format");
-                p.get("accel");
-                json!({"type": "Bitmap", "file": path, "raw": raw, "filter": filter, "wrap": wrap})
-            }
-            "checkerboard" => {
-                let colour = |name: &str, default: f64| -> Result<Value, ImportError> {
-                    match p.get(name) {
-                        None => Ok(json!(default)),
-                        Some(c) => colour(c),
-                    }
-                };
-                let (c0, c1) = (colour("color0", 0.4)?, colour("color1", 0.2)?);
-                if role == Use::Roughness {
-                    // Mitsuba 3's checkerboard, read as a number (`eval_1`), gives `color0` where
-                    // its colour lookup gives `color1`: the image it renders is kept.
-                    self.note(&el, "a checkerboard read as a number: Mitsuba 3 swaps its two values there (its eval_1), and so does the import");
-                    json!({"type": "Checkerboard", "color0": c1, "color1": c0})
-                } else {
-                    json!({"type": "Checkerboard", "color0": c0, "color1": c1})
-                }
-            }
+            "bitmap" => self.bitmap(&el, &p)?,
+            "checkerboard" => self.checkerboard(&el, &p, role)?,
             other => {
                 return Err(error_at(
                     &el.loc,
@@ -108,6 +68,51 @@ impl Importer {
             self.note(&el, "a roughness texture: each point's alpha is the texture's value there (a colour's luminance), isotropic");
         }
         Ok(Some(t))
+    }
+
+    /// A `bitmap`: its file (resolved like a mesh's), filter, wrap mode and `raw`.
+    fn bitmap(&mut self, el: &Element, p: &Params<'_>) -> Result<Value, ImportError> {
+        let name = p
+            .string("filename")?
+            .ok_or_else(|| error_at(&el.loc, "needs <string name=\"filename\">"))?;
+        let path = self.file_path(el, name)?;
+        let filter = p.string("filter_type")?.unwrap_or("bilinear");
+        let wrap = p.string("wrap_mode")?.unwrap_or("repeat");
+        if !matches!(filter, "bilinear" | "nearest") {
+            return Err(error_at(
+                &el.loc,
+                format!("filter_type \"{filter}\": bilinear or nearest"),
+            ));
+        }
+        if !matches!(wrap, "repeat" | "mirror" | "clamp") {
+            return Err(error_at(
+                &el.loc,
+                format!("wrap_mode \"{wrap}\": repeat, mirror or clamp"),
+            ));
+        }
+        let raw = p.boolean("raw", false)?;
+        // Storage precision and Mitsuba's lookup acceleration leave the image as it is.
+        p.get("format");
+        p.get("accel");
+        Ok(json!({"type": "Bitmap", "file": path, "raw": raw, "filter": filter, "wrap": wrap}))
+    }
+
+    /// A `checkerboard`; read as a number (`role` a roughness), its values swapped as Mitsuba 3
+    /// reads them there (its `eval_1` tests the squares the other way round).
+    fn checkerboard(
+        &mut self,
+        el: &Element,
+        p: &Params<'_>,
+        role: Use,
+    ) -> Result<Value, ImportError> {
+        let read = |name: &str, default: f64| p.get(name).map_or(Ok(json!(default)), colour);
+        let (c0, c1) = (read("color0", 0.4)?, read("color1", 0.2)?);
+        Ok(if role == Use::Roughness {
+            self.note(el, "a checkerboard read as a number: Mitsuba 3 swaps its two values there (its eval_1), and so does the import");
+            json!({"type": "Checkerboard", "color0": c1, "color1": c0})
+        } else {
+            json!({"type": "Checkerboard", "color0": c0, "color1": c1})
+        })
     }
 }
 

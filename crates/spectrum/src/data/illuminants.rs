@@ -148,7 +148,7 @@ pub const D65: [f64; D65_LEN] = [
 /// D65 from 785 to 830 nm at 5 nm (relative, 100 at 560 nm): the CIE's extension of [`D65`]
 /// (ISO/CIE 11664-2), as tabulated in Mitsuba 3's `include/mitsuba/core/spectrum.h`
 /// (`d65_table`, whose 360-780 nm entries equal [`D65`]'s). Used where D65 must span the
-/// visible range 360-830 nm: the illuminant of RGB colours ([`crate::d65_visible`]).
+/// visible range 360-830 nm: the illuminant of RGB colours ([`crate::rgb::d65_visible`]).
 pub const D65_785_TO_830: [f64; 10] =
     [63.8434, 64.304, 61.8779, 59.4519, 55.7054, 51.959, 54.6998, 57.4406, 58.8765, 60.3125];
 
