@@ -179,7 +179,7 @@ impl<'a> LightTracerScene<'a> {
 
     /// The delta lights that a point can sample: those with a delta position (points, spots,
     /// measured luminaires) and the parallel lights whose one beam through a point it can find
-    /// (skies, lasers of finite width; [`sampled_towards_its_beams`]). Next-event estimation
+    /// (skies, lasers of finite width; `sampled_towards_its_beams`). Next-event estimation
     /// samples each of them at every vertex.
     pub fn delta_lights(&self) -> &[LightId] {
         &self.delta_lights
@@ -307,7 +307,7 @@ impl<'a> LightTracerScene<'a> {
 
     /// What the scene contains, for the effects analysis. A light with a delta direction counts
     /// as reachable from camera paths when it can be sampled towards a point on one of its own
-    /// beams ([`sampled_towards_its_beams`]).
+    /// beams (`sampled_towards_its_beams`).
     pub fn features(&self, shapes_non_convex: &[bool]) -> SceneFeatures {
         let mut f = SceneFeatures {
             light_spectra_vary: self.lights.lights().iter().any(|l| !l.uniform_spectrum()),

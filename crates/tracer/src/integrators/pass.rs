@@ -111,7 +111,7 @@ impl<E: PassEstimator> Integrator for E {
     }
 
     /// One pass (see the module docs), cut short after a multiple of
-    /// [`DEADLINE_CHECK_ITEMS`] items once `work.deadline` has passed.
+    /// `DEADLINE_CHECK_ITEMS` items once `work.deadline` has passed.
     fn render_chunk(&self, work: ChunkWork, film: &mut dyn Splat) -> TraceStats {
         let mut stats = self.render_items(work, film);
         let items = self.items().max(1);
