@@ -89,7 +89,7 @@ const LAMBDA_STEP: f64 = 20.0;
 #[serde(try_from = "PlasticRepr", into = "PlasticRepr")]
 pub struct Plastic {
     reflectance: Reflectance,
-    ior: Ior,
+    ior: Arc<Ior>,
     alpha: f64,
     /// The coating's microfacet distribution (GGX unless asked).
     distribution: Distribution,
@@ -137,7 +137,7 @@ impl From<Plastic> for PlasticRepr {
     fn from(p: Plastic) -> Self {
         Self {
             reflectance: p.reflectance,
-            ior: p.ior.into(),
+            ior: (*p.ior).clone().into(),
             roughness: p.alpha,
             distribution: p.distribution,
         }
@@ -197,7 +197,7 @@ impl Plastic {
         let mean_reflectance = values.iter().sum::<f64>() / values.len().max(1) as f64;
         Ok(Self {
             reflectance,
-            ior,
+            ior: Arc::new(ior),
             alpha: roughness,
             distribution: kind,
             mean_reflectance,
@@ -207,11 +207,11 @@ impl Plastic {
 
     /// The same coating over the base albedo `reflectance` (a texel's), choosing the diffuse
     /// lobe by `mean` (any value in `(0, 1]` keeps the estimate exact; the base's mean is best).
-    /// Shares the coating's tables (only the index law is copied).
+    /// Shares the coating's tables and index, so it allocates nothing.
     pub(crate) fn with_base(&self, reflectance: Reflectance, mean: f64) -> Self {
         Self {
             reflectance,
-            ior: self.ior.clone(),
+            ior: Arc::clone(&self.ior),
             alpha: self.alpha,
             distribution: self.distribution,
             mean_reflectance: mean,

@@ -25,12 +25,12 @@
 
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::sync::{Arc, LazyLock};
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 use spectrace_sampling::files::read_scene_input_bytes;
-use spectrace_spectrum::srgb_decode;
+use spectrace_spectrum::{srgb_decode, srgb_to_xyz_matrix};
 
 use crate::MaterialError;
 
@@ -322,17 +322,6 @@ impl Bitmap {
                 (lo.min(f64::from(v)), hi.max(f64::from(v)))
             })
     }
-
-    /// The mean colour of the texels.
-    fn mean(&self) -> [f64; 3] {
-        let mut sum = [0.0; 3];
-        for p in &self.pixels.data {
-            for c in 0..3 {
-                sum[c] += f64::from(p[c]);
-            }
-        }
-        sum.map(|s| s / self.pixels.data.len() as f64)
-    }
 }
 
 /// A colour of a [`Checkerboard`]: a number (grey) or a linear-sRGB `[r, g, b]`.
@@ -357,7 +346,7 @@ impl Colour {
 
 /// Two colours in a checkerboard of period 1 in `uv` (after `to_uv`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, try_from = "CheckerboardRepr")]
 pub struct Checkerboard {
     /// Where `frac(u) > 1/2` and `frac(v) > 1/2` agree.
     #[serde(default = "default_color0")]
@@ -368,6 +357,26 @@ pub struct Checkerboard {
     /// The map from the hit's `uv` to the board's.
     #[serde(default = "identity", skip_serializing_if = "is_identity")]
     pub to_uv: UvTransform,
+}
+
+/// Scene-file form of [`Checkerboard`], checked on the way in.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CheckerboardRepr {
+    #[serde(default = "default_color0")]
+    color0: Colour,
+    #[serde(default = "default_color1")]
+    color1: Colour,
+    #[serde(default = "identity")]
+    to_uv: UvTransform,
+}
+
+impl TryFrom<CheckerboardRepr> for Checkerboard {
+    type Error = MaterialError;
+    fn try_from(r: CheckerboardRepr) -> Result<Self, MaterialError> {
+        check_transform(&r.to_uv)?;
+        Ok(Self { color0: r.color0, color1: r.color1, to_uv: r.to_uv })
+    }
 }
 
 fn default_color0() -> Colour {
@@ -411,25 +420,16 @@ impl Texture {
             }
         }
     }
-
-    /// The texture's mean colour (over the image, or of the two squares).
-    pub fn mean(&self) -> [f64; 3] {
-        match self {
-            Texture::Bitmap(b) => b.mean(),
-            Texture::Checkerboard(c) => {
-                let (a, b) = (c.color0.rgb(), c.color1.rgb());
-                [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]))
-            }
-        }
-    }
 }
 
-/// Rec. 709 luminance of a linear colour (exactly `v` for a grey `[v, v, v]`).
+/// The luminance `Y` of a linear-sRGB colour: the `Y` row of the sRGB-to-XYZ matrix (Rec. 709's
+/// 0.2126, 0.7152, 0.0722), exactly `v` for a grey `[v, v, v]`.
 pub fn luminance(rgb: [f64; 3]) -> f64 {
+    static Y: LazyLock<[f64; 3]> = LazyLock::new(|| srgb_to_xyz_matrix()[1]);
     if rgb[0] == rgb[1] && rgb[1] == rgb[2] {
         return rgb[0];
     }
-    0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
+    Y[0] * rgb[0] + Y[1] * rgb[1] + Y[2] * rgb[2]
 }
 
 #[cfg(test)]
@@ -486,8 +486,14 @@ mod tests {
         assert_eq!(c.rgb(DVec2::new(0.1, 0.1)), [1.0, 0.0, 0.0]);
         assert_eq!(c.rgb(DVec2::new(0.3, 0.3)), [1.0, 0.0, 0.0]);
         assert_eq!(c.rgb(DVec2::new(0.3, 0.1)), [0.5; 3]);
-        assert_eq!(c.mean(), [0.75, 0.25, 0.25]);
-        assert!((c.value(DVec2::new(0.1, 0.1)) - 0.2126).abs() < 1e-12);
+        // A red texel's number is the matrix's red luminance, Rec. 709's 0.2126 to 4 decimals.
+        let red = c.value(DVec2::new(0.1, 0.1));
+        assert!((red - srgb_to_xyz_matrix()[1][0]).abs() < 1e-15, "{red}");
+        assert!((red - 0.2126).abs() < 1e-4, "{red}");
+        let e = serde_json::from_str::<Texture>(
+            r#"{"type": "Checkerboard", "to_uv": [[1e309, 0, 0], [0, 1, 0]]}"#,
+        );
+        assert!(e.is_err(), "an infinite to_uv is refused");
         let e = serde_json::from_str::<Texture>(r#"{"type": "Checkerboard", "colour0": 1}"#);
         assert!(e.unwrap_err().to_string().contains("unknown field `colour0`"));
     }

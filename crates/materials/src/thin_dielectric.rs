@@ -24,9 +24,8 @@ use spectrace_spectrum::Transmittance;
 
 use spectrace_sampling::clamp_uniform;
 
-use crate::fresnel::fresnel_dielectric;
+use crate::fresnel::{fresnel_dielectric, reflect};
 use crate::ior::IorRepr;
-use crate::vectors::normalise;
 use crate::{
     BundleScattered, Incoming, Ior, Material, MaterialError, ScatterKind, Scattered, Transport,
     scale_bundle, scatter_each,
@@ -79,7 +78,7 @@ impl ThinDielectric {
     /// The direction and whether it passes through, chosen by `u0`.
     fn lobe(&self, d: DVec3, normal: DVec3, lambda: f64, u0: f64) -> (DVec3, bool) {
         if clamp_uniform(u0) < self.reflectance(d, normal, lambda) {
-            (normalise(d - 2.0 * d.dot(normal) * normal), false)
+            (reflect(d, normal), false)
         } else {
             (d, true)
         }

@@ -50,6 +50,18 @@ const METALS: &[(&str, &str)] = &[
     ("W", "W"),
 ];
 
+/// A microfacet `distribution`: `beckmann` (Mitsuba's default) or `ggx`.
+fn distribution<'a>(p: &Params<'a>) -> Result<&'a str, ImportError> {
+    let distribution = p.string("distribution")?.unwrap_or("beckmann");
+    if distribution != "beckmann" && distribution != "ggx" {
+        return Err(error_at(
+            &p.el.loc,
+            format!("distribution \"{distribution}\": ggx or beckmann"),
+        ));
+    }
+    Ok(distribution)
+}
+
 impl Importer {
     /// The material of a `<bsdf>` (followed through `<ref>`s); `sided` is whether a `twosided`
     /// wraps it.
@@ -57,11 +69,6 @@ impl Importer {
         let ids = self.ids();
         let el = super::resolve(&ids, el, "bsdf")?;
         let p = Params::new(el);
-        let one_sided_note = |s: &mut Self| {
-            if !two_sided {
-                s.note(el, "one-sided in Mitsuba; Spectrace's material reflects on both sides (the same image unless light reaches its back)");
-            }
-        };
         let material = match el.kind() {
             "twosided" => {
                 let inner = p.nested("bsdf");
@@ -84,12 +91,8 @@ impl Importer {
                 return Ok(m);
             }
             "diffuse" => {
-                one_sided_note(self);
-                let texture = match p.get("reflectance") {
-                    Some(e) => self.texture(e, Use::Reflectance)?,
-                    None => None,
-                };
-                match texture {
+                self.one_sided(el, two_sided);
+                match self.texture_param(&p, "reflectance", Use::Reflectance)? {
                     Some(t) => {
                         textured(json!({"type": "Diffuse", "reflectance": 0.5}), "reflectance", t)
                     }
@@ -151,10 +154,7 @@ impl Importer {
         p: &Params<'_>,
         two_sided: bool,
     ) -> Result<Value, ImportError> {
-        let texture = match p.get("diffuse_reflectance") {
-            Some(e) => self.texture(e, Use::Reflectance)?,
-            None => None,
-        };
+        let texture = self.texture_param(p, "diffuse_reflectance", Use::Reflectance)?;
         let base = match p.get("diffuse_reflectance") {
             Some(e) if texture.is_none() => spectrum(e, Role::Reflectance)?,
             _ => super::spectra::Spec::Constant(0.5),
@@ -164,13 +164,7 @@ impl Importer {
         let mut m = json!({"type": "Plastic", "ior": ior});
         if el.kind() == "roughplastic" {
             let alpha = p.float("alpha", 0.1)?;
-            let distribution = p.string("distribution")?.unwrap_or("beckmann");
-            if distribution != "beckmann" && distribution != "ggx" {
-                return Err(error_at(
-                    &el.loc,
-                    format!("distribution \"{distribution}\": ggx or beckmann"),
-                ));
-            }
+            let distribution = distribution(p)?;
             p.get("sample_visible");
             m["roughness"] = json!(alpha);
             m["distribution"] = json!(distribution);
@@ -182,9 +176,7 @@ impl Importer {
                 self.note(el, "nonlinear=false (Mitsuba's default) with a textured base: rendered with Spectrace's physical diffuse term (Mitsuba's nonlinear=true), whose colours are darker where the base is bright");
             }
             m["reflectance"] = json!(0.5);
-            if !two_sided {
-                self.note(el, "one-sided in Mitsuba; Spectrace's material reflects on both sides (the same image unless light reaches its back)");
-            }
+            self.one_sided(el, two_sided);
             return Ok(textured(m, "reflectance", t));
         }
         let base = if nonlinear {
@@ -204,9 +196,7 @@ impl Importer {
             })
         };
         m["reflectance"] = base.reflectance_json();
-        if !two_sided {
-            self.note(el, "one-sided in Mitsuba; Spectrace's material reflects on both sides (the same image unless light reaches its back)");
-        }
+        self.one_sided(el, two_sided);
         Ok(m)
     }
 
@@ -264,9 +254,7 @@ impl Importer {
             m["type"] = json!("RoughConductor");
             texture = self.roughness(p, &mut m)?;
         }
-        if !two_sided {
-            self.note(el, "one-sided in Mitsuba; Spectrace's material reflects on both sides (the same image unless light reaches its back)");
-        }
+        self.one_sided(el, two_sided);
         Ok(match texture {
             Some(t) => textured(m, "roughness", t),
             None => m,
@@ -300,18 +288,31 @@ impl Importer {
             },
             _ => return Err(error_at(&p.el.loc, "give both alpha_u and alpha_v")),
         }
-        let distribution = p.string("distribution")?.unwrap_or("beckmann");
-        if distribution != "beckmann" && distribution != "ggx" {
-            return Err(error_at(
-                &p.el.loc,
-                format!("distribution \"{distribution}\": ggx or beckmann"),
-            ));
-        }
-        m["distribution"] = json!(distribution);
+        m["distribution"] = json!(distribution(p)?);
         if !p.boolean("sample_visible", true)? {
             self.note(p.el, "sample_visible=false only changes Mitsuba's sampling, not the image; Spectrace samples visible normals");
         }
         Ok(texture)
+    }
+
+    /// Notes that a BSDF Mitsuba renders one-sided is two-sided here (unless a `twosided` wraps it).
+    fn one_sided(&mut self, el: &Element, two_sided: bool) {
+        if !two_sided {
+            self.note(el, "one-sided in Mitsuba; Spectrace's material reflects on both sides (the same image unless light reaches its back)");
+        }
+    }
+
+    /// Parameter `name` when it is a texture (see [`Importer::texture`]).
+    fn texture_param(
+        &mut self,
+        p: &Params<'_>,
+        name: &str,
+        role: Use,
+    ) -> Result<Option<Value>, ImportError> {
+        match p.get(name) {
+            Some(e) => self.texture(e, role),
+            None => Ok(None),
+        }
     }
 
     /// A reflectance parameter, or the default.
