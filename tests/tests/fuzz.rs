@@ -431,7 +431,12 @@ fn fuzz_mitsuba_files() {
         .unwrap()
         .replace("value=\"96\"", "value=\"24\"")
         .replace("value=\"72\"", "value=\"16\"");
-    let seeds = [many.to_owned(), own, textured];
+    std::fs::copy(workspace().join("scenes/mitsuba/sky.exr"), dir.join("sky.exr")).unwrap();
+    let envmap = std::fs::read_to_string(workspace().join("scenes/mitsuba/envmap.xml"))
+        .unwrap()
+        .replace("value=\"96\"", "value=\"24\"")
+        .replace("value=\"72\"", "value=\"16\"");
+    let seeds = [many.to_owned(), own, textured, envmap];
     let extremes = [
         "nan",
         "-1",

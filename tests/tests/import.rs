@@ -262,7 +262,7 @@ fn unsupported_elements_are_refused_with_file_and_line() {
             ":5:",
             "non-uniform",
         ),
-        (with_sensor(r#"<emitter type="envmap"/>"#), ":5:", "envmap"),
+        (with_sensor(r#"<emitter type="sunsky"/>"#), ":5:", "sunsky"),
         (
             with_sensor(
                 r#"<emitter type="directional"><spectrum name="irradiance" value="1"/></emitter>"#,

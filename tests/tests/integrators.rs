@@ -166,7 +166,7 @@ pub(crate) struct Cell {
 }
 
 /// A cell that sees every pixel.
-const fn all(effort: u64) -> Cell {
+pub(crate) const fn all(effort: u64) -> Cell {
     Cell { effort, sight: Sight::All }
 }
 
@@ -201,7 +201,7 @@ pub(crate) struct Row {
 
 /// What [`check_row`] rendered: per estimator, one image per seed; and the pixels that see no
 /// glass (`clear`, every pixel in a row without glass) and those that see only glass.
-struct Renders {
+pub(crate) struct Renders {
     images: [Vec<Vec<Xyz>>; 3],
     clear: Vec<bool>,
     covered: Vec<bool>,
@@ -300,7 +300,7 @@ fn assert_agree_on(
 
 /// Renders every cell of `row` and makes every check of the module's table; returns the renders
 /// for the row's own further checks.
-fn check_row(row: &Row) -> Renders {
+pub(crate) fn check_row(row: &Row) -> Renders {
     let (name, s) = (row.name, &row.scene);
     let (w, h) = (s.camera.width() as usize, s.camera.height() as usize);
     // The renderer's own pick sees the whole image.

@@ -202,6 +202,10 @@ impl LightSource for LightSet {
     fn take_lights(&mut self) -> Option<Vec<Box<dyn LightSource>>> {
         Some(std::mem::take(&mut self.lights))
     }
+    fn origin_weight(&self, beam: &Beam) -> f64 {
+        // The beam's own light knows how it weighed it.
+        self.lights.get(beam.parent.0 as usize).map_or(beam.scale, |l| l.origin_weight(beam))
+    }
     fn emission_density(&self, _origin: DVec3, _direction: DVec3) -> f64 {
         // A set's beams come from different lights: ask the beam's own light (its `parent`).
         0.0

@@ -136,6 +136,31 @@ pub trait LightSource: Send + Sync + Debug {
         0.0
     }
 
+    /// How the spectrum leaving `position` along the unit `direction` departs from
+    /// [`spd`](Self::spd) at `lambda` (nm): the spectral radiance (or intensity) there is the
+    /// whole-spectrum value ([`emitted_radiance`](Self::emitted_radiance),
+    /// [`LightSample::intensity`]) times `spd().value(lambda)` times this factor. 1 (the default)
+    /// for every light with [`uniform_spectrum`](Self::uniform_spectrum); a light whose colour
+    /// varies with direction or over its surface returns its ratio (its mean over wavelengths
+    /// drawn from `spd` is 1).
+    fn spectral_factor(&self, position: DVec3, direction: DVec3, lambda: f64) -> f64 {
+        let _ = (position, direction, lambda);
+        1.0
+    }
+
+    /// The part of `beam.scale` that weighs the beam's origin alone, for connections from the
+    /// origin in other directions than the beam's own (a light tracer's or BDPT's connection to
+    /// the camera, which multiply it by [`emission_density`](Self::emission_density) and
+    /// [`spectral_factor`](Self::spectral_factor)). The default is the whole `scale`, right for
+    /// every light whose beams' weights do not depend on the direction drawn. A light that draws
+    /// directions from a density not proportional to its radiance (an environment map) weighs
+    /// the direction in `scale` and returns the origin's weight here; its `emission_density` then
+    /// gives the radiant intensity per unit of that weight. A value of 1 also says that the
+    /// beam's wavelength was drawn from `spd`.
+    fn origin_weight(&self, beam: &Beam) -> f64 {
+        beam.scale
+    }
+
     /// Radiance (W m^-2 sr^-1, whole spectrum: multiply by `spd().value(lambda)` for the
     /// spectral radiance) leaving the point `position` of the light's surface towards the unit
     /// `direction`: what a camera ray that hits an area light sees. 0 (the default) for lights
@@ -153,8 +178,9 @@ pub trait LightSource: Send + Sync + Debug {
     /// which the caller counts as no contribution. Uniforms outside `[0, 1)` or NaN are clamped.
     ///
     /// With it, `emitted_radiance * |cos(normal, direction)| / (pdf_position * pdf_direction)`
-    /// is `power()` for every sample of an area light (each ray carries the whole power, as a
-    /// beam does); for delta lights the deltas stand as densities of 1 (see
+    /// is `power()` for every sample of an area light whose beams all weigh the same (each ray
+    /// carries the whole power, as a beam does), and `power()` on average for one that weighs
+    /// its beams' directions ([`origin_weight`](Self::origin_weight)); for delta lights the deltas stand as densities of 1 (see
     /// [`flags`](Self::flags)).
     fn sample_emission(&self, u: [f64; 4]) -> Option<EmissionSample> {
         let _ = u;
@@ -226,6 +252,14 @@ pub enum LightSurface {
         center: DVec3,
         /// Unit normal of the front.
         normal: DVec3,
+        /// Radius (m).
+        radius: f64,
+    },
+    /// A sphere emitting from its inside (an environment around the scene); its front faces
+    /// the centre.
+    Sphere {
+        /// Centre.
+        center: DVec3,
         /// Radius (m).
         radius: f64,
     },

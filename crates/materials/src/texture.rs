@@ -281,6 +281,21 @@ fn wrapped(i: i64, n: usize, wrap: Wrap) -> usize {
 }
 
 impl Bitmap {
+    /// The image's width and height in texels.
+    pub fn size(&self) -> (usize, usize) {
+        (self.pixels.width, self.pixels.height)
+    }
+
+    /// The linear colour of texel `(x, y)` (row 0 at the top), or black outside the image.
+    pub fn texel(&self, x: usize, y: usize) -> [f64; 3] {
+        let px = &self.pixels;
+        if x < px.width && y < px.height {
+            px.data[y * px.width + x].map(f64::from)
+        } else {
+            [0.0; 3]
+        }
+    }
+
     /// The linear colour at `uv`.
     pub fn rgb(&self, uv: DVec2) -> [f64; 3] {
         let p = apply(&self.to_uv, uv);

@@ -52,10 +52,10 @@ pub fn convert(
     Ok(imported.notes.iter().map(ToString::to_string).collect())
 }
 
-/// Rewrites every mesh path (`obj`, `ply`, `serialized`) and texture file relative to `dir` and
+/// Rewrites every mesh path (`obj`, `ply`, `serialized`), texture and environment file relative
+/// to `dir` and
 /// collects them in `inputs`.
 fn relativise_meshes(scene: &mut Value, dir: &Path, inputs: &mut Vec<PathBuf>) {
-    let Some(objects) = scene.get_mut("objects").and_then(Value::as_array_mut) else { return };
     let mut rebase = |p: &mut String| {
         let path = PathBuf::from(&*p);
         inputs.push(path.clone());
@@ -63,6 +63,10 @@ fn relativise_meshes(scene: &mut Value, dir: &Path, inputs: &mut Vec<PathBuf>) {
             *p = rel.to_string_lossy().into_owned();
         }
     };
+    if let Some(Value::String(p)) = scene.get_mut("environment").and_then(|e| e.get_mut("file")) {
+        rebase(p);
+    }
+    let Some(objects) = scene.get_mut("objects").and_then(Value::as_array_mut) else { return };
     for object in objects {
         for key in ["obj", "ply", "serialized"] {
             if let Some(Value::String(p)) = object.get_mut("shape").and_then(|s| s.get_mut(key)) {

@@ -40,6 +40,7 @@
 mod batch;
 mod camera;
 mod effects;
+mod environment;
 mod film;
 mod integrators;
 mod light_sampler;
@@ -56,6 +57,7 @@ pub use batch::{Kernel, LANES};
 pub use camera::{
     CameraError, CameraRay, CameraRepr, CameraSample, FovAxis, PinholeCamera, Projection,
 };
+pub use environment::{Environment, EnvironmentMap, EnvironmentSpec, MAX_ENVIRONMENT_TEXELS};
 pub use light_sampler::{LightSampler, PowerLightSampler, SampledLight};
 pub use object_light::{ObjectEmission, ObjectLight};
 pub use scene::{Emitter, LightTracerScene};

@@ -32,6 +32,8 @@ pub struct LightTracerScene<'a> {
     /// The spectrum of each light of the set, cached (bundled wavelengths are drawn from the
     /// spectrum of the beam's own light).
     spds: Vec<Arc<dyn SpectralPowerDistribution>>,
+    /// Whether each light's colour varies over its beams ([`LightSource::spectral_factor`]).
+    varying: Vec<bool>,
     /// What each shape emits, indexed like `materials` (empty: nothing emits).
     emitters: Vec<Option<Emitter>>,
     /// Some shape emits (so a ray may find light by hitting a surface).
@@ -103,6 +105,7 @@ impl<'a> LightTracerScene<'a> {
         camera: &'a PinholeCamera,
     ) -> Self {
         let spds = lights.lights().iter().map(|l| l.spd()).collect();
+        let varying = lights.lights().iter().map(|l| !l.uniform_spectrum()).collect();
         let area_lights = PowerLightSampler::new(lights, |l| {
             l.flags().is_some_and(|f| !f.delta_position && !f.delta_direction)
         });
@@ -131,6 +134,7 @@ impl<'a> LightTracerScene<'a> {
             lights,
             camera,
             spds,
+            varying,
             emitters: Vec::new(),
             surfaces_emit: false,
             light_shapes: Vec::new(),
@@ -252,6 +256,35 @@ impl<'a> LightTracerScene<'a> {
     #[inline]
     pub fn emitter(&self, primitive: u32) -> Option<&Emitter> {
         self.emitters.get(primitive as usize).and_then(Option::as_ref)
+    }
+
+    /// Whether light `id`'s colour varies over its beams, so that its spectral values need
+    /// [`Self::light_spectrum`] rather than its SPD alone.
+    #[inline]
+    pub fn spectrum_varies(&self, id: LightId) -> bool {
+        self.varying.get(id.0 as usize).copied().unwrap_or(false)
+    }
+
+    /// Light `id`'s spectrum at `lambda` for light leaving `position` along `direction`: its
+    /// SPD times its [`LightSource::spectral_factor`] (the SPD alone for a light whose colour
+    /// does not vary); 0 for an unknown light.
+    #[inline]
+    pub fn light_spectrum(
+        &self,
+        id: LightId,
+        position: DVec3,
+        direction: DVec3,
+        lambda: f64,
+    ) -> f64 {
+        let Some(spd) = self.spds.get(id.0 as usize) else { return 0.0 };
+        let v = spd.value(lambda);
+        if self.spectrum_varies(id) && v > 0.0 {
+            self.lights
+                .light(id)
+                .map_or(0.0, |l| v * l.spectral_factor(position, direction, lambda))
+        } else {
+            v
+        }
     }
 
     /// The spectrum of light `id` of the set.

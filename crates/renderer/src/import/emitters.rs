@@ -7,7 +7,8 @@
 //! of radiance `L` becomes a black sphere around the objects and the camera (1.5 times their
 //! bounding sphere) glowing on both sides with radiance `L`: every point inside receives `L` from
 //! every direction, exactly a constant environment (the outward half of its power is wasted by
-//! the light tracer).
+//! the light tracer). `envmap` becomes the scene's `environment` (the same texels, read as
+//! Mitsuba 3's spectral variants read them; `scale` kept, `to_world`'s rotation as `rotation`).
 
 use std::f64::consts::PI;
 
@@ -19,6 +20,7 @@ use super::params::Params;
 use super::spectra::{Role, spectrum};
 use super::values::{transform, vector};
 use super::xml::{Element, ImportError, error_at};
+use serde_json::Value;
 
 impl Importer {
     /// Adds a top-level `<emitter>` (an `area` one with an id is only a definition).
@@ -107,11 +109,20 @@ impl Importer {
                 }
                 return Ok(());
             }
-            "envmap" | "sunsky" | "projector" => {
+            "envmap" => {
+                let environment = self.envmap(el, &p, m)?;
+                p.finish()?;
+                if self.environment.is_some() {
+                    return Err(error_at(&el.loc, "a scene may have one envmap emitter"));
+                }
+                self.environment = Some((el.loc.clone(), environment));
+                return Ok(());
+            }
+            "sunsky" | "projector" => {
                 return Err(error_at(
                     &el.loc,
                     format!(
-                        "emitter type \"{}\" is not supported yet (area, point and spot are; docs/import.md)",
+                        "emitter type \"{}\" is not supported (area, point, spot, directional, constant and envmap are; docs/import.md)",
                         el.kind()
                     ),
                 ));
@@ -133,9 +144,49 @@ impl Importer {
 }
 
 impl Importer {
+    /// An `envmap`: its file (resolved like a mesh's), `scale`, and the rotation of `to_world`
+    /// (a translation is irrelevant to directions; anything else is refused).
+    fn envmap(&mut self, el: &Element, p: &Params<'_>, m: DMat4) -> Result<Value, ImportError> {
+        let name = p
+            .string("filename")?
+            .ok_or_else(|| error_at(&el.loc, "needs <string name=\"filename\">"))?;
+        let file = self.file_path(el, name)?;
+        let scale = p.float("scale", 1.0)?;
+        if !(scale > 0.0 && scale.is_finite()) {
+            return Err(error_at(&el.loc, format!("scale {scale}: must be finite and > 0")));
+        }
+        if p.boolean("mis_compensation", false)? {
+            self.note(el, "mis_compensation changes only Mitsuba's noise: not used");
+        }
+        let r = glam::DMat3::from_mat4(m);
+        let rotation = (r.transpose() * r - glam::DMat3::IDENTITY)
+            .to_cols_array()
+            .iter()
+            .all(|v| v.abs() <= 1e-6)
+            && r.determinant() > 0.0;
+        if !rotation {
+            return Err(error_at(
+                &el.loc,
+                "an envmap's to_world must be a rotation (with any translation): no scale or mirror",
+            ));
+        }
+        let rows = r.transpose().to_cols_array_2d();
+        let mut env = json!({"file": file, "scale": scale});
+        if r != glam::DMat3::IDENTITY {
+            env["rotation"] = json!(rows);
+        }
+        Ok(env)
+    }
+
     /// The lights placed around the scene once every object is known: the `Sky` of each
     /// directional emitter, and for a constant environment a glowing sphere around everything.
     pub(super) fn place_around(&mut self, camera: glam::DVec3) -> Result<(), ImportError> {
+        if let (Some((loc, _)), Some(_)) = (&self.environment, self.constant.first()) {
+            return Err(error_at(
+                loc,
+                "an envmap and a constant emitter in one scene are not supported (add the constant to the map)",
+            ));
+        }
         let Some(loc) = self
             .directional
             .first()

@@ -162,6 +162,8 @@ struct Importer {
     directional: Vec<(xml::Loc, DVec3, f64, Value)>,
     /// Constant environments (place, radiance, spectrum), placed around the objects.
     constant: Vec<(xml::Loc, f64, Value)>,
+    /// The `envmap` emitter (place, the native scene's `environment`).
+    environment: Option<(xml::Loc, Value)>,
 }
 
 impl Importer {
@@ -206,6 +208,9 @@ impl Importer {
             "settings": Value::Object(std::mem::take(&mut self.settings)),
             "output": {"name": name},
         });
+        if let Some((_, environment)) = self.environment.take() {
+            scene["environment"] = environment;
+        }
         if scene["settings"].get("integrator").is_none() {
             scene["settings"]["integrator"] = json!("path");
         }

@@ -4,14 +4,15 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use spectrace_geometry::{Disk, Rectangle};
+use glam::DVec3;
+use spectrace_geometry::{Bounds, Disk, Rectangle, Sphere};
 use spectrace_geometry::{Shape, Transform};
 use spectrace_lights::{LightId, LightSurface};
 use spectrace_lights::{LightSet, LightSource};
 use spectrace_materials::Diffuse;
 use spectrace_materials::Material;
 use spectrace_spectrum::Reflectance;
-use spectrace_tracer::{Emitter, ObjectLight};
+use spectrace_tracer::{Emitter, Environment, EnvironmentMap, ObjectLight};
 use spectrace_tracer::{IrradianceSensor, SensorSet};
 
 use super::{LoadOptions, Object, SceneError, scene_error};
@@ -99,6 +100,26 @@ impl<'a> Assembly<'a> {
         Ok(light)
     }
 
+    /// The scene's environment placed on a sphere around the objects and the camera (1.5 times
+    /// the radius of their bounding sphere: no receiver lies on the sphere itself, and its
+    /// choice does not change the image).
+    pub(super) fn environment(
+        &mut self,
+        map: EnvironmentMap,
+        camera: DVec3,
+    ) -> Result<Box<dyn LightSource>, SceneError> {
+        let bounds = self
+            .shapes
+            .iter()
+            .map(Shape::bounds)
+            .fold(Bounds::from_points([camera]), Bounds::union);
+        let center = bounds.center();
+        let radius = ((bounds.max - bounds.min).length() / 2.0).max(1e-3) * 1.5;
+        let light = Environment::new(map, center, radius)
+            .map_err(|e| self.error("environment", e.to_string()))?;
+        Ok(Box::new(light))
+    }
+
     /// The light set: the file's lights, then the glowing objects' (`(object index, light)`),
     /// which become those objects' emitters; then the area lights' surfaces as shapes.
     pub(super) fn add_lights(
@@ -147,6 +168,9 @@ impl<'a> Assembly<'a> {
                 }
                 LightSurface::Disk { center, normal, radius } => {
                     Disk::new(center, normal, radius).map(Shape::from)
+                }
+                LightSurface::Sphere { center, radius } => {
+                    Sphere::new(center, radius).map(Shape::from)
                 }
                 _ => continue,
             }

@@ -221,7 +221,11 @@ impl Scene {
             }
         }
         let object_shapes = parts.shapes.len();
-        let lights = parts.add_lights(file.lights, object_lights)?;
+        let mut file_lights = file.lights;
+        if let Some(map) = file.environment {
+            file_lights.push(parts.environment(map, file.camera.position())?);
+        }
+        let lights = parts.add_lights(file_lights, object_lights)?;
         let sensors = sensor_set(file.sensors, path)?;
         let world = World::with_base_dir(parts.shapes, base)
             .map_err(|e| scene_error(path, "objects", e.to_string()))?;

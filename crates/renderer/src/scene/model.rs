@@ -10,8 +10,8 @@ use spectrace_lights::LightSource;
 use spectrace_materials::Material;
 use spectrace_tracer::IrradianceSensor;
 use spectrace_tracer::{
-    BdptWavelengths, CameraWavelengths, DEFAULT_CHUNK_BEAMS, EffectsMode, ErrorMeasure,
-    IntegratorChoice, Kernel, MAX_DEPTH, ObjectEmission, PinholeCamera, SamplerKind,
+    BdptWavelengths, CameraWavelengths, DEFAULT_CHUNK_BEAMS, EffectsMode, EnvironmentMap,
+    ErrorMeasure, IntegratorChoice, Kernel, MAX_DEPTH, ObjectEmission, PinholeCamera, SamplerKind,
 };
 
 use super::{SceneError, scene_error};
@@ -29,6 +29,10 @@ pub struct SceneFile {
     /// (or left out) when objects glow.
     #[serde(default)]
     pub lights: Vec<Box<dyn LightSource>>,
+    /// Light from every direction at infinite distance, read from a latitude-longitude image
+    /// (`spectrace_tracer::Environment`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub environment: Option<EnvironmentMap>,
     /// How much to render and how.
     #[serde(default)]
     pub settings: Settings,

@@ -234,6 +234,33 @@ impl BeamTracer<'_, '_> {
         b
     }
 
+    /// The bundle's values at the beam's origin seen along `to_camera` (`value` the light's
+    /// emission density times the camera's importance): the beam's own wavelength weighs the
+    /// origin alone ([`LightSource::origin_weight`]), and a light whose colour varies gives its
+    /// spectrum that way.
+    fn origin_values(
+        &self,
+        beam: &Beam,
+        b: &Bundle,
+        to_camera: glam::DVec3,
+        value: f64,
+    ) -> [f64; MAX_BUNDLE] {
+        let scene = self.scene;
+        let mut weights = b.weights;
+        weights[0] = LightSource::origin_weight(scene.lights, beam) / b.len as f64;
+        let varying = scene.spectrum_varies(beam.parent);
+        let own = scene.lights.light(beam.parent);
+        std::array::from_fn(|j| {
+            let factor = match own {
+                Some(l) if varying && j < b.len => {
+                    l.spectral_factor(beam.origin, to_camera, b.lambdas[j])
+                }
+                _ => 1.0,
+            };
+            weights[j] * value * factor
+        })
+    }
+
     /// Traces one beam: its emission point seen by the camera, then every non-specular hit.
     fn trace_beam<S: Splat + ?Sized>(
         &self,
@@ -250,7 +277,7 @@ impl BeamTracer<'_, '_> {
             && let Some((seen, value)) =
                 connect_light_to_camera(scene, beam.parent, beam.origin, u_lens)
         {
-            let values = b.weights.map(|w| w * value);
+            let values = self.origin_values(&beam, &b, seen.to_camera, value);
             if film.splat_spectral(seen.x, seen.y, &b.lambdas[..b.len], &values[..b.len]) {
                 stats.splats += 1;
             }

@@ -150,6 +150,8 @@ pub(crate) struct LightChoice {
 pub(crate) struct Connection {
     /// The light.
     pub id: LightId,
+    /// The point of the light and the unit direction from it to the vertex.
+    pub from: (DVec3, DVec3),
     /// The direction from the vertex to the light.
     pub wi: DVec3,
     /// Intensity, cosine, inverse square and MIS weight over the light's probability.
@@ -215,14 +217,23 @@ impl PathState {
         }
     }
 
-    /// Light `light`'s SPD at the path's transport wavelengths (cached while the light and the
-    /// wavelengths stay the same); `None` for a light without one.
+    /// Light `light`'s spectrum at the path's transport wavelengths for light leaving
+    /// `position` along `direction` (cached while the light and the wavelengths stay the same,
+    /// for a light whose colour does not vary); `None` for a light without one.
     #[inline]
     fn light_values(
         &mut self,
         scene: &LightTracerScene<'_>,
         light: LightId,
+        position: DVec3,
+        direction: DVec3,
     ) -> Option<[f64; HERO]> {
+        if scene.spectrum_varies(light) {
+            scene.light_spd(light)?;
+            return Some(
+                self.transport.map(|l| scene.light_spectrum(light, position, direction, l)),
+            );
+        }
         if let Some((id, at, values)) = self.spd_cache
             && id == light
             && at == self.transport
@@ -235,11 +246,19 @@ impl PathState {
         Some(values)
     }
 
-    /// Adds `le` (whole spectrum, times light `light`'s SPD) weighted by `weight`.
+    /// Adds `le` (whole spectrum, times light `light`'s spectrum leaving `position` along
+    /// `direction`) weighted by `weight`.
     #[inline]
-    fn add_emission(&mut self, scene: &LightTracerScene<'_>, light: LightId, le: f64, weight: f64) {
+    fn add_emission(
+        &mut self,
+        scene: &LightTracerScene<'_>,
+        light: LightId,
+        (position, direction): (DVec3, DVec3),
+        le: f64,
+        weight: f64,
+    ) {
         if weight > 0.0 {
-            let Some(spd) = self.light_values(scene, light) else { return };
+            let Some(spd) = self.light_values(scene, light, position, direction) else { return };
             for ((r, &b), s) in self.radiance.iter_mut().zip(&self.beta).zip(spd) {
                 if b != 0.0 {
                     *r += b * le * s * weight;
@@ -389,7 +408,7 @@ impl<'a> PathTracer<'a> {
             } else {
                 power_heuristic(p.prev_pdf, scene.emitter_pdf(p.prev_point, hit))
             };
-            p.add_emission(scene, light, le, weight);
+            p.add_emission(scene, light, (hit.point, -p.ray.direction), le, weight);
         }
         if p.last_bounce {
             return None;
@@ -456,7 +475,7 @@ impl<'a> PathTracer<'a> {
         }
         let g = sample.intensity * cos / (sample.distance * sample.distance * pmf) * weight;
         let shadow = ShadowRay::between(End::Surface(hit), End::Light(id, sample.position));
-        Some(Connection { id, wi, g, shadow })
+        Some(Connection { id, from: (sample.position, sample.direction), wi, g, shadow })
     }
 
     /// Adds an unoccluded connection's light to the path's radiance.
@@ -469,7 +488,7 @@ impl<'a> PathTracer<'a> {
         stats: &mut TraceStats,
     ) {
         stats.splats += 1;
-        let Some(spd) = p.light_values(self.scene, c.id) else { return };
+        let Some(spd) = p.light_values(self.scene, c.id, c.from.0, c.from.1) else { return };
         let mut f = [0.0; HERO];
         let n = at.hit.shading_normal;
         at.material.eval_bundle(c.wi, at.wo, n, &p.transport, Transport::Radiance, &mut f);

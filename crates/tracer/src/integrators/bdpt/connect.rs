@@ -102,12 +102,16 @@ impl Bdpt<'_> {
         let VertexKind::Surface(hit) = pt.kind else { return None };
         let wo = (st.camera[st.t - 2].point - pt.point).normalize();
         let (id, le) = self.scene.emitted(&hit, wo)?;
-        let spd = self.scene.light_spd(id)?;
+        self.scene.light_spd(id)?;
         let end = self.light_end(id, wl)?;
         // One wavelength: the density it was drawn with divides; hero wavelengths: their film
         // weights do.
         let emitted: Lanes = std::array::from_fn(|j| {
-            if j < wl.n { le * spd.value(wl.lambdas[j]) / wl.density } else { 0.0 }
+            if j < wl.n {
+                le * self.scene.light_spectrum(id, hit.point, wo, wl.lambdas[j]) / wl.density
+            } else {
+                0.0
+            }
         });
         Some(Joined::at_pixel(times(pt.beta, emitted), wl, end))
     }
@@ -127,7 +131,19 @@ impl Bdpt<'_> {
                     return None;
                 }
                 let (seen, density) = connect_light_to_camera(self.scene, id, qs.point, qs.u)?;
-                ((seen.x, seen.y), seen.lens, scaled(qs.beta, density), wl.lambda())
+                // A light whose colour varies: its spectrum towards the camera, relative to its
+                // SPD (the beam's wavelengths were drawn from the SPD).
+                let value: Lanes = std::array::from_fn(|j| {
+                    let factor = if self.scene.spectrum_varies(id) && j < wl.n {
+                        self.scene.lights.light(id).map_or(0.0, |l| {
+                            l.spectral_factor(qs.point, seen.to_camera, wl.lambdas[j])
+                        })
+                    } else {
+                        1.0
+                    };
+                    qs.beta[j] * density * factor
+                });
+                ((seen.x, seen.y), seen.lens, value, wl.lambda())
             }
             VertexKind::Surface(hit) => {
                 let material = self.lobe(qs, &hit)?;
@@ -180,9 +196,16 @@ impl Bdpt<'_> {
         let geometry = cos * sample.intensity / (sample.distance * sample.distance * pmf);
         // One wavelength: the light was chosen given it, and its spectrum cancels the density
         // the wavelength was drawn with. Hero wavelengths: chosen by power, times its spectrum.
+        let (from, towards) = (sample.position, sample.direction);
         let spectrum = if wl.is_hero() {
-            let spd = scene.light_spd(chosen.id)?;
-            wl.lambdas.map(|l| spd.value(l))
+            scene.light_spd(chosen.id)?;
+            wl.lambdas.map(|l| scene.light_spectrum(chosen.id, from, towards, l))
+        } else if scene.spectrum_varies(chosen.id) {
+            // Its spectrum that way relative to its SPD, which the choice cancelled.
+            let light = scene.lights.light(chosen.id)?;
+            let mut m = [1.0; crate::HERO];
+            m[0] = light.spectral_factor(from, towards, wl.lambda());
+            m
         } else {
             [1.0; crate::HERO]
         };

@@ -279,8 +279,9 @@ impl<'a> Bdpt<'a> {
     /// Whether a sample with `beam` at `wl` may use camera strategies: always with hero
     /// wavelengths; with one, a beam of weight 1 at a wavelength the lights' spectrum has a
     /// density for (see the module docs).
-    fn camera_strategies(beam: &spectrace_lights::Beam, wl: &Wavelengths) -> bool {
-        wl.is_hero() || (beam.scale == 1.0 && wl.density > 0.0 && wl.density.is_finite())
+    fn camera_strategies(&self, beam: &spectrace_lights::Beam, wl: &Wavelengths) -> bool {
+        let weight = LightSource::origin_weight(self.scene.lights, beam);
+        wl.is_hero() || (weight == 1.0 && wl.density > 0.0 && wl.density.is_finite())
     }
 
     /// The sample's wavelengths: [`HERO`] of them from the camera's density, drawn with
@@ -320,7 +321,7 @@ impl<'a> Bdpt<'a> {
         let camera_u = CameraSamples::draw(&self.camera_layout, rng);
         let beam = LightSource::next_beam(scene.lights, rng);
         let wl = self.wavelengths(beam.lambda, self.hero.then_some(camera_u.wavelength));
-        let camera_strategies = Self::camera_strategies(&beam, &wl);
+        let camera_strategies = self.camera_strategies(&beam, &wl);
         let Some(light) = self.light_end(beam.parent, &wl) else { return };
         self.light_subpath(&beam, &light, &wl, rng, buffers, stats);
         if camera_strategies {

@@ -81,16 +81,30 @@ impl Bdpt<'_> {
         buffers: &mut Buffers,
         stats: &mut TraceStats,
     ) {
-        let camera_strategies = Self::camera_strategies(beam, wl);
+        let camera_strategies = self.camera_strategies(beam, wl);
         let scene = self.scene;
         buffers.light.clear();
         let u = VertexSamples::draw(&self.light_layout, rng);
         let Some(source) = scene.lights.light(light.id) else { return };
         let (pdf_pos, pdf_dir) = self.light_pdfs(light.id, beam.origin, beam.direction);
-        let Some(beta) = self.light_start_beta(beam, source, light, wl) else { return };
+        let Some(beta) = self.light_start_beta(beam, beam.scale, source, light, wl) else {
+            return;
+        };
+        // The light vertex weighs its origin alone: connections from it take other directions
+        // than the beam's (see `LightSource::origin_weight`).
+        let weight = source.origin_weight(beam);
+        let Some(at_origin) = self.light_start_beta(beam, weight, source, light, wl) else {
+            return;
+        };
         let ng = light_normal(source, beam.origin);
-        let mut start =
-            Vertex::at(VertexKind::Light(light.id), beam.origin, ng, beta, wl.lambda(), u.lens);
+        let mut start = Vertex::at(
+            VertexKind::Light(light.id),
+            beam.origin,
+            ng,
+            at_origin,
+            wl.lambda(),
+            u.lens,
+        );
         start.delta = light.first_vertex_delta();
         start.pdf_fwd = if camera_strategies { light.pmf * pdf_pos } else { 1.0 };
         buffers.light.push(start);
@@ -115,13 +129,14 @@ impl Bdpt<'_> {
     fn light_start_beta(
         &self,
         beam: &Beam,
+        scale: f64,
         source: &dyn LightSource,
         light: &LightEnd,
         wl: &Wavelengths,
     ) -> Option<Lanes> {
         if !wl.is_hero() {
             let mut beta = [0.0; HERO];
-            beta[0] = self.scene.lights.power() * beam.scale;
+            beta[0] = self.scene.lights.power() * scale;
             return Some(beta);
         }
         // The light set chose the beam's light by power.
@@ -129,9 +144,9 @@ impl Bdpt<'_> {
         if !(pmf > 0.0) {
             return None;
         }
-        let spd = source.spd();
         let power = source.power() / pmf;
-        Some(wl.lambdas.map(|l| power * spd.value(l)))
+        let (id, origin, direction) = (light.id, beam.origin, beam.direction);
+        Some(wl.lambdas.map(|l| power * self.scene.light_spectrum(id, origin, direction, l)))
     }
 
     /// Follows `start.ray` (whose first hit is `start.first`) through the scene, appending a
