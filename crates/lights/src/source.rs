@@ -148,6 +148,22 @@ pub trait LightSource: Send + Sync + Debug {
         1.0
     }
 
+    /// [`spectral_factor`](Self::spectral_factor) at each of `lambdas`, into `out` (as many
+    /// as the shorter of the two). The default asks one wavelength at a time; a light whose
+    /// factor shares work between wavelengths (finding where a direction falls in a map)
+    /// overrides it.
+    fn spectral_factors(
+        &self,
+        position: DVec3,
+        direction: DVec3,
+        lambdas: &[f64],
+        out: &mut [f64],
+    ) {
+        for (o, &l) in out.iter_mut().zip(lambdas) {
+            *o = self.spectral_factor(position, direction, l);
+        }
+    }
+
     /// The part of `beam.scale` that weighs the beam's origin alone, for connections from the
     /// origin in other directions than the beam's own (a light tracer's or BDPT's connection to
     /// the camera, which multiply it by [`emission_density`](Self::emission_density) and

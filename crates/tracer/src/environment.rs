@@ -531,14 +531,28 @@ impl LightSource for Environment {
         false
     }
 
-    fn spectral_factor(&self, _position: DVec3, direction: DVec3, lambda: f64) -> f64 {
-        let omega = -direction;
-        let c = self.corners(omega);
+    fn spectral_factor(&self, position: DVec3, direction: DVec3, lambda: f64) -> f64 {
+        let mut m = [0.0];
+        self.spectral_factors(position, direction, &[lambda], &mut m);
+        m[0]
+    }
+
+    fn spectral_factors(
+        &self,
+        _position: DVec3,
+        direction: DVec3,
+        lambdas: &[f64],
+        out: &mut [f64],
+    ) {
+        // One lookup of the map for every wavelength.
+        let c = self.corners(-direction);
         let integral: f64 = c.iter().map(|&(i, w)| w * self.nodes[i].integral).sum();
-        let rho: f64 = c.iter().map(|&(i, w)| w * self.nodes[i].rho.value(lambda)).sum();
-        let spd = self.spd.value(lambda);
-        let m = rho * d65_visible(lambda) / d65_luminance() / (integral * spd);
-        if m.is_finite() { m } else { 0.0 }
+        let norm = 1.0 / (d65_luminance() * integral);
+        for (o, &lambda) in out.iter_mut().zip(lambdas) {
+            let rho: f64 = c.iter().map(|&(i, w)| w * self.nodes[i].rho.value(lambda)).sum();
+            let m = rho * d65_visible(lambda) * norm / self.spd.value(lambda);
+            *o = if m.is_finite() { m } else { 0.0 };
+        }
     }
 
     fn origin_weight(&self, _beam: &Beam) -> f64 {

@@ -259,32 +259,36 @@ impl<'a> LightTracerScene<'a> {
     }
 
     /// Whether light `id`'s colour varies over its beams, so that its spectral values need
-    /// [`Self::light_spectrum`] rather than its SPD alone.
+    /// [`Self::light_spectra`] rather than its SPD alone.
     #[inline]
     pub fn spectrum_varies(&self, id: LightId) -> bool {
         self.varying.get(id.0 as usize).copied().unwrap_or(false)
     }
 
-    /// Light `id`'s spectrum at `lambda` for light leaving `position` along `direction`: its
-    /// SPD times its [`LightSource::spectral_factor`] (the SPD alone for a light whose colour
-    /// does not vary); 0 for an unknown light.
+    /// Light `id`'s spectrum at each of the [`crate::HERO`] wavelengths `lambdas` for light
+    /// leaving `position` along `direction`: its SPD times its
+    /// [`LightSource::spectral_factors`] (the SPD alone for a light whose colour does not vary;
+    /// one lookup of a varying light's colour for all the wavelengths); 0 for an unknown light.
     #[inline]
-    pub fn light_spectrum(
+    pub fn light_spectra(
         &self,
         id: LightId,
         position: DVec3,
         direction: DVec3,
-        lambda: f64,
-    ) -> f64 {
-        let Some(spd) = self.spds.get(id.0 as usize) else { return 0.0 };
-        let v = spd.value(lambda);
-        if self.spectrum_varies(id) && v > 0.0 {
-            self.lights
-                .light(id)
-                .map_or(0.0, |l| v * l.spectral_factor(position, direction, lambda))
-        } else {
-            v
+        lambdas: &[f64; crate::HERO],
+    ) -> [f64; crate::HERO] {
+        let Some(spd) = self.spds.get(id.0 as usize) else { return [0.0; crate::HERO] };
+        let mut values = lambdas.map(|l| spd.value(l));
+        if self.spectrum_varies(id) {
+            let mut factors = [0.0; crate::HERO];
+            if let Some(l) = self.lights.light(id) {
+                l.spectral_factors(position, direction, lambdas, &mut factors);
+            }
+            for (v, f) in values.iter_mut().zip(factors) {
+                *v *= f;
+            }
         }
+        values
     }
 
     /// The spectrum of light `id` of the set.

@@ -230,9 +230,7 @@ impl PathState {
     ) -> Option<[f64; HERO]> {
         if scene.spectrum_varies(light) {
             scene.light_spd(light)?;
-            return Some(
-                self.transport.map(|l| scene.light_spectrum(light, position, direction, l)),
-            );
+            return Some(scene.light_spectra(light, position, direction, &self.transport));
         }
         if let Some((id, at, values)) = self.spd_cache
             && id == light

@@ -106,13 +106,9 @@ impl Bdpt<'_> {
         let end = self.light_end(id, wl)?;
         // One wavelength: the density it was drawn with divides; hero wavelengths: their film
         // weights do.
-        let emitted: Lanes = std::array::from_fn(|j| {
-            if j < wl.n {
-                le * self.scene.light_spectrum(id, hit.point, wo, wl.lambdas[j]) / wl.density
-            } else {
-                0.0
-            }
-        });
+        let spectrum = self.scene.light_spectra(id, hit.point, wo, &wl.lambdas);
+        let emitted: Lanes =
+            std::array::from_fn(|j| if j < wl.n { le * spectrum[j] / wl.density } else { 0.0 });
         Some(Joined::at_pixel(times(pt.beta, emitted), wl, end))
     }
 
@@ -199,7 +195,7 @@ impl Bdpt<'_> {
         let (from, towards) = (sample.position, sample.direction);
         let spectrum = if wl.is_hero() {
             scene.light_spd(chosen.id)?;
-            wl.lambdas.map(|l| scene.light_spectrum(chosen.id, from, towards, l))
+            scene.light_spectra(chosen.id, from, towards, &wl.lambdas)
         } else if scene.spectrum_varies(chosen.id) {
             // Its spectrum that way relative to its SPD, which the choice cancelled.
             let light = scene.lights.light(chosen.id)?;

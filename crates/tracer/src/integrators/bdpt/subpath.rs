@@ -145,8 +145,8 @@ impl Bdpt<'_> {
             return None;
         }
         let power = source.power() / pmf;
-        let (id, origin, direction) = (light.id, beam.origin, beam.direction);
-        Some(wl.lambdas.map(|l| power * self.scene.light_spectrum(id, origin, direction, l)))
+        let spectrum = self.scene.light_spectra(light.id, beam.origin, beam.direction, &wl.lambdas);
+        Some(spectrum.map(|s| power * s))
     }
 
     /// Follows `start.ray` (whose first hit is `start.first`) through the scene, appending a
