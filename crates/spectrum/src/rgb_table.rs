@@ -3,8 +3,9 @@
 //! [`SigmoidSpectrum::fit`] solves one colour exactly; a bitmap texture has up to millions of
 //! texel colours, filtered between texels at every hit, so textures look their spectra up in a
 //! table instead, as Mitsuba 3 and pbrt-v4 do. The table is generated here by the project's own
-//! solver the first time a process asks for it (about a second on two cores), never shipped as
-//! data.
+//! solver as a process needs it, never shipped as data: each column of entries along `z` is
+//! fitted the first time a lookup touches it (about a millisecond), so a scene pays for the
+//! colours it has (all 12,288 columns take about 5 s on one core).
 //!
 //! # Layout
 //! A colour `(r, g, b)` with largest component `c[i]` is placed by `i` (which of three tables),
@@ -19,7 +20,7 @@
 //! neighbour's coefficients. Entries on the gamut's faces (`z = 0`, a component 0) need infinite
 //! coefficients and keep the solver's best finite ones; their colours are still within 1e-3.
 
-use std::sync::LazyLock;
+use std::sync::{LazyLock, OnceLock};
 
 use crate::rgb::{COARSE, FINE, SigmoidSpectrum, newton_steps};
 
@@ -28,8 +29,9 @@ use crate::rgb::{COARSE, FINE, SigmoidSpectrum, newton_steps};
 pub struct RgbTable {
     /// The `z` sample positions, increasing from 0 to 1.
     scale: Vec<f64>,
-    /// Coefficients, indexed `[i][z][y][x]` flattened.
-    coefficients: Vec<[f64; 3]>,
+    /// Coefficients along `z` for each `(i, y, x)`, indexed `[i][y][x]` flattened: each column
+    /// fitted the first time a lookup needs it.
+    columns: Vec<OnceLock<Box<[[f64; 3]]>>>,
 }
 
 /// `a`, fitted on the coarse quadrature, refined on the fine one (one or two Newton steps away).
@@ -47,15 +49,17 @@ impl RgbTable {
     /// Points per axis.
     pub const RESOLUTION: usize = 64;
 
-    /// The process's table, generated on first use.
+    /// The process's table. Its columns are fitted as lookups need them (a column of 64
+    /// entries in about a millisecond), so a scene pays only for the colours it has.
     pub fn get() -> &'static RgbTable {
-        static TABLE: LazyLock<RgbTable> = LazyLock::new(RgbTable::generate);
+        static TABLE: LazyLock<RgbTable> = LazyLock::new(RgbTable::new);
         &TABLE
     }
 
-    fn index(i: usize, z: usize, y: usize, x: usize) -> usize {
+    fn new() -> Self {
         let n = Self::RESOLUTION;
-        ((i * n + z) * n + y) * n + x
+        let scale = (0..n).map(|k| smoothstep(smoothstep(k as f64 / (n - 1) as f64))).collect();
+        Self { scale, columns: (0..3 * n * n).map(|_| OnceLock::new()).collect() }
     }
 
     /// The colour of entry `(i, z, y, x)`.
@@ -69,55 +73,31 @@ impl RgbTable {
         rgb
     }
 
-    fn generate() -> Self {
+    /// The coefficients of column `(i, y, x)` along `z`, fitted on first use.
+    fn column(&self, i: usize, y: usize, x: usize) -> &[[f64; 3]] {
         let n = Self::RESOLUTION;
-        let scale: Vec<f64> =
-            (0..n).map(|k| smoothstep(smoothstep(k as f64 / (n - 1) as f64))).collect();
-        let mut table = Self { scale, coefficients: vec![[0.0; 3]; 3 * n * n * n] };
-        // One job per (i, y): a column of x, each walked along z.
-        let jobs: Vec<(usize, usize)> = (0..3).flat_map(|i| (0..n).map(move |y| (i, y))).collect();
-        let threads = std::thread::available_parallelism().map_or(1, |t| t.get()).min(jobs.len());
-        let results: Vec<Vec<(usize, [f64; 3])>> = std::thread::scope(|s| {
-            let table = &table;
-            let handles: Vec<_> = (0..threads)
-                .map(|t| {
-                    let jobs = &jobs;
-                    s.spawn(move || {
-                        let mut out = Vec::new();
-                        for &(i, y) in jobs.iter().skip(t).step_by(threads) {
-                            for x in 0..n {
-                                table.walk(i, y, x, &mut out);
-                            }
-                        }
-                        out
-                    })
-                })
-                .collect();
-            handles.into_iter().map(|h| h.join().unwrap_or_default()).collect()
-        });
-        for (index, c) in results.into_iter().flatten() {
-            table.coefficients[index] = c;
-        }
-        table
+        self.columns[(i * n + y) * n + x].get_or_init(|| self.walk(i, y, x))
     }
 
     /// Fits entries `(i, *, y, x)` along `z`, from `n / 5` outwards, each from its neighbour.
-    fn walk(&self, i: usize, y: usize, x: usize, out: &mut Vec<(usize, [f64; 3])>) {
+    fn walk(&self, i: usize, y: usize, x: usize) -> Box<[[f64; 3]]> {
         let n = Self::RESOLUTION;
+        let mut out = vec![[0.0; 3]; n];
         let start = n / 5;
         let first = SigmoidSpectrum::continuation(self.colour(i, start, y, x), &COARSE, 8);
         let face = x == 0 || y == 0;
         let target = self.colour(i, start, y, x);
-        out.push((Self::index(i, start, y, x), if face { polish(first, target) } else { first }));
+        out[start] = if face { polish(first, target) } else { first };
         for range in [(start + 1..n).collect::<Vec<_>>(), (0..start).rev().collect()] {
             let mut a = first;
             for z in range {
                 let target = self.colour(i, z, y, x);
                 newton_steps(&mut a, target, &COARSE, 8);
                 let face = x == 0 || y == 0 || z == 0;
-                out.push((Self::index(i, z, y, x), if face { polish(a, target) } else { a }));
+                out[z] = if face { polish(a, target) } else { a };
             }
         }
+        out.into_boxed_slice()
     }
 
     /// The smooth reflectance of the linear-sRGB colour `rgb` (components clamped to `[0, 1]`,
@@ -146,11 +126,11 @@ impl RgbTable {
         let z0 = self.scale.partition_point(|&s| s <= z).saturating_sub(1).min(n - 2);
         let fz = ((z - self.scale[z0]) / (self.scale[z0 + 1] - self.scale[z0])).clamp(0.0, 1.0);
         let mut c = [0.0; 3];
-        for (dz, wz) in [(0, 1.0 - fz), (1, fz)] {
-            for (dy, wy) in [(0, 1.0 - fy), (1, fy)] {
-                for (dx, wx) in [(0, 1.0 - fx), (1, fx)] {
-                    let e = self.coefficients[Self::index(i, z0 + dz, y0 + dy, x0 + dx)];
-                    let w = wz * wy * wx;
+        for (dy, wy) in [(0, 1.0 - fy), (1, fy)] {
+            for (dx, wx) in [(0, 1.0 - fx), (1, fx)] {
+                let column = self.column(i, y0 + dy, x0 + dx);
+                for (dz, wz) in [(0, 1.0 - fz), (1, fz)] {
+                    let (e, w) = (column[z0 + dz], wz * wy * wx);
                     for k in 0..3 {
                         c[k] += w * e[k];
                     }
