@@ -532,3 +532,39 @@ fn a_sensor_pass_to_a_target_reaches_it_and_the_closed_form() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A sensor under a white environment map (every texel 1: D65 of luminance 1 from every
+/// direction), lying outside everything but a black floor below it: each cell reads
+/// `pi integral(L_lambda 683 ybar)` lux, the sky's whole upper hemisphere. The environment's
+/// sphere must enclose the sensor for it to be lit at all.
+#[test]
+fn a_sensor_under_a_white_environment_reads_pi_times_its_luminance() {
+    let dir = folder("env-sensor");
+    let map = dir.join("white.exr");
+    exr::prelude::write_rgb_file(&map, 8, 4, |_, _| (1.0f32, 1.0f32, 1.0f32)).unwrap();
+    let json = format!(
+        r#"{{
+  "camera": {{"position": [0, 1, 5], "look_at": [0, 0, 0], "fov": 40, "width": 8, "height": 8}},
+  "objects": [{{"shape": {{"type": "Rectangle", "corner": [-0.5, -0.01, -0.5], "edge_u": [0, 0, 1],
+                            "edge_v": [1, 0, 0]}}, "material": {{"type": "Diffuse", "reflectance": 0}}}}],
+  "environment": {{"file": {map:?}}},
+  "sensors": [{{"type": "IrradianceSensor", "name": "plane", "corner": [-3, 2, -3],
+               "edge_u": [0, 0, 2], "edge_v": [2, 0, 0], "cells": [8, 8]}}]
+}}"#
+    );
+    let scene = Scene::from_json(&json, &dir.join("scene.json")).unwrap_or_else(|e| panic!("{e}"));
+    let steps = 47_000;
+    let h = (830.0 - 360.0) / steps as f64;
+    let lux: f64 = PI
+        * h
+        * (0..steps)
+            .map(|k| {
+                let l = 360.0 + (k as f64 + 0.5) * h;
+                spectrace_spectrum::rgb::d65_visible(l) / spectrace_spectrum::rgb::d65_luminance()
+                    * spectrace_spectrum::lumens_per_watt(l)
+            })
+            .sum::<f64>();
+    let (got, errors, average_error) = measure_path(&scene, 4000);
+    assert_cells_agree("path, white environment", &got, &errors, &[lux; 64], average_error);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -24,7 +24,7 @@
 //! with `phi = 2 pi u`, `theta = pi v`, turned to the world by `rotation`.
 //!
 //! **How it is made finite.** The renderer places the map on a sphere around the scene's
-//! objects and camera (its centre and radius are the renderer's choice, and do not change the
+//! objects, camera and sensors (its centre and radius are the renderer's choice, and do not change the
 //! image): every point inside receives `L(omega)` from direction `omega`, exactly an environment
 //! at infinite distance. The sphere is part of the scene (it absorbs what reaches it).
 //!

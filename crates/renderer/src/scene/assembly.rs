@@ -100,19 +100,19 @@ impl<'a> Assembly<'a> {
         Ok(light)
     }
 
-    /// The scene's environment placed on a sphere around the objects and the camera (1.5 times
-    /// the radius of their bounding sphere: no receiver lies on the sphere itself, and its
-    /// choice does not change the image).
+    /// The scene's environment placed on a sphere around the objects and the `receivers` (the
+    /// camera, the sensors): 1.5 times the radius of their bounding sphere, so no receiver lies
+    /// on the sphere itself; its choice does not change the image.
     pub(super) fn environment(
         &mut self,
         map: EnvironmentMap,
-        camera: DVec3,
+        receivers: &[DVec3],
     ) -> Result<Box<dyn LightSource>, SceneError> {
         let bounds = self
             .shapes
             .iter()
             .map(Shape::bounds)
-            .fold(Bounds::from_points([camera]), Bounds::union);
+            .fold(Bounds::from_points(receivers.iter().copied()), Bounds::union);
         let center = bounds.center();
         let radius = ((bounds.max - bounds.min).length() / 2.0).max(1e-3) * 1.5;
         let light = Environment::new(map, center, radius)

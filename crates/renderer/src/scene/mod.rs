@@ -223,7 +223,15 @@ impl Scene {
         let object_shapes = parts.shapes.len();
         let mut file_lights = file.lights;
         if let Some(map) = file.environment {
-            file_lights.push(parts.environment(map, file.camera.position())?);
+            // Everything that receives light lies inside its sphere: the camera and the
+            // sensors' corners too.
+            let receivers: Vec<glam::DVec3> = std::iter::once(file.camera.position())
+                .chain(file.sensors.iter().flat_map(|s| {
+                    let (c, u, v) = (s.corner(), s.edge_u(), s.edge_v());
+                    [c, c + u, c + v, c + u + v]
+                }))
+                .collect();
+            file_lights.push(parts.environment(map, &receivers)?);
         }
         let lights = parts.add_lights(file_lights, object_lights)?;
         let sensors = sensor_set(file.sensors, path)?;
