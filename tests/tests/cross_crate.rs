@@ -11,6 +11,7 @@ mod integrators;
 mod kernels;
 mod measured_auto;
 mod photometry;
+mod real_luminaires;
 mod rendering;
 mod rough_materials;
 mod textures;

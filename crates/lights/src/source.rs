@@ -222,6 +222,13 @@ pub trait LightSource: Send + Sync + Debug {
         None
     }
 
+    /// What the light did to read its input that its user should be told: a lamp set chosen
+    /// among several, a file read as Windows-1252. Empty by default; renderers print these as
+    /// warnings when the scene is loaded.
+    fn notes(&self) -> Vec<String> {
+        Vec::new()
+    }
+
     /// The light's emitting surface, so a renderer can make it part of the scene: visible to
     /// camera rays (with [`emitted_radiance`](Self::emitted_radiance)) and blocking light. `None`
     /// (the default) for lights without one (points, parallel beams).

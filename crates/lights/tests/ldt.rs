@@ -103,26 +103,36 @@ fn a_complete_file_reads_back_every_field() {
         (b.colour_temperature.as_str(), b.colour_rendering.as_str(), b.watts),
         ("4000 K", "Ra 80", 20.0)
     );
-    assert_eq!(f.direct_ratios, [0.45, 0.52, 0.58, 0.63, 0.67, 0.72, 0.76, 0.79, 0.83, 0.86]);
+    assert_eq!(
+        f.direct_ratios,
+        [0.45, 0.52, 0.58, 0.63, 0.67, 0.72, 0.76, 0.79, 0.83, 0.86].map(Some)
+    );
     assert_eq!(f.c_angles, vec![0.0, 90.0, 180.0, 270.0]);
     assert_eq!(f.gamma_angles, vec![0.0, 45.0, 90.0]);
     assert_eq!(f.intensities, vec![vec![300.0, 250.5, 100.0], vec![310.0, 240.0, 90.0]]);
     assert!(!f.is_absolute());
-    assert_eq!(f.total_flux(), 2300.5);
+    assert_eq!((f.set_flux(0), f.set_flux(1), f.set_flux(2)), (Some(1200.0), Some(1100.5), None));
 }
 
+/// The lamp sets are alternatives (as DIALux and Relux read them): the table is scaled by the
+/// chosen set's flux alone, never by their sum.
 #[test]
-fn candela_planes_are_absolute_cd_per_klm_times_the_summed_lamp_flux() {
-    let p = LdtFile::parse(DOWNLIGHT, "dl.ldt").unwrap().candela_planes();
-    assert_eq!(p.horizontal, vec![0.0, 90.0]);
-    assert_eq!(p.vertical, vec![0.0, 45.0, 90.0]);
-    assert_eq!(p.lamp_lumens, Some(2300.5));
-    let expected = [[300.0, 250.5, 100.0], [310.0, 240.0, 90.0]];
-    for (row, want) in p.candela.iter().zip(expected) {
-        for (&cd, klm) in row.iter().zip(want) {
-            assert!((cd - klm * 2.3005).abs() < 1e-9 * cd.max(1.0), "{cd} vs {klm} cd/klm");
+fn candela_planes_are_absolute_cd_per_klm_times_one_lamp_sets_flux() {
+    let f = LdtFile::parse(DOWNLIGHT, "dl.ldt").unwrap();
+    for (set, flux) in [(0, 1200.0), (1, 1100.5)] {
+        let p = f.candela_planes(set).unwrap();
+        assert_eq!(p.horizontal, vec![0.0, 90.0]);
+        assert_eq!(p.vertical, vec![0.0, 45.0, 90.0]);
+        assert_eq!(p.lamp_lumens, Some(flux));
+        let expected = [[300.0, 250.5, 100.0], [310.0, 240.0, 90.0]];
+        for (row, want) in p.candela.iter().zip(expected) {
+            for (&cd, klm) in row.iter().zip(want) {
+                let scaled = klm * flux / 1000.0;
+                assert!((cd - scaled).abs() < 1e-9 * cd.max(1.0), "{cd} vs {klm} cd/klm");
+            }
         }
     }
+    assert!(f.candela_planes(2).is_none());
 }
 
 #[test]
@@ -203,13 +213,13 @@ fn each_symmetry_stores_its_planes_and_maps_them_to_the_ies_ranges() {
             assert_eq!(f.symmetry.indicator(), isym);
             assert_eq!(f.intensities, stored, "Isym {isym}");
             assert_eq!(f.light_output_ratio, 72.5);
-            let p = f.candela_planes();
+            let p = f.candela_planes(0).unwrap();
             assert_eq!(p.horizontal, horizontal, "Isym {isym}");
             assert_eq!(p.vertical, g.to_vec());
-            assert_eq!(p.lamp_lumens, Some(2000.0));
-            // 2000 lm: twice the cd/klm values.
+            assert_eq!(p.lamp_lumens, Some(1500.0));
+            // Set 1's 1500 lm: 1.5 times the cd/klm values.
             let doubled: Vec<Vec<f64>> =
-                stored.iter().map(|r| r.iter().map(|v| 2.0 * v).collect()).collect();
+                stored.iter().map(|r| r.iter().map(|v| 1.5 * v).collect()).collect();
             assert_eq!(p.candela, doubled, "Isym {isym}");
         }
         // One plane too few stored: the file ends early.
@@ -230,7 +240,7 @@ fn negative_lamp_counts_mean_absolute_photometry() {
     let f = LdtFile::parse(&text, "abs.ldt").unwrap();
     assert!(f.is_absolute());
     assert_eq!(f.lamp_sets[0].lamps, -1);
-    let p = f.candela_planes();
+    let p = f.candela_planes(0).unwrap();
     assert_eq!(p.lamp_lumens, None);
     assert_eq!(p.candela, vec![vec![700.0, 175.0]]);
     // Mixing absolute and relative sets is refused at the second set's count (line 33).

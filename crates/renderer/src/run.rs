@@ -54,6 +54,9 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
     )?;
     let mut warnings: Vec<String> =
         scene.notes.iter().map(|n| format!("imported with an approximation: {n}")).collect();
+    for (i, light) in scene.lights.lights().iter().enumerate() {
+        warnings.extend(light.notes().into_iter().map(|n| format!("lights[{i}]: {n}")));
+    }
     let (choice, reason, plan) = match measure_choice(scene, options, &plan, &fallback) {
         Ok(Some(m)) => {
             // The pilots' time comes out of the budget.

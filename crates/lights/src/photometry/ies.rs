@@ -27,7 +27,10 @@
 //! vertical angles lie in `[0, 180]` and horizontal ones in `[0, 360]`, both strictly
 //! increasing; the horizontal angles start at 0 (or 90 for the quadrant form 90..270 some
 //! files use) and end where the symmetry the format defines allows (0: axial symmetry, 90:
-//! quadrant, 180: bilateral, 360: none); nothing follows the last candela value but blanks.
+//! quadrant, 180: bilateral, 360: none); nothing follows the last candela value but blanks and
+//! one `END` (some 1986-form files close with it). The `TILT` keyword is read in any case
+//! (`tilt=none`), and the text as [`super::decode_text`] gives it (UTF-8 or Windows-1252, any
+//! line ends, a trailing ^Z dropped).
 
 use super::{CandelaPlanes, PhotometryError};
 
@@ -189,9 +192,12 @@ impl IesFile {
                 ));
             };
             let trimmed = line.trim();
-            if let Some(rest) =
-                trimmed.strip_prefix("TILT=").or_else(|| trimmed.strip_prefix("TILT ="))
-            {
+            // `TILT=`, in any case, with blanks before the `=` allowed.
+            let tilt = trimmed
+                .get(..4)
+                .filter(|t| t.eq_ignore_ascii_case("TILT"))
+                .and_then(|_| trimmed[4..].trim_start().strip_prefix('='));
+            if let Some(rest) = tilt {
                 tilt_line = (i + 1, rest.trim().to_owned());
                 i += 1;
                 break;
@@ -345,6 +351,13 @@ impl IesFile {
                 values.push(v * multiplier);
             }
             candela.push(values);
+        }
+        // Some 1986-form files close with an `END` line after the table.
+        let rest = &tokens.items[tokens.next.min(tokens.items.len())..];
+        if let [(_, end)] = rest
+            && end.eq_ignore_ascii_case("END")
+        {
+            tokens.next += 1;
         }
         if let Some(&(line, t)) = tokens.items.get(tokens.next) {
             return Err(err(

@@ -48,9 +48,11 @@
 //! **Lamps.** A set's number of lamps is a non-zero whole number. A negative number marks
 //! *absolute photometry* (the 2009 note): the set's flux is then the luminaire's own measured
 //! flux, the lamps number its absolute value, and [`CandelaPlanes::lamp_lumens`] is `None`. All
-//! sets must then be negative (a mix is refused). The absolute candela of the table are the
-//! cd/klm values times the summed flux of all lamp sets / 1000; the conversion factor (line 24)
-//! is kept but not applied, as the readers of the documents above do.
+//! sets must then be negative (a mix is refused). Several lamp sets are alternatives (the lamps
+//! the luminaire may be fitted with), read as DIALux and Relux read them: the absolute candela
+//! of the table are the cd/klm values times *one* set's flux / 1000 (set 1 unless the scene's
+//! `lamp_set` says otherwise); the conversion factor (line 24) is kept but not applied, as the
+//! readers of the documents above do.
 //!
 //! **Checks**, each an error naming the file, the line and the cause: Ityp 0..=3; Isym 0..=4;
 //! Mc and Ng whole numbers from 1 to [`MAX_ANGLES`] (so at most `MAX_ANGLES^2` intensities);
@@ -62,7 +64,8 @@
 //! file that ends early (the error names the last line and what was expected); anything but
 //! blank lines after the last intensity. Dc and Dg are kept, not compared with the angles (the
 //! angle lines are what the table uses). Fields the table does not depend on (dimensions, tilt,
-//! conversion factor, direct ratios) are only checked to be numbers.
+//! conversion factor) are only checked to be numbers; a blank direct-ratio line reads as missing.
+//! The text is read as [`super::decode_text`] gives it (UTF-8 or Windows-1252, any line ends).
 
 use super::{CandelaPlanes, MAX_ANGLES, PhotometryError};
 
@@ -168,8 +171,9 @@ pub struct LdtFile {
     pub tilt: f64,
     /// The standard sets of lamps (line 26 counts them).
     pub lamp_sets: Vec<LampSet>,
-    /// Direct ratios for the room indices k = 0.6, 0.8, 1, 1.25, 1.5, 2, 2.5, 3, 4, 5.
-    pub direct_ratios: [f64; 10],
+    /// Direct ratios for the room indices k = 0.6, 0.8, 1, 1.25, 1.5, 2, 2.5, 3, 4, 5 (`None`
+    /// where the line is blank).
+    pub direct_ratios: [Option<f64>; 10],
     /// All `Mc` C angles (degrees), strictly increasing from 0.
     pub c_angles: Vec<f64>,
     /// The `Ng` gamma angles (degrees from nadir), strictly increasing within [0, 180].
@@ -360,9 +364,19 @@ impl LdtFile {
                 watts,
             });
         }
-        let mut direct_ratios = [0.0; 10];
+        // Direct ratios serve room-index tables, not the candela table: blank lines (as some
+        // makers ship them) are read as missing.
+        let mut direct_ratios = [None; 10];
         for (i, d) in direct_ratios.iter_mut().enumerate() {
-            *d = r.number(&format!("direct ratio[{i}]"))?.0;
+            let what = format!("direct ratio[{i}]");
+            let (text, line) = r.text(&what)?;
+            *d = match parse_number(text) {
+                Some(v) => Some(v),
+                None if text.is_empty() => None,
+                None => {
+                    return Err(r.error(line, format!("{what}: expected a number, found `{text}`")));
+                }
+            };
         }
         let c_angles = r.numbers("C angle", mc)?;
         increasing(&r, &c_angles, "C angles")?;
@@ -461,9 +475,10 @@ impl LdtFile {
         self.lamp_sets.iter().any(|s| s.lamps < 0)
     }
 
-    /// The summed flux of all lamp sets (lm), the flux the cd/klm values are relative to.
-    pub fn total_flux(&self) -> f64 {
-        self.lamp_sets.iter().map(|s| s.flux).sum()
+    /// The flux of lamp set `set` (0-based; lm), the flux the cd/klm values are relative to
+    /// when that set is fitted; `None` past the last set.
+    pub fn set_flux(&self, set: usize) -> Option<f64> {
+        self.lamp_sets.get(set).map(|s| s.flux)
     }
 
     /// The stored C angles (degrees): the planes `intensities` holds, in the IES ranges
@@ -476,12 +491,15 @@ impl LdtFile {
         self.c_angles.iter().skip(first).take(count).copied().collect()
     }
 
-    /// The table as [`CandelaPlanes`]: the stored planes in absolute candela (cd/klm times the
-    /// summed lamp flux / 1000), `lamp_lumens` that sum (`None` for absolute photometry).
-    pub fn candela_planes(&self) -> CandelaPlanes {
-        let flux = self.total_flux();
+    /// The table as [`CandelaPlanes`] with lamp set `set` (0-based) fitted: the stored planes in
+    /// absolute candela (cd/klm times the set's flux / 1000), `lamp_lumens` that flux (`None`
+    /// for absolute photometry). A file's lamp sets are alternatives (the lamps the luminaire
+    /// may be fitted with), as DIALux and Relux read them, so one set is used, never their sum.
+    /// `None` past the last set.
+    pub fn candela_planes(&self, set: usize) -> Option<CandelaPlanes> {
+        let flux = self.set_flux(set)?;
         let scale = flux / 1000.0;
-        CandelaPlanes {
+        Some(CandelaPlanes {
             horizontal: self.stored_c_angles(),
             vertical: self.gamma_angles.clone(),
             candela: self
@@ -490,7 +508,7 @@ impl LdtFile {
                 .map(|row| row.iter().map(|v| v * scale).collect())
                 .collect(),
             lamp_lumens: (!self.is_absolute()).then_some(flux),
-        }
+        })
     }
 }
 

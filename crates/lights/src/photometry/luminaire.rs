@@ -13,6 +13,7 @@
 //! | `multiplier` | | 1 | scales every candela value (and so the flux) |
 //! | `lumens` | lm | | instead of `multiplier`: scales the table so the luminaire emits this flux |
 //! | `wavelength_sampling` | | `"importance"` | as for every light |
+//! | `lamp_set` | | `1` | `EulumdatLight` only: which of the file's lamp sets (alternatives) is fitted, from 1 |
 //!
 //! ```json
 //! {"type": "IesLight", "file": "downlight.ies", "position": [0, 2.8, 0],
@@ -341,6 +342,7 @@ impl Luminaire {
             multiplier,
             lumens: scale.lumens,
             wavelength_sampling: sampling,
+            lamp_set: None,
         };
         Ok((luminaire, repr))
     }
@@ -464,6 +466,9 @@ macro_rules! luminaire_light_source {
         fn map_spd(&mut self, f: &crate::SpdMap<'_>) -> Result<bool, LightError> {
             self.luminaire.emission.map_spd(f)
         }
+        fn notes(&self) -> Vec<String> {
+            self.notes.to_vec()
+        }
         fn flags(&self) -> Option<LightFlags> {
             Some(LightFlags { delta_position: true, delta_direction: false })
         }
@@ -491,6 +496,7 @@ pub struct IesLight {
     luminaire: Luminaire,
     repr: Arc<LuminaireRepr>,
     file: Arc<IesFile>,
+    notes: Arc<[String]>,
 }
 
 /// Scene-file form of [`IesLight`] and [`EulumdatLight`].
@@ -513,6 +519,8 @@ pub(crate) struct LuminaireRepr {
     lumens: Option<f64>,
     #[serde(default)]
     wavelength_sampling: WavelengthSampling,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    lamp_set: Option<usize>,
 }
 
 impl LuminaireRepr {
@@ -557,28 +565,44 @@ pub(crate) fn check_multiplier(light: &'static str, m: f64) -> Result<f64, Light
     }
 }
 
-/// Reads a photometric file named in a scene file (relative to its folder).
+/// Reads a photometric file named in a scene file (relative to its folder) as makers ship it
+/// ([`super::decode_text`]): its path, its text and what reading it took, if anything.
 pub(crate) fn read_photometric_file(
     light: &'static str,
     file: &std::path::Path,
     what: &str,
-) -> Result<(PathBuf, String), LightError> {
-    spectrace_sampling::files::read_scene_input(file, MAX_PHOTOMETRIC_BYTES, what)
-        .map_err(|message| LightError::File { light, field: "file", message })
+) -> Result<(PathBuf, String, Option<String>), LightError> {
+    let (path, bytes) =
+        spectrace_sampling::files::read_scene_input_bytes(file, MAX_PHOTOMETRIC_BYTES, what)
+            .map_err(|message| LightError::File { light, field: "file", message })?;
+    let (text, note) = super::decode_text(&bytes);
+    Ok((path, text, note))
 }
 
 impl TryFrom<LuminaireRepr> for IesLight {
     type Error = LightError;
     fn try_from(r: LuminaireRepr) -> Result<Self, LightError> {
         const LIGHT: &str = "IesLight";
-        let (path, text) = read_photometric_file(LIGHT, &r.file, "IES file")?;
-        let ies = IesFile::parse(&text, &path.display().to_string()).map_err(|e| {
-            LightError::File { light: LIGHT, field: "file", message: e.to_string() }
+        if let Some(set) = r.lamp_set {
+            return Err(LightError::parameter(
+                LIGHT,
+                "lamp_set",
+                set,
+                "is a EULUMDAT key: an IES file has one set of lamps",
+            ));
+        }
+        let (path, text, note) = read_photometric_file(LIGHT, &r.file, "IES file")?;
+        let name = path.display().to_string();
+        let ies = IesFile::parse(&text, &name).map_err(|e| LightError::File {
+            light: LIGHT,
+            field: "file",
+            message: e.to_string(),
         })?;
         let spd = Luminaire::spectrum(LIGHT, r.spd.clone(), r.cct, None)?;
         let light =
             Self::build(ies, (r.position, r.nadir, r.c0), spd, r.scale(), r.wavelength_sampling)?;
-        Ok(Self { repr: Arc::new(r), ..light })
+        let notes = note.map(|n| format!("{name}: {n}")).into_iter().collect();
+        Ok(Self { repr: Arc::new(r), notes, ..light })
     }
 }
 
@@ -624,7 +648,7 @@ impl IesLight {
             scale,
             sampling,
         )?;
-        Ok(Self { luminaire, repr: Arc::new(repr), file: Arc::new(ies) })
+        Ok(Self { luminaire, repr: Arc::new(repr), file: Arc::new(ies), notes: Arc::new([]) })
     }
 
     /// The parsed file.
@@ -662,6 +686,7 @@ pub struct EulumdatLight {
     luminaire: Luminaire,
     repr: Arc<LuminaireRepr>,
     file: Arc<LdtFile>,
+    notes: Arc<[String]>,
 }
 
 /// The colour temperature (K) of a EULUMDAT lamp set, when its text is a number of kelvin
@@ -677,15 +702,45 @@ impl TryFrom<LuminaireRepr> for EulumdatLight {
     type Error = LightError;
     fn try_from(r: LuminaireRepr) -> Result<Self, LightError> {
         const LIGHT: &str = "EulumdatLight";
-        let (path, text) = read_photometric_file(LIGHT, &r.file, "EULUMDAT file")?;
-        let ldt = LdtFile::parse(&text, &path.display().to_string()).map_err(|e| {
-            LightError::File { light: LIGHT, field: "file", message: e.to_string() }
+        let (path, text, note) = read_photometric_file(LIGHT, &r.file, "EULUMDAT file")?;
+        let name = path.display().to_string();
+        let ldt = LdtFile::parse(&text, &name).map_err(|e| LightError::File {
+            light: LIGHT,
+            field: "file",
+            message: e.to_string(),
         })?;
-        let default_cct = ldt.lamp_sets.first().and_then(|l| lamp_cct(&l.colour_temperature));
+        let sets = ldt.lamp_sets.len();
+        let set = r.lamp_set.unwrap_or(1);
+        if !(1..=sets).contains(&set) {
+            return Err(LightError::parameter(
+                LIGHT,
+                "lamp_set",
+                set,
+                "must name one of the file's lamp sets, counting from 1",
+            ));
+        }
+        let mut notes: Vec<String> = note.map(|n| format!("{name}: {n}")).into_iter().collect();
+        if sets > 1 {
+            let fluxes: Vec<String> =
+                ldt.lamp_sets.iter().map(|l| format!("{} lm", l.flux)).collect();
+            notes.push(format!(
+                "{name}: {sets} lamp sets ({}), alternatives as DIALux and Relux read them: set \
+                 {set} used (`lamp_set` chooses another)",
+                fluxes.join(", ")
+            ));
+        }
+        let default_cct =
+            ldt.lamp_sets[set - 1..].first().and_then(|l| lamp_cct(&l.colour_temperature));
         let spd = Luminaire::spectrum(LIGHT, r.spd.clone(), r.cct, default_cct)?;
-        let light =
-            Self::build(ldt, (r.position, r.nadir, r.c0), spd, r.scale(), r.wavelength_sampling)?;
-        Ok(Self { repr: Arc::new(r), ..light })
+        let light = Self::build_with(
+            ldt,
+            set - 1,
+            (r.position, r.nadir, r.c0),
+            spd,
+            r.scale(),
+            r.wavelength_sampling,
+        )?;
+        Ok(Self { repr: Arc::new(r), notes: notes.into(), ..light })
     }
 }
 
@@ -696,8 +751,9 @@ impl From<EulumdatLight> for LuminaireRepr {
 }
 
 impl EulumdatLight {
-    /// A luminaire with the table of `ldt` (absolute: cd/klm times the lamp flux / 1000, times
-    /// `multiplier`) at `position`, oriented by `nadir` and `c0`, emitting `spd`.
+    /// A luminaire with the table of `ldt` (absolute: cd/klm times the flux of its first lamp
+    /// set / 1000, times `multiplier`) at `position`, oriented by `nadir` and `c0`, emitting
+    /// `spd`.
     ///
     /// # Errors
     /// As [`IesLight::new`].
@@ -710,20 +766,25 @@ impl EulumdatLight {
         multiplier: f64,
         sampling: WavelengthSampling,
     ) -> Result<Self, LightError> {
-        Self::build(ldt, (position, nadir, c0), spd, Scale::by(multiplier), sampling)
+        Self::build_with(ldt, 0, (position, nadir, c0), spd, Scale::by(multiplier), sampling)
     }
 
-    fn build(
+    /// With lamp set `set` (0-based) fitted.
+    fn build_with(
         ldt: LdtFile,
+        set: usize,
         placement: (DVec3, DVec3, DVec3),
         spd: Arc<dyn SpectralPowerDistribution>,
         scale: Scale,
         sampling: WavelengthSampling,
     ) -> Result<Self, LightError> {
-        let planes = ldt.candela_planes();
+        let planes = ldt.candela_planes(set).ok_or_else(|| {
+            LightError::parameter("EulumdatLight", "lamp_set", set + 1, "the file has no such set")
+        })?;
         let (luminaire, repr) =
             Luminaire::placed("EulumdatLight", (&planes, 1.0), placement, spd, scale, sampling)?;
-        Ok(Self { luminaire, repr: Arc::new(repr), file: Arc::new(ldt) })
+        let file = Arc::new(ldt);
+        Ok(Self { luminaire, repr: Arc::new(repr), file, notes: Arc::new([]) })
     }
 
     /// The parsed file.

@@ -37,6 +37,37 @@ impl fmt::Display for PhotometryError {
 
 impl std::error::Error for PhotometryError {}
 
+/// The text of a photometric file as makers ship it: UTF-8 (a byte-order mark dropped), or,
+/// where the bytes are not UTF-8, Windows-1252 (the Latin-1 superset older lighting software
+/// writes: a `°` or `§` in a label); every line end (CR LF, LF, or an old Mac's lone CR) made a
+/// LF; DOS end-of-file marks (^Z) at the end dropped. Returns the text and what was done that a
+/// reader should be told (`None` for plain UTF-8 with LF or CR LF line ends).
+pub fn decode_text(bytes: &[u8]) -> (String, Option<String>) {
+    let mut notes = Vec::new();
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    let text = match std::str::from_utf8(bytes) {
+        Ok(t) => t.to_owned(),
+        Err(e) => {
+            notes.push(format!(
+                "not UTF-8 (byte {:#04x} at offset {}): read as Windows-1252 (Latin-1)",
+                bytes[e.valid_up_to()],
+                e.valid_up_to()
+            ));
+            encoding_rs::WINDOWS_1252.decode_without_bom_handling(bytes).0.into_owned()
+        }
+    };
+    let trimmed = text.trim_end_matches(|c: char| c == '\u{1a}' || c.is_whitespace());
+    if trimmed.len() < text.trim_end().len() {
+        notes.push("a DOS end-of-file mark (^Z) at the end was ignored".to_owned());
+    }
+    let lone_cr = text.replace("\r\n", "").contains('\r');
+    if lone_cr {
+        notes.push("lines end in a lone CR (old Mac OS): read as line ends".to_owned());
+    }
+    let text = trimmed.replace("\r\n", "\n").replace('\r', "\n");
+    (text, (!notes.is_empty()).then(|| notes.join("; ")))
+}
+
 /// The former name of [`PhotometryError`], from when the IES reader was the only one.
 pub type IesError = PhotometryError;
 
