@@ -116,10 +116,11 @@ fn malformed_files_are_refused_with_their_line_and_cause() {
             && e.contains("vertical angles must increase strictly: 40 after 45"),
         "{e}"
     );
-    // Types A and B, said clearly.
+    // Type A, said clearly; a type C table read as type B has angles out of type B's range,
+    // named with their line.
     let e = error(&LM63_2002.replace("5 3 1 2", "5 3 2 2"));
     assert!(
-        e.starts_with("bad.ies:10:") && e.contains("type B") && e.contains("only type C"),
+        e.starts_with("bad.ies:13:") && e.contains("type B horizontal angles end at 90"),
         "{e}"
     );
     let e = error(&LM63_2002.replace("5 3 1 2", "5 3 3 2"));

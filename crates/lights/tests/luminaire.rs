@@ -489,3 +489,86 @@ fn lumens_scale_the_table_to_the_luminaires_flux() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A type B (floodlight) file of asymmetric made-up intensities. Its table is read about its
+/// horizontal polar axis `c0`, the photometric axis along `nadir`: the direction of type B
+/// angles `(H, V)` is `sin H c0 + cos H (cos V nadir + sin V (nadir x c0))`, where the light
+/// gives the file's value; the flux is the file's zonal sum `sum avg4 dV (sin H_b - sin H_a)`
+/// (the bilinear interpolant in `(V, sin H)` integrated exactly); a table given for `H >= 0`
+/// only is the mirrored full one; and the back half-space gets no light.
+#[test]
+fn type_b_tables_turn_about_their_horizontal_axis() {
+    let hs = [-90.0, -40.0, 0.0, 30.0, 90.0];
+    let vs = [-90.0, -20.0, 0.0, 45.0, 90.0];
+    let value = |h: f64, v: f64| 100.0 + 3.0 * (h + 90.0) + 0.5 * (v + 90.0) + 0.01 * h * v;
+    let file = |hs: &[f64]| {
+        let mut t = String::from("IESNA:LM-63-2002\n[TEST] type B\nTILT=NONE\n");
+        t += &format!("1 -1 1 {} {} 2 2 0.4 0.2 0\n1 1 100\n", vs.len(), hs.len());
+        t += &vs.map(|v| v.to_string()).join(" ");
+        t += "\n";
+        t += &hs.iter().map(|h| h.to_string()).collect::<Vec<_>>().join(" ");
+        t += "\n";
+        for &h in hs {
+            // The pole (H = +-90) is one direction whatever V.
+            let row: Vec<String> = vs
+                .iter()
+                .map(|&v| value(h, if h.abs() == 90.0 { 0.0 } else { v }).to_string())
+                .collect();
+            t += &row.join(" ");
+            t += "\n";
+        }
+        t
+    };
+    let (nadir, c0) = (DVec3::NEG_Y, DVec3::X);
+    let light = |text: &str| {
+        let f = spectrace_lights::photometry::IesFile::parse(text, "flood.ies").unwrap();
+        IesLight::new(
+            f,
+            DVec3::ZERO,
+            nadir,
+            c0,
+            std::sync::Arc::new(spectrace_lights::spectrum::CieIlluminant::new("A").unwrap()),
+            1.0,
+            Default::default(),
+        )
+        .unwrap()
+    };
+    let full = light(&file(&hs));
+    let direction = |h: f64, v: f64| {
+        let (h, v) = (h.to_radians(), v.to_radians());
+        c0 * h.sin() + (nadir * v.cos() + nadir.cross(c0) * v.sin()) * h.cos()
+    };
+    // The poles (H = +-90) are left out: every plane meets there, the dark back's too, so the
+    // intensity exactly at a pole is a discontinuity of no solid angle.
+    for &h in hs.iter().filter(|h| h.abs() < 90.0) {
+        for &v in &vs {
+            let want = value(h, v);
+            let got = full.candela_towards(direction(h, v));
+            assert!((got - want).abs() < 1e-9 * want, "H {h}, V {v}: {got} vs {want}");
+        }
+    }
+    assert_eq!(full.candela_towards(-nadir), 0.0, "the back of a floodlight is dark");
+    let mut zonal = 0.0;
+    for i in 0..hs.len() - 1 {
+        for j in 0..vs.len() - 1 {
+            let c = |h: f64, v: f64| value(h, if h.abs() == 90.0 { 0.0 } else { v });
+            let avg = (c(hs[i], vs[j])
+                + c(hs[i + 1], vs[j])
+                + c(hs[i], vs[j + 1])
+                + c(hs[i + 1], vs[j + 1]))
+                / 4.0;
+            zonal += avg
+                * (vs[j + 1] - vs[j]).to_radians()
+                * (hs[i + 1].to_radians().sin() - hs[i].to_radians().sin());
+        }
+    }
+    assert!((full.lumens() - zonal).abs() < 1e-6 * zonal, "{} vs {zonal}", full.lumens());
+    // A symmetric table given from H = 0: the same light as its mirrored full table.
+    let half = light(&file(&[0.0, 30.0, 90.0]));
+    for (h, v) in [(-30.0, 45.0), (30.0, 45.0), (-60.0, -20.0), (60.0, -20.0)] {
+        let a = half.candela_towards(direction(h, v));
+        let b = half.candela_towards(direction(-h, v));
+        assert!((a - b).abs() < 1e-9 * a.max(1.0), "mirror H {h}, V {v}: {a} vs {b}");
+        assert!(a > 0.0, "H {h}, V {v} is in front");
+    }
+}

@@ -78,7 +78,7 @@ pub use plan::{
     plan_with,
 };
 pub use probe::{PROBE_BEAMS, PROBE_SECONDS, ProbeOutcome, probe, probe_with};
-pub use report::{AccuracyEstimate, PREDICTED_ERRORS, RenderReport, duration};
+pub use report::{AccuracyEstimate, LightReport, PREDICTED_ERRORS, RenderReport, duration};
 pub use run::{InMemoryRender, render_file, render_in_memory, render_scene};
 pub use scene::{
     DEFAULT_SENSOR_FLOOR_LUX, DEFAULT_SENSOR_SPP, DEFAULT_SPP, EffectsSettings, ErrorImage,

@@ -1,4 +1,7 @@
-//! The pre-render probe: does the film fit in memory, and can light reach the camera at all?
+//! The pre-render probe: does the film fit in memory, and can light reach the camera at all? A
+//! camera that sees no light while light reaches the scene (a sensor, or surfaces out of view or
+//! black) renders a dark image, with a warning; only a scene where visible light reaches
+//! nothing is an error.
 
 use std::time::Instant;
 
@@ -27,6 +30,10 @@ pub struct ProbeOutcome {
     pub lit: bool,
     /// Wall time (s).
     pub seconds: f64,
+    /// `true`: no probe path lit the film, but light does reach the scene (a sensor records
+    /// it, or beams land on surfaces the camera does not see or that reflect nothing), so a
+    /// dark image is the result, not an error.
+    pub dark: bool,
 }
 
 /// A sink that only records whether visible light reached the film (no film is allocated).
@@ -133,19 +140,47 @@ pub fn probe_with(
         beams: stats.beams,
         lit: sink.lit,
         seconds: started.elapsed().as_secs_f64(),
+        dark: false,
     };
     if sink.lit || (timed_out && stats.beams < max_beams) {
         return Ok(outcome);
+    }
+    if light_reaches_the_scene(scene, max_beams) {
+        return Ok(ProbeOutcome { dark: true, ..outcome });
     }
     Err(SceneError::Scene {
         path: scene.path.clone(),
         field: "lights".to_owned(),
         message: format!(
-            "no light can reach the camera: none of {} probe paths (beams or camera samples) lit a point the camera sees \
-             with visible light ({} hit a surface, {} reached the film). Check that the lights face the \
-             objects, that their spectra lie in 360-830 nm, that some surface is not a mirror or glass, and \
-             that the camera looks at the lit objects.",
+            "no light can reach the camera or anything else: none of {} probe paths (beams or camera samples) lit a point the camera sees \
+             with visible light ({} hit a surface, {} reached the film), no visible light lands on any surface, and no sensor \
+             records it. Check that the lights face the objects, that their spectra lie in 360-830 nm, and that the camera \
+             looks at the lit objects.",
             stats.beams, stats.hits, stats.splats
         ),
     })
+}
+
+/// Whether visible light reaches anything in the scene: some light has a visible spectrum, and
+/// there is a sensor to record it or one of up to `beams` light-tracer beams lands on a surface.
+fn light_reaches_the_scene(scene: &Scene, beams: u64) -> bool {
+    let visible = scene
+        .lights
+        .lights()
+        .iter()
+        .any(|l| spectrace_spectrum::luminous_efficacy(l.spd().as_ref()) > 0.0);
+    if !visible {
+        return false;
+    }
+    if !scene.sensors.is_empty() {
+        return true;
+    }
+    let effects = crate::decide_effects(scene, None);
+    let hit = with_integrator(scene, IntegratorChoice::Light, effects, |tracer| {
+        let mut sink = VisibleLight { width: 1, height: 1, lit: false };
+        let work = ChunkWork { seed: u64::MAX - 1, chunk: 0, items: beams, deadline: None };
+        tracer.render_chunk(work, &mut sink).hits > 0
+    });
+    scene.lights.reset_count();
+    hit
 }

@@ -78,8 +78,34 @@ pub struct RenderReport {
     /// The illuminance sensors' figures (empty for a scene without sensors).
     #[serde(default)]
     pub sensors: Vec<SensorReport>,
+    /// Every light of the scene, in the order of the light set: its type, power and flux.
+    #[serde(default)]
+    pub lights: Vec<LightReport>,
     /// Spectrace version.
     pub version: String,
+}
+
+/// One light of a render, as the sidecar lists it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LightReport {
+    /// The light's type, as scene files name it (`"IesLight"`, `"Environment"`, ...).
+    #[serde(rename = "type")]
+    pub kind: String,
+    /// Radiant power (W); `null` beyond the range of `f64`.
+    pub watts: Option<f64>,
+    /// Luminous flux (lm): the power times its spectrum's luminous efficacy; `null` beyond the
+    /// range of `f64`.
+    pub lumens: Option<f64>,
+}
+
+impl LightReport {
+    /// The sidecar's entry for `light`.
+    pub fn of(light: &dyn spectrace_lights::LightSource) -> Self {
+        let watts = light.power();
+        let lumens = watts * spectrace_spectrum::luminous_efficacy(light.spd().as_ref());
+        let finite = |v: f64| v.is_finite().then_some(v);
+        Self { kind: light.typetag_name().to_owned(), watts: finite(watts), lumens: finite(lumens) }
+    }
 }
 
 /// The relative errors the sidecar predicts render times for (10%, 5%, 2%, 1%).
@@ -168,7 +194,7 @@ impl AccuracyEstimate {
     pub fn summary(&self) -> String {
         let Some(e) = self.relative_error else {
             return format!(
-                "error: no estimate ({} batches, need 2 and a lit image)",
+                "estimated error: none ({} batches; an estimate needs 2 and a lit image)",
                 self.batches
             );
         };
@@ -267,6 +293,7 @@ pub(crate) fn report(
         out_of_range_values: written.out_of_range_values,
         warnings,
         sensors: Vec::new(),
+        lights: Vec::new(),
         version: env!("CARGO_PKG_VERSION").to_owned(),
     }
 }

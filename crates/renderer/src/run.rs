@@ -13,7 +13,7 @@ use crate::measured::measure_choice;
 
 use crate::plan::scene_normalisation;
 use crate::progress::render_with_progress;
-use crate::report::report;
+use crate::report::{LightReport, report};
 use crate::say::tell;
 use crate::sensors::render_sensors;
 use crate::shard::write_part;
@@ -74,6 +74,11 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
     warnings.extend(estimate_warning);
     let effects = decide_effects(scene, options.effects);
     if options.verbose {
+        for (i, l) in scene.lights.lights().iter().enumerate() {
+            let r = LightReport::of(l.as_ref());
+            let (w, lm) = (r.watts.unwrap_or(f64::INFINITY), r.lumens.unwrap_or(f64::INFINITY));
+            tell!("lights[{i}]: {} of {w:.6} W, {lm:.2} lm", r.kind);
+        }
         tell!("{}", effects.summary());
         tell!("integrator: {reason}");
     }
@@ -213,7 +218,7 @@ fn probe_noting(
     verbose: bool,
 ) -> Result<ProbeOutcome, RenderError> {
     let probed = probe_with(scene, plan, tracer)?;
-    if verbose && !probed.lit {
+    if verbose && !probed.lit && !probed.dark {
         tell!(
             "note: the pre-render probe ran out of time after {} paths without seeing light reach \
              the camera; rendering anyway",
@@ -252,6 +257,7 @@ impl Finished<'_> {
             written,
         );
         r.integrator_reason = setup.reason.to_owned();
+        r.lights = scene.lights.lights().iter().map(|l| LightReport::of(l.as_ref())).collect();
         let error_decides = setup.plan.target_error.is_some();
         r.sampler =
             sampler_of(scene.settings.sampler, setup.choice, error_decides).name().to_owned();

@@ -104,8 +104,20 @@ pub(crate) fn integrator_warnings(scene: &Scene, choice: IntegratorChoice) -> Ve
     warnings
 }
 
-/// The warning for an image that came out black after an inconclusive probe.
+/// The warning for an image that came out black: a dark result, or after an inconclusive probe.
 pub(crate) fn black_image_warning(probed: &ProbeOutcome, output: &RenderOutput) -> Option<String> {
+    let black = || {
+        output.film.accepted() == 0
+            || output.film.to_xyz(1.0).iter().all(|p| p.x == 0.0 && p.y == 0.0 && p.z == 0.0)
+    };
+    if probed.dark && black() {
+        return Some(
+            "the camera sees no light: the image is dark, although light reaches the scene (a \
+             sensor records it, or it lands on surfaces the camera does not see or that reflect \
+             nothing)"
+                .to_owned(),
+        );
+    }
     (!probed.lit && output.film.accepted() == 0).then(|| {
         format!(
             "no light reached the camera: the image is black (the pre-render probe ran out of \

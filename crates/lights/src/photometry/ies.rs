@@ -17,8 +17,8 @@
 //!
 //! Numbers after the `TILT` line may be split over lines at will and separated by blanks or
 //! commas. Lumens per lamp of `-1` mean *absolute photometry* (the candela values are the
-//! luminaire's own, no lamp rating). Only photometry type C (1) is read: types A (3) and B (2)
-//! are refused with a message saying so. A `TILT=<file>` naming another file is refused (the
+//! luminaire's own, no lamp rating). Photometry types C (1) and B (2, floodlights: see
+//! [`IesFile::type_b_planes`]) are read; type A (3) is refused with a message saying so. A `TILT=<file>` naming another file is refused (the
 //! reader opens nothing); `TILT=INCLUDE` is read and kept.
 //!
 //! Checks, each an error naming the file, the line and the cause: a `TILT` line is required;
@@ -63,6 +63,18 @@ pub struct Tilt {
     pub factors: Vec<f64>,
 }
 
+/// The photometry type of a file (its goniometer's axes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Photometry {
+    /// Type C (1): a vertical polar axis through the luminaire; vertical angles from nadir,
+    /// horizontal angles the C planes about it (building luminaires).
+    C,
+    /// Type B (2): a horizontal polar axis across the luminaire; vertical angles turn the
+    /// measuring plane about it, horizontal angles are measured within the plane from the
+    /// photometric axis (floodlights).
+    B,
+}
+
 /// The luminous dimensions' unit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Units {
@@ -96,7 +108,10 @@ pub struct IesFile {
     pub ballast_factor: f64,
     /// Input power (W).
     pub input_watts: f64,
-    /// Vertical angles (degrees from nadir, type C), strictly increasing.
+    /// The photometry type: C (building luminaires) or B (floodlights).
+    pub photometry: Photometry,
+    /// Vertical angles (degrees), strictly increasing: from nadir for type C; for type B the
+    /// rotation of the measuring plane about the horizontal polar axis.
     pub vertical: Vec<f64>,
     /// Horizontal angles (degrees, the C-planes), strictly increasing.
     pub horizontal: Vec<f64>,
@@ -266,15 +281,13 @@ impl IesFile {
         let n_vertical = tokens.count("the number of vertical angles", MAX_ANGLES)?;
         let n_horizontal = tokens.count("the number of horizontal angles", MAX_ANGLES)?;
         let (kind, line) = tokens.number("the photometric type")?;
-        match kind {
-            1.0 => {}
-            2.0 | 3.0 => {
-                let name = if kind == 2.0 { "B" } else { "A" };
+        let photometry = match kind {
+            1.0 => Photometry::C,
+            2.0 => Photometry::B,
+            3.0 => {
                 return Err(err(
                     line,
-                    format!(
-                        "photometric type {kind} (type {name}): only type C (1, the goniometer of building luminaires) is supported"
-                    ),
+                    "photometric type 3 (type A): only types C (1) and B (2) are read".to_owned(),
                 ));
             }
             _ => {
@@ -283,7 +296,7 @@ impl IesFile {
                     format!("photometric type = {kind}: must be 1 (C), 2 (B) or 3 (A)"),
                 ));
             }
-        }
+        };
         let (u, line) = tokens.number("the units type")?;
         let units = match u {
             1.0 => Units::Feet,
@@ -305,37 +318,9 @@ impl IesFile {
         let horizontal = tokens.numbers("horizontal angle", n_horizontal)?;
         increasing(&vertical, "vertical angles", &err)?;
         increasing(&horizontal, "horizontal angles", &err)?;
-        for &(v, line) in &vertical {
-            if !(0.0..=180.0).contains(&v) {
-                return Err(err(
-                    line,
-                    format!("vertical angle {v}: type C vertical angles lie in [0, 180]"),
-                ));
-            }
-        }
-        for &(h, line) in &horizontal {
-            if !(0.0..=360.0).contains(&h) {
-                return Err(err(
-                    line,
-                    format!("horizontal angle {h}: type C horizontal angles lie in [0, 360]"),
-                ));
-            }
-        }
-        let (h0, h0_line) = horizontal[0];
-        let (hn, hn_line) = horizontal[n_horizontal - 1];
-        if !(h0 == 0.0 || (h0 == 90.0 && hn == 270.0)) {
-            return Err(err(
-                h0_line,
-                format!("first horizontal angle {h0}: must be 0 (or 90 for the range 90-270)"),
-            ));
-        }
-        if h0 == 0.0 && ![0.0, 90.0, 180.0, 360.0].contains(&hn) {
-            return Err(err(
-                hn_line,
-                format!(
-                    "last horizontal angle {hn}: must be 0 (axial symmetry), 90 (quadrants), 180 (bilateral) or 360 (none)"
-                ),
-            ));
+        match photometry {
+            Photometry::C => check_type_c(&vertical, &horizontal, &err)?,
+            Photometry::B => check_type_b(&vertical, &horizontal, &err)?,
         }
         let mut candela = Vec::with_capacity(n_horizontal);
         for (h, &(angle, _)) in horizontal.iter().enumerate() {
@@ -376,6 +361,7 @@ impl IesFile {
             dimensions: [width, length, height],
             ballast_factor,
             input_watts,
+            photometry,
             vertical: vertical.iter().map(|v| v.0).collect(),
             horizontal: horizontal.iter().map(|v| v.0).collect(),
             candela,
@@ -386,14 +372,142 @@ impl IesFile {
 impl IesFile {
     /// The table as [`CandelaPlanes`]: the angles and candela as stored (multiplier applied),
     /// `lamp_lumens` the lamps times their rated lumens (`None` for absolute photometry).
+    ///
+    /// A type B table is given as the type C table of the same distribution about its own
+    /// polar axis (see [`Self::type_b_planes`]); the light places that axis where a type C
+    /// file's nadir goes.
     pub fn candela_planes(&self) -> CandelaPlanes {
-        CandelaPlanes {
-            horizontal: self.horizontal.clone(),
-            vertical: self.vertical.clone(),
-            candela: self.candela.clone(),
-            lamp_lumens: self.lumens_per_lamp.map(|l| l * f64::from(self.lamps)),
+        let lamp_lumens = self.lumens_per_lamp.map(|l| l * f64::from(self.lamps));
+        match self.photometry {
+            Photometry::C => CandelaPlanes {
+                horizontal: self.horizontal.clone(),
+                vertical: self.vertical.clone(),
+                candela: self.candela.clone(),
+                lamp_lumens,
+            },
+            Photometry::B => {
+                let (horizontal, vertical, candela) = self.type_b_planes();
+                CandelaPlanes { horizontal, vertical, candela, lamp_lumens }
+            }
         }
     }
+
+    /// A type B table as type C planes about the polar axis: a direction of type B angles
+    /// `(H, V)` (`H` within the measuring plane from the photometric axis, `V` the plane's turn
+    /// about the polar axis) lies at `gamma' = 90 - H` from the axis, in the plane `C' = V` (`V`
+    /// below 0 as `360 + V`), the photometric axis being `C' = 0, gamma' = 90`. A table given
+    /// from 0 only is mirrored first. The unmeasured back half (`C'` from 90 to 270) is dark:
+    /// planes of zero just inside it (1e-6 degrees). The intensity stays bilinear in
+    /// `(C', cos gamma') = (V, sin H)`, the grid the measurement was made on, so the flux is
+    /// the file's exact zonal sum.
+    pub fn type_b_planes(&self) -> (Vec<f64>, Vec<f64>, Vec<Vec<f64>>) {
+        // Mirror a half table: rows over H, columns over V.
+        let mirror = |angles: &[f64]| -> Vec<f64> {
+            if angles[0] == 0.0 {
+                angles.iter().rev().map(|a| -a).chain(angles[1..].iter().copied()).collect()
+            } else {
+                angles.to_vec()
+            }
+        };
+        let source = |angles: &[f64], i: usize| -> usize {
+            if angles[0] == 0.0 { i.abs_diff(angles.len() - 1) } else { i }
+        };
+        let hs = mirror(&self.horizontal);
+        let vs = mirror(&self.vertical);
+        let value = |h: usize, v: usize| {
+            self.candela[source(&self.horizontal, h)][source(&self.vertical, v)]
+        };
+        // gamma' increasing: H from 90 down to -90.
+        let gammas: Vec<f64> = hs.iter().rev().map(|h| 90.0 - h).collect();
+        let column = |v: usize| -> Vec<f64> { (0..hs.len()).rev().map(|h| value(h, v)).collect() };
+        // The plane at V = 0, interpolated where the file has none.
+        let zero = vs.partition_point(|&v| v < 0.0);
+        let mut planes: Vec<(f64, Vec<f64>)> = Vec::new();
+        if vs[zero] != 0.0 {
+            let (a, b) = (zero - 1, zero);
+            let t = -vs[a] / (vs[b] - vs[a]);
+            let (ca, cb) = (column(a), column(b));
+            planes.push((0.0, ca.iter().zip(&cb).map(|(x, y)| x + t * (y - x)).collect()));
+        }
+        planes.extend((zero..vs.len()).map(|v| (vs[v], column(v))));
+        const EDGE: f64 = 1e-6;
+        planes.push((90.0 + EDGE, vec![0.0; gammas.len()]));
+        planes.push((270.0 - EDGE, vec![0.0; gammas.len()]));
+        planes.extend((0..zero).map(|v| (360.0 + vs[v], column(v))));
+        let (horizontal, candela) = planes.into_iter().unzip();
+        (horizontal, gammas, candela)
+    }
+}
+
+/// The type C angle ranges: vertical in [0, 180], horizontal in [0, 360], starting at 0 (or 90
+/// for the range 90-270) and ending where a symmetry allows.
+fn check_type_c(
+    vertical: &[(f64, usize)],
+    horizontal: &[(f64, usize)],
+    err: &impl Fn(usize, String) -> PhotometryError,
+) -> Result<(), PhotometryError> {
+    let n_horizontal = horizontal.len();
+    for &(v, line) in vertical {
+        if !(0.0..=180.0).contains(&v) {
+            return Err(err(
+                line,
+                format!("vertical angle {v}: type C vertical angles lie in [0, 180]"),
+            ));
+        }
+    }
+    for &(h, line) in horizontal {
+        if !(0.0..=360.0).contains(&h) {
+            return Err(err(
+                line,
+                format!("horizontal angle {h}: type C horizontal angles lie in [0, 360]"),
+            ));
+        }
+    }
+    let (h0, h0_line) = horizontal[0];
+    let (hn, hn_line) = horizontal[n_horizontal - 1];
+    if !(h0 == 0.0 || (h0 == 90.0 && hn == 270.0)) {
+        return Err(err(
+            h0_line,
+            format!("first horizontal angle {h0}: must be 0 (or 90 for the range 90-270)"),
+        ));
+    }
+    if h0 == 0.0 && ![0.0, 90.0, 180.0, 360.0].contains(&hn) {
+        return Err(err(
+            hn_line,
+            format!(
+                "last horizontal angle {hn}: must be 0 (axial symmetry), 90 (quadrants), 180 (bilateral) or 360 (none)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The type B angle ranges: both within [-90, 90], each starting at -90 (or at 0 for a table
+/// symmetric about its plane 0) and ending at 90.
+fn check_type_b(
+    vertical: &[(f64, usize)],
+    horizontal: &[(f64, usize)],
+    err: &impl Fn(usize, String) -> PhotometryError,
+) -> Result<(), PhotometryError> {
+    for (values, what) in [(vertical, "vertical"), (horizontal, "horizontal")] {
+        let (first, line) = values[0];
+        let (last, last_line) = values[values.len() - 1];
+        if !(first == -90.0 || first == 0.0) {
+            return Err(err(
+                line,
+                format!(
+                    "first {what} angle {first}: type B {what} angles start at -90 (or 0 for a symmetric table)"
+                ),
+            ));
+        }
+        if last != 90.0 {
+            return Err(err(
+                last_line,
+                format!("last {what} angle {last}: type B {what} angles end at 90"),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Checks that `values` strictly increase, naming the first that does not.

@@ -6,8 +6,8 @@
 //! |---|---|---|---|
 //! | `file` | path | required | the photometric file, relative to the scene file's folder |
 //! | `position` | m | required | the luminaire's photometric centre |
-//! | `nadir` | | `[0, -1, 0]` | direction of vertical angle 0 (straight down from the luminaire) |
-//! | `c0` | | `[1, 0, 0]` | direction of C-plane 0 (made perpendicular to `nadir`; must not be parallel to it) |
+//! | `nadir` | | `[0, -1, 0]` | direction of vertical angle 0 (straight down from the luminaire); for an IES type B file, the photometric axis |
+//! | `c0` | | `[1, 0, 0]` | direction of C-plane 0 (made perpendicular to `nadir`; must not be parallel to it); for an IES type B file, the `H = +90` end of the polar axis |
 //! | `spd` | SPD | see below | spectrum of the light |
 //! | `cct` | K | | instead of `spd`: a blackbody at this colour temperature |
 //! | `multiplier` | | 1 | scales every candela value (and so the flux) |
@@ -640,7 +640,13 @@ impl IesLight {
         sampling: WavelengthSampling,
     ) -> Result<Self, LightError> {
         let planes = ies.candela_planes();
-        let (luminaire, repr) = Luminaire::placed(
+        // A type B table's planes turn about its horizontal polar axis, `c0`; its photometric
+        // axis, where a type C table's nadir is, is `nadir`.
+        let placement = match ies.photometry {
+            super::Photometry::C => placement,
+            super::Photometry::B => (placement.0, placement.2, placement.1),
+        };
+        let (luminaire, mut repr) = Luminaire::placed(
             "IesLight",
             (&planes, ies.ballast_factor),
             placement,
@@ -648,6 +654,10 @@ impl IesLight {
             scale,
             sampling,
         )?;
+        if ies.photometry == super::Photometry::B {
+            // The scene-file form keeps the keys as given.
+            std::mem::swap(&mut repr.nadir, &mut repr.c0);
+        }
         Ok(Self { luminaire, repr: Arc::new(repr), file: Arc::new(ies), notes: Arc::new([]) })
     }
 

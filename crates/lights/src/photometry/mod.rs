@@ -13,7 +13,7 @@ mod ies;
 mod ldt;
 mod luminaire;
 
-pub use ies::{IesFile, IesVersion, MAX_ANGLES, Tilt, Units};
+pub use ies::{IesFile, IesVersion, MAX_ANGLES, Photometry, Tilt, Units};
 pub use ldt::{LampSet, LdtFile, LdtSymmetry, MAX_LAMP_SETS};
 pub use luminaire::{CandelaDistribution, EulumdatLight, IesLight, MAX_PHOTOMETRIC_BYTES};
 
