@@ -14,16 +14,7 @@ use crate::rendering::temp_dir;
 
 /// `../shared/realworld/scenes` beside the workspace, if present.
 fn realworld_scenes() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/realworld/scenes");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!(
-            "skipped: {} is absent (the real scenes live outside the repository)",
-            dir.display()
-        );
-        None
-    }
+    crate::rendering::realworld("scenes")
 }
 
 /// Writes `files` (name, text) into a fresh folder and returns the first one's path.

@@ -14,16 +14,7 @@ use crate::rendering::temp_dir;
 
 /// `../shared/realworld/photometry/files` beside the workspace, if present.
 fn realworld_photometry() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/realworld/photometry/files");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!(
-            "skipped: {} is absent (the real files live outside the repository)",
-            dir.display()
-        );
-        None
-    }
+    crate::rendering::realworld("photometry/files")
 }
 
 /// The flux (lm) of a table, integrated independently of the light: per C plane the exact

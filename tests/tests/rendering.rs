@@ -15,6 +15,21 @@ use spectrace_renderer::{
 use spectrace_spectrum::{CIE_Y_INTEGRAL, SpectralPowerDistribution, Uniform, xyz_of};
 use spectrace_tracer::{Integrator, IntegratorChoice, LightTracer, RenderOutput, render};
 
+/// `../shared/realworld/<sub>` beside the workspace (files people outside the project wrote,
+/// kept out of the repository), if present; a test that needs it skips, saying so, without it.
+pub(crate) fn realworld(sub: &str) -> Option<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/realworld").join(sub);
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        eprintln!(
+            "skipped: {} is absent (the real files live outside the repository)",
+            dir.display()
+        );
+        None
+    }
+}
+
 /// A fresh, empty folder for one test's files (also used by the hostile-input tests).
 pub(crate) fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("spectrace-test-{}-{name}", std::process::id()));
