@@ -41,6 +41,7 @@ mod beam;
 mod counter;
 mod error;
 mod geometry;
+mod glare;
 mod laser;
 pub mod photometry;
 mod set;
@@ -52,8 +53,9 @@ pub use area::{DiskLight, RectangleLight};
 pub use beam::{Beam, LightId};
 pub use counter::BeamCounter;
 pub use error::LightError;
+pub use glare::{GlareView, LuminousOpening};
 pub use laser::Laser;
-pub use photometry::{EulumdatLight, IesLight};
+pub use photometry::{EulumdatLight, IesLight, LuminaireLumens};
 pub use set::LightSet;
 pub use sky::Sky;
 pub use source::{

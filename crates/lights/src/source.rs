@@ -10,7 +10,8 @@ use serde::{Deserialize, Serialize};
 use spectrace_sampling::PiecewiseConstant;
 use spectrace_spectrum::{SpectralPowerDistribution, cmf, integrate_panels, luminous_efficacy};
 
-use crate::{Beam, BeamCounter, LightError};
+use crate::photometry::LuminaireLumens;
+use crate::{Beam, BeamCounter, GlareView, LightError};
 
 /// A light source as a beam generator (seed section 2).
 ///
@@ -233,6 +234,26 @@ pub trait LightSource: Send + Sync + Debug {
     /// camera rays (with [`emitted_radiance`](Self::emitted_radiance)) and blocking light. `None`
     /// (the default) for lights without one (points, parallel beams).
     fn surface(&self) -> Option<LightSurface> {
+        None
+    }
+
+    /// For a measured luminaire: the flux of its candela table against its lamps' rated flux
+    /// and its light output ratio (see [`LuminaireLumens`] for the definitions), for a
+    /// renderer to print and record. `None` (the default) for lights that are not measured
+    /// luminaires; [`crate::IesLight`] and [`crate::EulumdatLight`] return theirs.
+    fn photometric_summary(&self) -> Option<LuminaireLumens> {
+        None
+    }
+
+    /// What an eye at `eye` sees of the light, for a glare rating (CIE 117-1995's `L` and
+    /// `omega`, see [`GlareView`]): the luminance and solid angle of its luminous parts. `None`
+    /// (the default) for lights that do not say, for the eye at the light, for luminous parts
+    /// of no projected area that way (a point source has no luminance; a flat opening seen
+    /// edge-on or from its dark side shows none), or when nothing finite results.
+    /// [`crate::IesLight`] and [`crate::EulumdatLight`] answer from the luminous opening of
+    /// their file ([`crate::LuminousOpening`]).
+    fn glare_view(&self, eye: DVec3) -> Option<GlareView> {
+        let _ = eye;
         None
     }
 }

@@ -33,6 +33,7 @@
 //! line ends, a trailing ^Z dropped).
 
 use super::{CandelaPlanes, PhotometryError};
+use crate::glare::LuminousOpening;
 
 /// Most angles along either axis of a candela table.
 pub const MAX_ANGLES: usize = 4096;
@@ -369,7 +370,98 @@ impl IesFile {
     }
 }
 
+/// Metres per foot (units type 1).
+const METRES_PER_FOOT: f64 = 0.3048;
+
 impl IesFile {
+    /// The luminous opening the file's width, length and height describe, in metres; `None`
+    /// for a point source (`0 0 0`), for a combination of signs the file's version does not
+    /// define, or for a dimension that is not finite.
+    ///
+    /// **Axes.** LM-63 measures type C horizontal angles from the *photometric horizontal*,
+    /// "a horizontal direction from photometric center that is coincident with horizontal
+    /// angle 0 and vertical angle 90" (LM-63-2002, section 3); the *length* lies along it (the
+    /// 0-180 degree plane: the shape LM-63-2002 calls "horizontal cylinder along photometric
+    /// horizontal" takes its axis from the length; the 0 degree axis "is oriented parallel to
+    /// the length of the luminaire", as Autodesk's IES documentation puts it; Radiance's
+    /// ies2rad lays the length along its `x` axis, horizontal angle 0), the *width* across it
+    /// (along the 90-270 degree plane) and the *height* vertically. For type B files
+    /// (floodlights) the same frame is taken about the photometric axis (horizontal and
+    /// vertical angle 0, the opening's normal) and the photometric horizontal (horizontal
+    /// angle 0, vertical angle 90), the width lying along the polar axis: a reading of ours,
+    /// the standard naming no axes for them.
+    ///
+    /// **Shapes** (`w`, `l`, `h` the signed width, length and height; `W`, `L`, `H` their
+    /// magnitudes; feet converted at 0.3048 m). LM-63-2002 and LM-63-2019 (Table 1, "luminous
+    /// opening shapes"):
+    ///
+    /// | `w l h` | shape | [`LuminousOpening`] |
+    /// |---|---|---|
+    /// | `0 0 0` | point | `None` |
+    /// | `+ + 0` | rectangular | `Box` of heights 0 |
+    /// | `+ + +` | rectangular with luminous sides | `Box`, every side `H` |
+    /// | `- - 0` | circular (`w = l`) or ellipse | `Cylinder` of heights 0 |
+    /// | `- - +` | vertical cylinder or vertical ellipsoidal cylinder | `Cylinder`, heights `H` |
+    /// | `- - -` | sphere or ellipsoidal spheroid | `Ellipsoid` |
+    /// | `- + -` | horizontal (ellipsoidal) cylinder along photometric horizontal | `CylinderAlongC0` |
+    /// | `+ - -` | horizontal (ellipsoidal) cylinder perpendicular to photometric horizontal | `CylinderAlongC90` |
+    /// | `- 0 -` | vertical circle or ellipse facing photometric horizontal | `VerticalEllipse` |
+    ///
+    /// Also read, as Radiance's ies2rad does: `0 + +` and `+ 0 +`, vertical rectangles (`Box`
+    /// with a zero length or width). The earlier versions (LM-63-1986, -1991 and -1995) wrote
+    /// round shapes with a zero length; they are read as ies2rad reads LM-63-1995: `- 0 0` a
+    /// disk and `- 0 +` a vertical cylinder of diameter `W`, `- 0 -` a sphere of diameter `W`,
+    /// `0 + -` a horizontal cylinder along the photometric horizontal (length `L`, diameter
+    /// `H`), `+ 0 -` one perpendicular to it (length `W`, diameter `H`), `+ - +` and `- + +`
+    /// vertical elliptic cylinders, `+ - -` and `- + -` ellipsoids, and `- + 0` an ellipse.
+    /// Signs one table leaves unused are read as the other defines them (files in the wild
+    /// write `- 0 0` disks under a 2002 version line); where the tables disagree (`- 0 -`,
+    /// `+ - -`, `- + -`) the file's version line decides.
+    pub fn luminous_opening(&self) -> Option<LuminousOpening> {
+        let scale = match self.units {
+            Units::Feet => METRES_PER_FOOT,
+            Units::Metres => 1.0,
+        };
+        let [w, l, h] = self.dimensions.map(|d| d * scale);
+        if ![w, l, h].iter().all(|d| d.is_finite()) {
+            return None;
+        }
+        let (width, length, height) = (w.abs(), l.abs(), h.abs());
+        let sign = |d: f64| -> i8 {
+            if d > 0.0 {
+                1
+            } else if d < 0.0 {
+                -1
+            } else {
+                0
+            }
+        };
+        let modern = matches!(self.version, IesVersion::Lm63_2002 | IesVersion::Lm63_2019);
+        let opening = match (sign(w), sign(l), sign(h)) {
+            (0, 0, 0) => return None,
+            (0..=1, 0..=1, 0..=1) => LuminousOpening::Box { length, width, heights: [height; 4] },
+            (-1, -1, 0..=1) => LuminousOpening::Cylinder { length, width, heights: [height; 4] },
+            (-1, -1, -1) => LuminousOpening::Ellipsoid { length, width, height },
+            (-1, 0, 0..=1) => {
+                LuminousOpening::Cylinder { length: width, width, heights: [height; 4] }
+            }
+            (-1, 1, -1) if modern => LuminousOpening::CylinderAlongC0 { length, width, height },
+            (1, -1, -1) if modern => LuminousOpening::CylinderAlongC90 { length, width, height },
+            (-1, 0, -1) if modern => LuminousOpening::VerticalEllipse { width, height },
+            // LM-63-1986, -1991 and -1995, as Radiance's ies2rad reads them.
+            (-1, 0, -1) => LuminousOpening::Ellipsoid { length: width, width, height: width },
+            (0, 1, -1) => LuminousOpening::CylinderAlongC0 { length, width: height, height },
+            (1, 0, -1) => LuminousOpening::CylinderAlongC90 { length: height, width, height },
+            (1, -1, 1) | (-1, 1, 1) => {
+                LuminousOpening::Cylinder { length, width, heights: [height; 4] }
+            }
+            (1, -1, -1) | (-1, 1, -1) => LuminousOpening::Ellipsoid { length, width, height },
+            (-1, 1, 0) => LuminousOpening::Cylinder { length, width, heights: [0.0; 4] },
+            _ => return None,
+        };
+        Some(opening).filter(LuminousOpening::is_valid)
+    }
+
     /// The table as [`CandelaPlanes`]: the angles and candela as stored (multiplier applied),
     /// `lamp_lumens` the lamps times their rated lumens (`None` for absolute photometry).
     ///

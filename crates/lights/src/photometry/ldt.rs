@@ -68,6 +68,7 @@
 //! The text is read as [`super::decode_text`] gives it (UTF-8 or Windows-1252, any line ends).
 
 use super::{CandelaPlanes, MAX_ANGLES, PhotometryError};
+use crate::glare::LuminousOpening;
 
 /// Most lamp sets a file may declare (line 26).
 pub const MAX_LAMP_SETS: usize = 20;
@@ -479,6 +480,23 @@ impl LdtFile {
     /// when that set is fitted; `None` past the last set.
     pub fn set_flux(&self, set: usize) -> Option<f64> {
         self.lamp_sets.get(set).map(|s| s.flux)
+    }
+
+    /// The luminous area (lines 16-21), in metres: `None` when every dimension is 0 (a point)
+    /// or one is negative. Its *length* (line 16) lies along the C0-C180 plane and its *width*
+    /// (line 17) along C90-C270; a width of 0 makes it round, of diameter the length (a
+    /// [`LuminousOpening::Cylinder`]), else it is a rectangle (a [`LuminousOpening::Box`]). The
+    /// heights of lines 18-21 are those of its luminous sides seen in the planes C0, C90, C180
+    /// and C270 (for a round area, of the quarters of its rim centred on them).
+    pub fn luminous_opening(&self) -> Option<LuminousOpening> {
+        let [length, width] = self.luminous_area_mm.map(|d| d / 1000.0);
+        let heights = self.luminous_heights_mm.map(|d| d / 1000.0);
+        let opening = if width == 0.0 {
+            LuminousOpening::Cylinder { length, width: length, heights }
+        } else {
+            LuminousOpening::Box { length, width, heights }
+        };
+        Some(opening).filter(LuminousOpening::is_valid)
     }
 
     /// The stored C angles (degrees): the planes `intensities` holds, in the IES ranges

@@ -53,9 +53,22 @@
 //! EULUMDAT files the blackbody at the first lamp set's colour temperature when that is a
 //! number of kelvin. The colour does not change with direction.
 //!
+//! # Lamps, light output ratio and glare
+//! [`IesLight::lumens_summary`] and [`EulumdatLight::lumens_summary`] (and, through a
+//! `dyn LightSource`, [`LightSource::photometric_summary`]) compare the table's flux with the
+//! lamps' rated flux: [`LuminaireLumens`] defines each number. [`LightSource::glare_view`] gives
+//! what an eye sees of the luminaire for CIE 117's Unified Glare Rating: the luminous
+//! intensity towards the eye over the projected area of the file's luminous opening
+//! ([`crate::GlareView`], [`LuminousOpening`], [`IesFile::luminous_opening`],
+//! [`LdtFile::luminous_opening`]). A file of opening `0 0 0` (a point) gives no view. The
+//! horizontal face of a flat or box-shaped opening counts on the side(s) the table sends light
+//! to: seen from below when some measured value below the horizontal is positive, from above
+//! when some value above it is (an uplight); a type B table's opening faces its photometric
+//! axis.
+//!
 //! # What is not modelled
-//! The luminaire is a point (far-field photometry): its luminous opening's dimensions are read
-//! but not used, so illuminance closer than about five opening sizes is that of the point.
+//! The luminaire emits from a point (far-field photometry): its luminous opening serves the
+//! glare view only, so illuminance closer than about five opening sizes is that of the point.
 //! `TILT=INCLUDE` data are read but not applied (the luminaire is taken at its measured tilt).
 
 use std::f64::consts::TAU;
@@ -69,6 +82,7 @@ use spectrace_sampling::PiecewiseBilinear;
 use spectrace_spectrum::{Blackbody, CieIlluminant, SpectralPowerDistribution, watts_from_lumens};
 
 use crate::geometry::{finite_point, unit_direction};
+use crate::glare::{LuminousOpening, PlacedOpening, lit_faces};
 use crate::source::uniform;
 use crate::spot::{point_emission, point_sample};
 use crate::{
@@ -247,6 +261,11 @@ impl Orientation {
         Ok(Self { nadir, c0, c90: c0.cross(nadir) })
     }
 
+    /// The world directions of C0, C90 and the nadir: the frame of a type C opening.
+    pub(crate) fn axes(&self) -> [DVec3; 3] {
+        [self.c0, self.c90, self.nadir]
+    }
+
     /// The world direction of `(C, cos gamma)`.
     fn direction(&self, c: f64, cos_gamma: f64) -> DVec3 {
         let sin_gamma = (1.0 - cos_gamma * cos_gamma).max(0.0).sqrt();
@@ -268,6 +287,8 @@ pub(crate) struct Luminaire {
     pub(crate) position: DVec3,
     pub(crate) orientation: Orientation,
     pub(crate) distribution: Arc<CandelaDistribution>,
+    /// Flux (lm) of the file's table at its own scale (see [`LuminaireLumens::file_lumens`]).
+    pub(crate) file_lumens: f64,
 }
 
 impl Luminaire {
@@ -292,7 +313,8 @@ impl Luminaire {
             )
         })?;
         let emission = SpdLight::new(light, spd, power, sampling)?;
-        Ok(Self { emission, position, orientation, distribution: Arc::new(distribution) })
+        let distribution = Arc::new(distribution);
+        Ok(Self { emission, position, orientation, distribution, file_lumens: lumens })
     }
 
     /// A luminaire of the stored table `planes.0` with every value times `planes.1` (a file's
@@ -309,6 +331,8 @@ impl Luminaire {
         let multiplier = check_multiplier(light, scale.multiplier)?;
         let orientation = Orientation::new(light, nadir, c0)?;
         let mut distribution = distribution_of(light, planes.0, multiplier * planes.1)?;
+        // Flux is linear in the table, and the factor is > 0 (a zero one leaves no table).
+        let file_lumens = distribution.lumens() / (multiplier * planes.1);
         if let Some(lumens) = scale.lumens {
             if multiplier != 1.0 {
                 return Err(LightError::parameter(
@@ -330,8 +354,9 @@ impl Luminaire {
             let factor = planes.1 * lumens / distribution.lumens();
             distribution = distribution_of(light, planes.0, factor)?;
         }
-        let luminaire =
+        let mut luminaire =
             Self::new(light, position, orientation, distribution, spd.clone(), sampling)?;
+        luminaire.file_lumens = file_lumens;
         let repr = LuminaireRepr {
             file: PathBuf::new(),
             position,
@@ -414,9 +439,83 @@ impl Luminaire {
     }
 }
 
-/// The inherent accessors of a type holding a [`Luminaire`] in the field `luminaire`.
+/// A measured luminaire's luminous flux against its lamps' ([`IesLight::lumens_summary`],
+/// [`EulumdatLight::lumens_summary`], [`LightSource::photometric_summary`]). Its
+/// [`Display`](std::fmt::Display) reads `table 2340.5 lm, lamps 2 x 1500 lm = 3000 lm, LOR 0.780`
+/// (with a EULUMDAT file, ` (file states 0.780)` after it).
+///
+/// Definitions, with `flux(T)` the luminous flux of a candela table `T` (its integral over the
+/// sphere, interpolated as the module documentation says):
+/// - `table_lumens = flux(the light's table)`: what the light emits, every factor applied (an
+///   IES file's candela multiplier and ballast factor, EULUMDAT's set flux / 1000, the scene's
+///   `multiplier`, or the scene's `lumens` itself): [`IesLight::lumens`].
+/// - `file_lumens = flux(the file's table at its own scale)`: IES candela values times the
+///   file's candela multiplier (not its ballast factor, nor the scene's factors); EULUMDAT
+///   cd/klm times the fitted lamp set's flux / 1000.
+/// - `lamp_lumens`: the rated flux of the lamps the table is relative to, IES `lamps x
+///   lumens per lamp`, EULUMDAT the fitted set's total flux; `None` for absolute photometry
+///   (IES lumens per lamp `-1`, EULUMDAT negative lamp counts), where the table is the
+///   luminaire's own measurement and no lamp is rated.
+/// - `light_output_ratio = file_lumens / lamp_lumens` (a fraction, the luminaire's LOR: the
+///   share of its lamps' flux that leaves it). The ballast factor scales the lamps and the
+///   luminaire alike, so it is left out of both; so are the scene's factors.
+/// - `stated_light_output_ratio`: EULUMDAT only, the file's own LORL (line 23) / 100, to compare
+///   with the computed one (a file whose two disagree was written with another table or lamp
+///   flux); `None` for IES files, which state none.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LuminaireLumens {
+    /// Flux (lm) the light emits: its candela table with every factor applied.
+    pub table_lumens: f64,
+    /// Flux (lm) of the file's table at its own scale (see the type's documentation).
+    pub file_lumens: f64,
+    /// Number of lamps: the IES file's count, or the fitted EULUMDAT set's (its magnitude).
+    pub lamp_count: u32,
+    /// Rated flux (lm) of all the lamps together; `None` for absolute photometry.
+    pub lamp_lumens: Option<f64>,
+    /// `file_lumens / lamp_lumens` (fraction); `None` for absolute photometry.
+    pub light_output_ratio: Option<f64>,
+    /// The light output ratio a EULUMDAT file states (LORL / 100, fraction); `None` for IES.
+    pub stated_light_output_ratio: Option<f64>,
+}
+
+impl std::fmt::Display for LuminaireLumens {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        /// Lumens to 0.1 lm, without a trailing `.0`.
+        fn lm(x: f64) -> f64 {
+            (x * 10.0).round() / 10.0
+        }
+        write!(f, "table {} lm", lm(self.table_lumens))?;
+        match (self.lamp_lumens, self.light_output_ratio) {
+            (Some(lamps), Some(lor)) => {
+                let each = lamps / f64::from(self.lamp_count.max(1));
+                write!(
+                    f,
+                    ", lamps {} x {} lm = {} lm, LOR {lor:.3}",
+                    self.lamp_count,
+                    lm(each),
+                    lm(lamps)
+                )?;
+            }
+            _ => write!(f, ", absolute photometry (no rated lamp flux)")?,
+        }
+        if let Some(stated) = self.stated_light_output_ratio {
+            write!(f, " (file states {stated:.3})")?;
+        }
+        Ok(())
+    }
+}
+
+/// The inherent accessors of a type holding a [`Luminaire`] in the field `luminaire` and a
+/// [`PlacedOpening`] in the field `opening`.
 macro_rules! luminaire_accessors {
     () => {
+        /// The luminous opening the file describes (metres, in the luminaire's frame: see
+        /// [`LuminousOpening`]); `None` for a point source or a shape the file does not
+        /// define. Only [`LightSource::glare_view`] uses it: the light emits from its centre.
+        pub fn luminous_opening(&self) -> Option<LuminousOpening> {
+            self.opening.opening()
+        }
+
         /// The candela distribution (absolute, every multiplier applied).
         pub fn distribution(&self) -> &CandelaDistribution {
             &self.luminaire.distribution
@@ -435,8 +534,9 @@ macro_rules! luminaire_accessors {
     };
 }
 
-/// Implements the beam and density methods of [`LightSource`] for a type holding a
-/// [`Luminaire`] in the field `luminaire`.
+/// Implements the beam, density, summary and glare methods of [`LightSource`] for a type
+/// holding a [`Luminaire`] in the field `luminaire`, a [`PlacedOpening`] in `opening` and an
+/// inherent `lumens_summary`.
 macro_rules! luminaire_light_source {
     () => {
         fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
@@ -484,6 +584,12 @@ macro_rules! luminaire_light_source {
         fn pdf_emission(&self, _position: DVec3, direction: DVec3) -> Option<(f64, f64)> {
             Some((1.0, self.luminaire.pdf_direction(direction)))
         }
+        fn photometric_summary(&self) -> Option<LuminaireLumens> {
+            Some(self.lumens_summary())
+        }
+        fn glare_view(&self, eye: DVec3) -> Option<crate::GlareView> {
+            self.opening.view(self.luminaire.position, eye, |d| self.candela_towards(d))
+        }
     };
 }
 
@@ -497,6 +603,7 @@ pub struct IesLight {
     repr: Arc<LuminaireRepr>,
     file: Arc<IesFile>,
     notes: Arc<[String]>,
+    opening: PlacedOpening,
 }
 
 /// Scene-file form of [`IesLight`] and [`EulumdatLight`].
@@ -654,16 +761,49 @@ impl IesLight {
             scale,
             sampling,
         )?;
-        if ies.photometry == super::Photometry::B {
-            // The scene-file form keeps the keys as given.
-            std::mem::swap(&mut repr.nadir, &mut repr.c0);
-        }
-        Ok(Self { luminaire, repr: Arc::new(repr), file: Arc::new(ies), notes: Arc::new([]) })
+        // The opening's frame: C0, C90, nadir for type C; for type B the photometric
+        // horizontal, the polar axis and the photometric axis (see `IesFile::luminous_opening`):
+        // the orientation's C90, nadir and C0 (its nadir is the polar axis, its C0 the
+        // photometric axis). A type B table is dark behind its photometric axis.
+        let [c0, c90, nadir] = luminaire.orientation.axes();
+        let opening = match ies.photometry {
+            super::Photometry::C => {
+                let (lower, upper) = lit_faces(&ies.vertical, &ies.candela);
+                PlacedOpening::new(ies.luminous_opening(), [c0, c90, nadir], lower, upper)
+            }
+            super::Photometry::B => {
+                // The scene-file form keeps the keys as given.
+                std::mem::swap(&mut repr.nadir, &mut repr.c0);
+                PlacedOpening::new(ies.luminous_opening(), [c90, nadir, c0], true, false)
+            }
+        };
+        Ok(Self {
+            luminaire,
+            repr: Arc::new(repr),
+            file: Arc::new(ies),
+            notes: Arc::new([]),
+            opening,
+        })
     }
 
     /// The parsed file.
     pub fn file(&self) -> &IesFile {
         &self.file
+    }
+
+    /// The luminaire's flux against its lamps' (see [`LuminaireLumens`]): lamp lumens
+    /// `lamps x lumens per lamp`, no stated light output ratio.
+    pub fn lumens_summary(&self) -> LuminaireLumens {
+        let lamp_lumens = self.file.lumens_per_lamp.map(|l| l * f64::from(self.file.lamps));
+        let file_lumens = self.luminaire.file_lumens;
+        LuminaireLumens {
+            table_lumens: self.lumens(),
+            file_lumens,
+            lamp_count: self.file.lamps,
+            lamp_lumens,
+            light_output_ratio: lamp_lumens.map(|l| file_lumens / l),
+            stated_light_output_ratio: None,
+        }
     }
 
     luminaire_accessors!();
@@ -697,6 +837,9 @@ pub struct EulumdatLight {
     repr: Arc<LuminaireRepr>,
     file: Arc<LdtFile>,
     notes: Arc<[String]>,
+    opening: PlacedOpening,
+    /// The fitted lamp set, 0-based.
+    lamp_set: usize,
 }
 
 /// The colour temperature (K) of a EULUMDAT lamp set, when its text is a number of kelvin
@@ -793,13 +936,44 @@ impl EulumdatLight {
         })?;
         let (luminaire, repr) =
             Luminaire::placed("EulumdatLight", (&planes, 1.0), placement, spd, scale, sampling)?;
+        let (lower, upper) = lit_faces(&ldt.gamma_angles, &ldt.intensities);
+        let opening =
+            PlacedOpening::new(ldt.luminous_opening(), luminaire.orientation.axes(), lower, upper);
         let file = Arc::new(ldt);
-        Ok(Self { luminaire, repr: Arc::new(repr), file, notes: Arc::new([]) })
+        Ok(Self {
+            luminaire,
+            repr: Arc::new(repr),
+            file,
+            notes: Arc::new([]),
+            opening,
+            lamp_set: set,
+        })
     }
 
     /// The parsed file.
     pub fn file(&self) -> &LdtFile {
         &self.file
+    }
+
+    /// The fitted lamp set (0-based: the scene file's `lamp_set` minus 1).
+    pub fn lamp_set(&self) -> usize {
+        self.lamp_set
+    }
+
+    /// The luminaire's flux against its lamps' (see [`LuminaireLumens`]): lamp lumens the
+    /// fitted set's flux, and the file's stated LORL.
+    pub fn lumens_summary(&self) -> LuminaireLumens {
+        let set = self.file.lamp_sets.get(self.lamp_set);
+        let lamp_lumens = set.map(|s| s.flux).filter(|_| !self.file.is_absolute());
+        let file_lumens = self.luminaire.file_lumens;
+        LuminaireLumens {
+            table_lumens: self.lumens(),
+            file_lumens,
+            lamp_count: set.map_or(0, |s| s.lamps.unsigned_abs()),
+            lamp_lumens,
+            light_output_ratio: lamp_lumens.map(|l| file_lumens / l),
+            stated_light_output_ratio: Some(self.file.light_output_ratio / 100.0),
+        }
     }
 
     luminaire_accessors!();

@@ -13,9 +13,14 @@ mod ies;
 mod ldt;
 mod luminaire;
 
+/// The luminous opening shape the readers give ([`IesFile::luminous_opening`],
+/// [`LdtFile::luminous_opening`]), also at the crate root.
+pub use crate::glare::LuminousOpening;
 pub use ies::{IesFile, IesVersion, MAX_ANGLES, Photometry, Tilt, Units};
 pub use ldt::{LampSet, LdtFile, LdtSymmetry, MAX_LAMP_SETS};
-pub use luminaire::{CandelaDistribution, EulumdatLight, IesLight, MAX_PHOTOMETRIC_BYTES};
+pub use luminaire::{
+    CandelaDistribution, EulumdatLight, IesLight, LuminaireLumens, MAX_PHOTOMETRIC_BYTES,
+};
 
 /// Where a photometric file went wrong: the file's name as given, the line (1-based) and the
 /// cause.
