@@ -10,6 +10,7 @@ mod import;
 mod integrators;
 mod kernels;
 mod measured_auto;
+mod observers;
 mod photometry;
 mod real_luminaires;
 mod rendering;

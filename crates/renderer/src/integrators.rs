@@ -67,36 +67,21 @@ pub fn with_integrator<R>(
     effects: Effects,
     f: impl FnOnce(&dyn Integrator) -> R,
 ) -> R {
-    with_integrator_filling(scene, choice, effects, true, f)
+    with_kernel(scene, choice, effects, (scene.settings.kernel, false), f)
 }
 
-/// As [`with_integrator`]; with `sensors` false the light tracer leaves the scene's sensors
-/// alone (a shard's part holds the image only).
-pub fn with_integrator_filling<R>(
-    scene: &Scene,
-    choice: IntegratorChoice,
-    effects: Effects,
-    sensors: bool,
-    f: impl FnOnce(&dyn Integrator) -> R,
-) -> R {
-    with_kernel(scene, choice, effects, sensors, (scene.settings.kernel, false), f)
-}
-
-/// As [`with_integrator_filling`], with the path tracer's camera paths traced by `kernel`, and
+/// As [`with_integrator`], with the path tracer's camera paths traced by `kernel`, and
 /// `settings.sampler` resolved knowing whether the error estimate decides the stop
 /// ([`sampler_of`]).
 pub(crate) fn with_kernel<R>(
     scene: &Scene,
     choice: IntegratorChoice,
     effects: Effects,
-    sensors: bool,
     (kernel, error_decides): (Kernel, bool),
     f: impl FnOnce(&dyn Integrator) -> R,
 ) -> R {
-    let none = spectrace_tracer::SensorSet::default();
     let sampler = sampler_of(scene.settings.sampler, choice, error_decides);
     let tracer_scene = tracer_scene(scene).with_sampler(sampler);
-    let tracer_scene = if sensors { tracer_scene } else { tracer_scene.with_sensors(&none) };
     let mut settings = integrator_settings(scene);
     settings.path.kernel = kernel;
     let integrator = build_integrator(choice, &tracer_scene, &settings, effects);

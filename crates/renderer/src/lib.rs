@@ -40,9 +40,11 @@ mod files;
 mod import;
 mod integrators;
 pub mod measured;
+mod observers;
 mod options;
 mod output;
 mod part;
+mod part_receivers;
 pub mod pilot;
 mod plan;
 mod probe;
@@ -69,28 +71,36 @@ pub use files::{
 pub use import::{
     ImportError, ImportNote, Imported, import_mitsuba, import_mitsuba_with, is_mitsuba_scene,
 };
-pub use integrators::{tracer_scene, with_integrator, with_integrator_filling};
+pub use integrators::{tracer_scene, with_integrator};
+pub use observers::{
+    GlareTerm, ObservedLux, ObserverReport, guth_position_index, observer_summary,
+    render_observers, unified_glare_rating,
+};
 pub use options::{RenderError, RenderOptions};
 pub use output::{EncodedImage, OUTPUT_BYTES_PER_PIXEL, encode_image, write_exr, write_png};
 pub use part::{PARTIAL_VERSION, PartialFilm};
+pub use part_receivers::{ReceiversPart, SensorDefinition};
 pub use plan::{
     MAX_THREADS, Normalisation, choose_integrator, decide_effects, normalisation, plan_for,
     plan_with,
 };
 pub use probe::{PROBE_BEAMS, PROBE_SECONDS, ProbeOutcome, probe, probe_with};
-pub use report::{AccuracyEstimate, LightReport, PREDICTED_ERRORS, RenderReport, duration};
+pub use report::{
+    AccuracyEstimate, LightReport, LuminaireReport, PREDICTED_ERRORS, RenderReport, duration,
+};
 pub use run::{InMemoryRender, render_file, render_in_memory, render_scene};
 pub use scene::{
-    DEFAULT_SENSOR_FLOOR_LUX, DEFAULT_SENSOR_SPP, DEFAULT_SPP, EffectsSettings, ErrorImage,
-    LoadOptions, Object, OutputSettings, Scene, SceneError, SceneFile, SensorIntegrator, Settings,
-    SettingsGiven, check_target_error,
+    DEFAULT_OBSERVER_SPP, DEFAULT_SENSOR_FLOOR_LUX, DEFAULT_SENSOR_SPP, DEFAULT_SPP,
+    EffectsSettings, ErrorImage, LoadOptions, Object, OutputSettings, Scene, SceneError, SceneFile,
+    SensorIntegrator, Settings, SettingsGiven, check_target_error,
 };
 pub use sensor_output::{
     MAX_SENSOR_CELLS, SensorGrid, SensorSummary, sensor_colour, write_sensor_files,
 };
 pub use sensors::{
-    SensorEstimate, SensorReport, SensorSource, check_sensor_names, planned_sensor_outputs,
-    sensor_grid, sensor_integrator, sensor_pass, sensor_pass_path, sensor_plan, sensor_summary,
+    FILLED_BY_IMAGE, FILLED_BY_LIGHT_PASS, FILLED_BY_PATH_PASS, PassShare, SensorEstimate,
+    SensorReport, SensorSource, check_sensor_names, planned_sensor_outputs, sensor_grid,
+    sensor_integrator, sensor_pass, sensor_pass_path, sensor_plan, sensor_summary,
     worst_cell_error, write_sensors,
 };
 pub use shard::merge_parts;

@@ -5,7 +5,8 @@
 //! anything larger than [`MAX_PART_BYTES`](crate::MAX_PART_BYTES), any claimed length beyond
 //! that limit, trailing bytes, and any value a render could not have produced (non-finite or
 //! non-positive light power, a pixel array that does not match the image size, negative pixel
-//! sums, a pass layer no render of the part's kind keeps, chunks outside the plan, cut chunks
+//! sums, a pass layer no render of the part's kind keeps, sensor and observer sums that do not
+//! match their definitions, chunks outside the plan, cut chunks
 //! not among them or not cut, beams other than the chunks hold, an inconsistent effects
 //! decision, an output name that is not a plain file name).
 
@@ -43,10 +44,12 @@ pub struct PartialFilm {
     pub name: String,
     /// The shard's render.
     pub output: RenderOutput,
+    /// The shard's share of the sensors and observers (empty lists for a scene without them).
+    pub receivers: crate::part_receivers::ReceiversPart,
 }
 
 /// Current [`PartialFilm::version`].
-pub const PARTIAL_VERSION: u32 = 8;
+pub const PARTIAL_VERSION: u32 = 9;
 
 /// bincode's configuration for part files: the standard encoding, with every claimed length
 /// bounded by the file-size limit so a forged length cannot make the decoder reserve memory.
@@ -115,7 +118,8 @@ impl PartialFilm {
             );
         }
         let out = &self.output;
-        validate_film(out)?;
+        self.receivers.validate()?;
+        validate_film(out, self.receivers.image_cells())?;
         if out.film.has_pass_layer()
             && (self.plan.time_budget.is_none()
                 || !crate::integrators::is_camera_integrator(self.integrator))
@@ -165,7 +169,7 @@ fn bad<T>(field: &str, why: String) -> Result<T, String> {
 }
 
 /// The plan: work to do, no shard (a part stores the whole plan), a valid budget and target.
-fn validate_plan(plan: &RenderPlan) -> Result<(), String> {
+pub(crate) fn validate_plan(plan: &RenderPlan) -> Result<(), String> {
     if plan.beams == 0 || plan.chunk_beams == 0 {
         return bad(
             "plan",
@@ -186,21 +190,22 @@ fn validate_plan(plan: &RenderPlan) -> Result<(), String> {
     Ok(())
 }
 
-/// The film: a valid image size, exactly its pixels (shards fill no sensors), no negative sum.
-fn validate_film(out: &RenderOutput) -> Result<(), String> {
+/// The film: a valid image size, exactly its pixels and `cells` sensor cells (those the light
+/// tracer's beams fill), no negative sum.
+fn validate_film(out: &RenderOutput, cells: usize) -> Result<(), String> {
     let (w, h) = (out.film.width(), out.film.height());
     if w == 0 || h == 0 || u64::from(w) * u64::from(h) > 1 << 25 {
         return bad("output.film", format!("size {w}x{h} is not a valid image size"));
     }
     out.film.check_sums().or_else(|e| bad("output.film", e))?;
-    // Shards fill no sensors, so a part's film is its pixels and nothing more.
-    let extra = out.film.sensor_cells();
-    if extra != 0 {
+    let extra = out.film.sums_after_pixels();
+    let expected = spectrace_tracer::SENSOR_SLOTS * cells;
+    if extra != expected {
         return bad(
             "output.film",
             format!(
-                "holds {} sums, but a {w}x{h} image has {} pixels (and a part no sensor cells)",
-                w * h + extra,
+                "holds {} sums, but a {w}x{h} image has {} pixels and its sensors {expected} sums",
+                u64::from(w * h) + extra as u64,
                 w * h
             ),
         );
@@ -210,7 +215,7 @@ fn validate_film(out: &RenderOutput) -> Result<(), String> {
 
 /// The chunks: strictly increasing, in the plan; the cut ones among them, cut, and only with a
 /// time budget; and exactly the beams counted: the whole chunks' plus the cut ones' counts.
-fn validate_chunks(plan: &RenderPlan, out: &RenderOutput) -> Result<(), String> {
+pub(crate) fn validate_chunks(plan: &RenderPlan, out: &RenderOutput) -> Result<(), String> {
     let total_chunks = plan.chunks();
     if let Some(pair) = out.chunks.windows(2).find(|p| p[0] >= p[1]) {
         return bad(

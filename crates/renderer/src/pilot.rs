@@ -193,7 +193,7 @@ fn pilot(
         // The error estimate decides here: independent passes for `auto`'s sampler, whose
         // spread is the error itself (see `sampler_of`).
         let build = (scene.settings.kernel, true);
-        let out = with_kernel(scene, choice, effects, true, build, |tracer| {
+        let out = with_kernel(scene, choice, effects, build, |tracer| {
             render_observed(tracer, plan, observe)
         })
         .map_err(|e| RenderError::Options(e.to_string()));

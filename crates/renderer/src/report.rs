@@ -78,6 +78,9 @@ pub struct RenderReport {
     /// The illuminance sensors' figures (empty for a scene without sensors).
     #[serde(default)]
     pub sensors: Vec<SensorReport>,
+    /// The observers' figures (empty for a scene without observers).
+    #[serde(default)]
+    pub observers: Vec<crate::ObserverReport>,
     /// Every light of the scene, in the order of the light set: its type, power and flux.
     #[serde(default)]
     pub lights: Vec<LightReport>,
@@ -96,6 +99,27 @@ pub struct LightReport {
     /// Luminous flux (lm): the power times its spectrum's luminous efficacy; `null` beyond the
     /// range of `f64`.
     pub lumens: Option<f64>,
+    /// For a measured luminaire: its lamps (`lamp_count`, their rated flux `lamp_lumens`, `null`
+    /// for absolute photometry), the flux of the file's table at its own scale
+    /// (`file_lumens`), `light_output_ratio` (that over the lamps' flux) and, for EULUMDAT, the
+    /// ratio the file states; absent for other lights.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub luminaire: Option<LuminaireReport>,
+}
+
+/// A measured luminaire's lamps and light output ratio, in the sidecar.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LuminaireReport {
+    /// Flux of the file's candela table at its own scale (lm).
+    pub file_lumens: f64,
+    /// Number of lamps.
+    pub lamp_count: u32,
+    /// Rated flux of all the lamps (lm); `null` for absolute photometry.
+    pub lamp_lumens: Option<f64>,
+    /// `file_lumens / lamp_lumens`; `null` for absolute photometry.
+    pub light_output_ratio: Option<f64>,
+    /// The light output ratio the file states (EULUMDAT's LORL, as a fraction).
+    pub stated_light_output_ratio: Option<f64>,
 }
 
 impl LightReport {
@@ -104,7 +128,19 @@ impl LightReport {
         let watts = light.power();
         let lumens = watts * spectrace_spectrum::luminous_efficacy(light.spd().as_ref());
         let finite = |v: f64| v.is_finite().then_some(v);
-        Self { kind: light.typetag_name().to_owned(), watts: finite(watts), lumens: finite(lumens) }
+        let luminaire = light.photometric_summary().map(|s| LuminaireReport {
+            file_lumens: s.file_lumens,
+            lamp_count: s.lamp_count,
+            lamp_lumens: s.lamp_lumens,
+            light_output_ratio: s.light_output_ratio,
+            stated_light_output_ratio: s.stated_light_output_ratio,
+        });
+        Self {
+            kind: light.typetag_name().to_owned(),
+            watts: finite(watts),
+            lumens: finite(lumens),
+            luminaire,
+        }
     }
 }
 
@@ -293,6 +329,7 @@ pub(crate) fn report(
         out_of_range_values: written.out_of_range_values,
         warnings,
         sensors: Vec::new(),
+        observers: Vec::new(),
         lights: Vec::new(),
         version: env!("CARGO_PKG_VERSION").to_owned(),
     }

@@ -73,12 +73,17 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
     let (plan, estimate_warning) = fit_estimate(scene, plan)?;
     warnings.extend(estimate_warning);
     let effects = decide_effects(scene, options.effects);
-    if options.verbose {
-        for (i, l) in scene.lights.lights().iter().enumerate() {
+    for (i, l) in scene.lights.lights().iter().enumerate() {
+        let summary = l.photometric_summary();
+        // Measured luminaires always say what their file holds; the rest only when verbose.
+        if options.verbose || summary.is_some() {
             let r = LightReport::of(l.as_ref());
             let (w, lm) = (r.watts.unwrap_or(f64::INFINITY), r.lumens.unwrap_or(f64::INFINITY));
-            tell!("lights[{i}]: {} of {w:.6} W, {lm:.2} lm", r.kind);
+            let file = summary.map(|s| format!(" ({s})")).unwrap_or_default();
+            tell!("lights[{i}]: {} of {w:.6} W, {lm:.2} lm{file}", r.kind);
         }
+    }
+    if options.verbose {
         tell!("{}", effects.summary());
         tell!("integrator: {reason}");
     }
@@ -94,7 +99,7 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
             tell!("wavelengths: {text}");
         }
     }
-    with_kernel(scene, choice, effects, plan.shard.is_none(), (kernel, error_decides), |tracer| {
+    with_kernel(scene, choice, effects, (kernel, error_decides), |tracer| {
         let setup = Setup { choice, reason: &reason, effects, plan, name: &name, kernel };
         render_with(scene, options, &setup, warnings, tracer)
     })
@@ -171,7 +176,7 @@ pub fn render_in_memory(
     let kernel = options.kernel.unwrap_or(scene.settings.kernel);
     let build = (kernel, plan.target_error.is_some());
     let output =
-        with_kernel(scene, choice, effects, true, build, |tracer| render(tracer, &plan, &|_| {}))
+        with_kernel(scene, choice, effects, build, |tracer| render(tracer, &plan, &|_| {}))
             .map_err(|e| RenderError::Options(e.to_string()))?;
     scene.lights.reset_count();
     let image = image(&output, scene_normalisation(scene, choice));
@@ -203,7 +208,7 @@ fn render_with(
     let (output, wall) = render_with_progress(tracer, &setup.plan, options.verbose)?;
     let finished = Finished { scene, setup, integrator: tracer.name(), wall, warnings };
     match setup.plan.shard {
-        Some(shard) => write_shard(&finished, options, shard, output),
+        Some(shard) => write_shard(&finished, options, shard, tracer, output),
         None => write_render(&finished, options, tracer, probed, &output),
     }
 }
@@ -274,9 +279,18 @@ fn write_shard(
     finished: &Finished<'_>,
     options: &RenderOptions,
     shard: (u64, u64),
+    tracer: &dyn Integrator,
     output: RenderOutput,
 ) -> Result<RenderReport, RenderError> {
     let (scene, setup) = (finished.scene, finished.setup);
+    let fills = tracer.sensor_cells() > 0;
+    let receivers = crate::part_receivers::shard_receivers(
+        scene,
+        fills,
+        setup.plan.threads,
+        setup.effects,
+        shard,
+    )?;
     let path = part_path(&options.out_dir, setup.name, shard);
     let report = finished
         .report(&output, Written { files: vec![path.display().to_string()], ..Written::default() });
@@ -292,6 +306,7 @@ fn write_shard(
         output_settings: options.output_settings(scene),
         name: setup.name.to_owned(),
         output,
+        receivers,
     };
     write_part(&path, part)?;
     Ok(report)
@@ -318,8 +333,13 @@ fn write_render(
             tell!("{}", sensor_summary(r));
         }
     }
+    let observers = crate::render_observers(scene, setup.plan.threads, setup.effects)?;
+    for r in &observers {
+        tell!("{}", crate::observer_summary(r));
+    }
     let mut report = finished.report(output, written);
     report.sensors = sensors;
+    report.observers = observers;
     write_sidecar(&options.out_dir, setup.name, &report)?;
     Ok(report)
 }

@@ -7,10 +7,12 @@
 //! corner and `iv` along `edge_v`.
 //!
 //! [`write_sensor_files`] writes, into the output folder, through [`write_atomically`]:
-//! - `NAME.csv`: header `iu,iv,x,y,z,irradiance_w_m2,illuminance_lux`, one row per cell (`iv` the
-//!   outer loop, `iu` the inner), numbers printed so they read back exactly, `\n` line ends.
+//! - `NAME.csv`: header `iu,iv,x,y,z,irradiance_w_m2,illuminance_lux,melanopic_edi_lux`, one row
+//!   per cell (`iv` the outer loop, `iu` the inner), numbers printed so they read back exactly,
+//!   `\n` line ends. `melanopic_edi_lux` is the melanopic equivalent daylight illuminance of CIE
+//!   S 026 (the melanopic irradiance is it times 1.3262e-3 W/lm).
 //! - `NAME.exr`: an image of `nu x nv` pixels, one per cell, with the 32-bit float channels
-//!   `illuminance_lux` and `irradiance_w_m2`. Cell `(iu, iv)` is pixel `(x = iu, y = nv - 1 - iv)`:
+//!   `illuminance_lux`, `irradiance_w_m2` and `melanopic_edi_lux`. Cell `(iu, iv)` is pixel `(x = iu, y = nv - 1 - iv)`:
 //!   image rows run top to bottom, so `+v` (along `edge_v`) is up in image viewers. Written
 //!   sequentially (the same grid always gives the same bytes). Values whose magnitude does not fit
 //!   a 32-bit float are refused (the CSV has the full f64 values; values below about 1.4e-45 are
@@ -49,6 +51,8 @@ pub struct SensorGrid {
     pub irradiance: Vec<f64>,
     /// Illuminance in lux (lm/m^2), indexed as `irradiance`.
     pub illuminance: Vec<f64>,
+    /// Melanopic equivalent daylight illuminance in lux (CIE S 026), indexed as `irradiance`.
+    pub melanopic_edi: Vec<f64>,
 }
 
 /// Summary figures (lux) as lighting standards define them (EN 12464-1 / EN 12193: uniformity
@@ -65,6 +69,11 @@ pub struct SensorSummary {
     pub uniformity: f64,
     /// Average irradiance over the cells (W/m^2).
     pub average_w_m2: f64,
+    /// Average melanopic equivalent daylight illuminance over the cells (lux, CIE S 026).
+    pub average_melanopic_edi_lux: f64,
+    /// Melanopic daylight efficacy ratio of the light on the sensor: average m-EDI over average
+    /// illuminance (1 for D65 daylight); 0 when the average illuminance is 0.
+    pub melanopic_der: f64,
     /// Number of cells, `nu * nv`.
     pub cells: u64,
     /// Area of the rectangle, `|edge_u x edge_v|` (m^2).
@@ -97,6 +106,12 @@ impl SensorGrid {
             maximum_lux,
             uniformity,
             average_w_m2: mean(&self.irradiance),
+            average_melanopic_edi_lux: mean(&self.melanopic_edi),
+            melanopic_der: if average_lux > 0.0 {
+                mean(&self.melanopic_edi) / average_lux
+            } else {
+                0.0
+            },
             cells: self.cell_count(),
             area_m2: self.edge_u.cross(self.edge_v).length(),
         }
@@ -110,15 +125,18 @@ impl SensorGrid {
             + (f64::from(iv) + 0.5) / nv * self.edge_v
     }
 
-    /// The CSV: header `iu,iv,x,y,z,irradiance_w_m2,illuminance_lux`, then one row per cell,
+    /// The CSV: header `iu,iv,x,y,z,irradiance_w_m2,illuminance_lux,melanopic_edi_lux`, then one
+    /// row per cell,
     /// `iv` the outer loop and `iu` the inner, numbers that read back exactly, `\n` line ends. A
     /// value missing from a too-short vector is written as `NaN`, and rows stop after the longer
     /// vector's last value ([`write_sensor_files`] refuses such grids).
     pub fn csv(&self) -> String {
         let [nu, nv] = self.cells;
-        let rows = self.cell_count().min(self.irradiance.len().max(self.illuminance.len()) as u64);
+        let longest =
+            self.irradiance.len().max(self.illuminance.len()).max(self.melanopic_edi.len());
+        let rows = self.cell_count().min(longest as u64);
         let mut out = String::with_capacity(48 + rows as usize * 96);
-        out.push_str("iu,iv,x,y,z,irradiance_w_m2,illuminance_lux\n");
+        out.push_str("iu,iv,x,y,z,irradiance_w_m2,illuminance_lux,melanopic_edi_lux\n");
         for iv in 0..nv {
             for iu in 0..nu {
                 let i = iv as usize * nu as usize + iu as usize;
@@ -128,8 +146,9 @@ impl SensorGrid {
                 let c = self.cell_centre(iu, iv);
                 let e = self.irradiance.get(i).copied().unwrap_or(f64::NAN);
                 let l = self.illuminance.get(i).copied().unwrap_or(f64::NAN);
+                let m = self.melanopic_edi.get(i).copied().unwrap_or(f64::NAN);
                 // Writing to a String cannot fail.
-                let _ = writeln!(out, "{iu},{iv},{},{},{},{e},{l}", c.x, c.y, c.z);
+                let _ = writeln!(out, "{iu},{iv},{},{},{},{e},{l},{m}", c.x, c.y, c.z);
             }
         }
         out
@@ -240,9 +259,11 @@ impl SensorGrid {
                 return Err(format!("sensor {name:?}: {what} {v} is not finite"));
             }
         }
-        for (what, unit, values) in
-            [("irradiance", "W/m^2", &self.irradiance), ("illuminance", "lx", &self.illuminance)]
-        {
+        for (what, unit, values) in [
+            ("irradiance", "W/m^2", &self.irradiance),
+            ("illuminance", "lx", &self.illuminance),
+            ("melanopic_edi", "lx", &self.melanopic_edi),
+        ] {
             if values.len() as u64 != n {
                 return Err(format!(
                     "sensor {name:?}: {what} has {} values for {nu} x {nv} = {n} cells",
@@ -277,8 +298,13 @@ impl SensorGrid {
         let channels = SpecificChannels::build()
             .with_channel("illuminance_lux")
             .with_channel("irradiance_w_m2")
+            .with_channel("melanopic_edi_lux")
             .with_pixel_fn(|Vec2(x, y): Vec2<usize>| {
-                (at(&self.illuminance, x, y), at(&self.irradiance, x, y))
+                (
+                    at(&self.illuminance, x, y),
+                    at(&self.irradiance, x, y),
+                    at(&self.melanopic_edi, x, y),
+                )
             });
         let image = Image::from_encoded_channels((nu, nv), Encoding::SMALL_LOSSLESS, channels);
         image.write().non_parallel().to_file(path).map_err(|e| e.to_string())
@@ -517,6 +543,7 @@ mod tests {
             edge_v: DVec3::new(0.0, 2.0, 1.0),
             cells: [3, 2],
             irradiance: illuminance.iter().map(|l| l / 683.0).collect(),
+            melanopic_edi: illuminance.iter().map(|l| l * 0.5).collect(),
             illuminance,
         }
     }
@@ -526,7 +553,7 @@ mod tests {
         let g = grid();
         let csv = g.csv();
         let lines: Vec<&str> = csv.split('\n').collect();
-        assert_eq!(lines[0], "iu,iv,x,y,z,irradiance_w_m2,illuminance_lux");
+        assert_eq!(lines[0], "iu,iv,x,y,z,irradiance_w_m2,illuminance_lux,melanopic_edi_lux");
         assert_eq!(lines.len(), 1 + 6 + 1, "one row per cell and a final newline");
         assert_eq!(*lines.last().unwrap(), "");
         assert!(!csv.contains('\r'));
@@ -538,6 +565,7 @@ mod tests {
         assert!((DVec3::new(f[2], f[3], f[4]) - expected).length() < 1e-12, "{f:?}");
         assert_eq!(f[5], 500.0 / 683.0, "irradiance round-trips exactly");
         assert_eq!(f[6], 500.0);
+        assert_eq!((f.len(), f[7]), (8, 250.0), "melanopic EDI last");
         // iu counts along edge_u from the corner.
         let first: Vec<f64> = lines[1].split(',').map(|s| s.parse().unwrap()).collect();
         let second: Vec<f64> = lines[2].split(',').map(|s| s.parse().unwrap()).collect();
@@ -563,6 +591,7 @@ mod tests {
         assert_eq!(s.maximum_lux, 600.0);
         assert_eq!(s.uniformity, 100.0 / 350.0);
         assert!((s.average_w_m2 - 350.0 / 683.0).abs() < 1e-15);
+        assert_eq!((s.average_melanopic_edi_lux, s.melanopic_der), (175.0, 0.5));
         assert_eq!(s.cells, 6);
         // |(3,0,0) x (0,2,1)| = |(0,-3,6)| = sqrt(45).
         assert!((s.area_m2 - 45f64.sqrt()).abs() < 1e-12);
@@ -643,6 +672,7 @@ mod tests {
             cells: [1, 1],
             irradiance: vec![1.0],
             illuminance: vec![683.0],
+            melanopic_edi: vec![300.0],
         };
         let img = one.false_colour();
         assert!(img.width() >= 800 && img.height() >= 800);
@@ -651,6 +681,7 @@ mod tests {
             cells: [5000, 1],
             irradiance: vec![1.0; 5000],
             illuminance: (0..5000).map(f64::from).collect(),
+            melanopic_edi: vec![1.0; 5000],
             ..one
         };
         let img = strip.false_colour();
@@ -695,9 +726,10 @@ mod tests {
             .specific_channels()
             .required("illuminance_lux")
             .required("irradiance_w_m2")
+            .required("melanopic_edi_lux")
             .collect_pixels(
-                |res, _| vec![vec![(0f32, 0f32); res.width()]; res.height()],
-                |rows, pos, (l, e): (f32, f32)| rows[pos.y()][pos.x()] = (l, e),
+                |res, _| vec![vec![(0f32, 0f32, 0f32); res.width()]; res.height()],
+                |rows, pos, (l, e, m): (f32, f32, f32)| rows[pos.y()][pos.x()] = (l, e, m),
             )
             .first_valid_layer()
             .all_attributes()
@@ -707,7 +739,8 @@ mod tests {
         assert_eq!((rows.len(), rows[0].len()), (2, 3));
         for (i, (l, e)) in g.illuminance.iter().zip(&g.irradiance).enumerate() {
             let (iu, iv) = (i % 3, i / 3);
-            assert_eq!(rows[1 - iv][iu], (*l as f32, *e as f32), "cell ({iu}, {iv})");
+            let m = g.melanopic_edi[i] as f32;
+            assert_eq!(rows[1 - iv][iu], (*l as f32, *e as f32, m), "cell ({iu}, {iv})");
         }
         // Deterministic bytes, and the CSV is the grid's.
         let bytes = std::fs::read(&written[1]).unwrap();

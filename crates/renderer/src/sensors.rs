@@ -40,6 +40,13 @@ pub struct SensorReport {
     pub uniformity: f64,
     /// Average irradiance (W/m^2).
     pub average_w_m2: f64,
+    /// Average melanopic equivalent daylight illuminance (lux, CIE S 026).
+    #[serde(default)]
+    pub average_melanopic_edi_lux: f64,
+    /// Melanopic daylight efficacy ratio: average m-EDI over average illuminance (1 for D65);
+    /// 0 when no light arrived.
+    #[serde(default)]
+    pub melanopic_der: f64,
     /// Estimated relative standard error of `average_lux` (one sigma), from the spread of the
     /// beams' contributions; `null` when no light arrived.
     pub average_relative_error: Option<f64>,
@@ -108,11 +115,13 @@ pub fn sensor_pass(
     let started = Instant::now();
     let traced = tracer_scene(scene).sensors_only();
     let tracer = LightTracer::new(&traced, scene.tracer_settings(), effects);
-    let plan = RenderPlan { error_estimate: false, target_error: None, shard: None, ..*plan };
+    let plan = RenderPlan { error_estimate: false, target_error: None, ..*plan };
     let output =
         render_plan(&tracer, &plan, &|_| {}).map_err(|e| RenderError::Options(e.to_string()))?;
     scene.lights.reset_count();
-    Ok((output.film, output.beams, started.elapsed().as_secs_f64()))
+    let seconds = started.elapsed().as_secs_f64();
+    let beams = output.beams;
+    Ok((output.film, beams, seconds))
 }
 
 /// Runs a sensor pass with the path tracer sampling points on the sensors: `passes` samples of
@@ -138,28 +147,96 @@ fn sensor_pass_path_seeded(
     effects: Effects,
     seed: u64,
 ) -> Result<(Film, u64, f64), RenderError> {
-    let started = Instant::now();
-    let traced = tracer_scene(scene);
-    let tracer = SensorPathTracer::new(
-        PathTracer::new(&traced, scene.path_settings(), effects),
-        &scene.sensors,
-    );
     let cells = u64::from(scene.sensors.total_cells()).max(1);
-    let plan = RenderPlan {
-        beams: passes.saturating_mul(cells),
-        chunk_beams: cells,
-        seed,
+    let plan = RenderPlan { seed, ..per_item_plan(passes, cells, scene, threads) };
+    let started = Instant::now();
+    let output = path_pass_output(scene, &plan, effects)?;
+    Ok((output.film, output.beams / cells, started.elapsed().as_secs_f64()))
+}
+
+/// The plan of a pass of `passes` samples of each of `items` receivers (sensor cells, or
+/// observers' quantities): a chunk is one sample of every item; the scene's seed, no shard.
+pub(crate) fn per_item_plan(passes: u64, items: u64, scene: &Scene, threads: usize) -> RenderPlan {
+    RenderPlan {
+        beams: passes.saturating_mul(items),
+        chunk_beams: items,
+        seed: scene.settings.seed,
         threads,
         shard: None,
         time_budget: None,
         error_estimate: false,
         target_error: None,
         error_measure: Default::default(),
-    };
-    let output =
-        render_plan(&tracer, &plan, &|_| {}).map_err(|e| RenderError::Options(e.to_string()))?;
-    Ok((output.film, output.beams / cells, started.elapsed().as_secs_f64()))
+    }
 }
+
+/// The path tracer's sensor pass on `plan` (which may name a shard).
+fn path_pass_output(
+    scene: &Scene,
+    plan: &RenderPlan,
+    effects: Effects,
+) -> Result<RenderOutput, RenderError> {
+    let traced = tracer_scene(scene);
+    let tracer = SensorPathTracer::new(
+        PathTracer::new(&traced, scene.path_settings(), effects),
+        &scene.sensors,
+    );
+    render_plan(&tracer, plan, &|_| {}).map_err(|e| RenderError::Options(e.to_string()))
+}
+
+/// A pass over receivers, or a shard's share of one: its whole plan (without the shard), what
+/// was rendered, and the work items per independent sample (the receivers for a pass sampling
+/// each of them once per chunk, 1 for light paths).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PassShare {
+    /// The pass's plan, without its shard.
+    pub plan: RenderPlan,
+    /// What was rendered of it.
+    pub output: RenderOutput,
+    /// Work items per independent sample: `N = output.beams / items_per_sample`.
+    pub items_per_sample: u64,
+}
+
+/// The fixed sensor pass after a camera integrator's image (`sensor_spp` samples per cell, or
+/// `sensor_beams` light paths), on `shard`'s chunks of it (all of them for `None`), with how it
+/// fills the sensors.
+///
+/// # Errors
+/// [`RenderError::Options`] if the film cannot be made.
+pub(crate) fn fixed_sensor_pass(
+    scene: &Scene,
+    threads: usize,
+    effects: Effects,
+    shard: Option<(u64, u64)>,
+) -> Result<(PassShare, &'static str), RenderError> {
+    let started = Instant::now();
+    let (plan, mut output, items_per_sample, filled_by) =
+        if sensor_integrator(scene) == SensorIntegrator::Light {
+            let plan = sensor_plan(scene, threads);
+            let traced = tracer_scene(scene).sensors_only();
+            let tracer = LightTracer::new(&traced, scene.tracer_settings(), effects);
+            let output = render_plan(&tracer, &RenderPlan { shard, ..plan }, &|_| {})
+                .map_err(|e| RenderError::Options(e.to_string()))?;
+            scene.lights.reset_count();
+            (plan, output, 1, FILLED_BY_LIGHT_PASS)
+        } else {
+            let passes = scene.settings.sensor_spp.unwrap_or(DEFAULT_SENSOR_SPP);
+            let cells = u64::from(scene.sensors.total_cells()).max(1);
+            let plan = per_item_plan(passes, cells, scene, threads);
+            let output = path_pass_output(scene, &RenderPlan { shard, ..plan }, effects)?;
+            (plan, output, cells, FILLED_BY_PATH_PASS)
+        };
+    output.seconds = started.elapsed().as_secs_f64();
+    let plan = RenderPlan { threads: 0, ..plan };
+    Ok((PassShare { plan, output, items_per_sample }, filled_by))
+}
+
+/// `filled_by` of sensors filled by the light tracer's image beams.
+pub const FILLED_BY_IMAGE: &str = "image beams (light tracer)";
+/// `filled_by` of sensors filled by a light-tracer sensor pass.
+pub const FILLED_BY_LIGHT_PASS: &str = "sensor pass (light tracer)";
+/// `filled_by` of sensors filled by the path tracer from points sampled on them.
+pub const FILLED_BY_PATH_PASS: &str = "points sampled on the sensor (path tracer)";
 
 /// The plan of a sensor pass: `settings.sensor_beams` beams (default `settings.beams`), the
 /// scene's seed, chunking and threads, no time budget.
@@ -221,6 +298,7 @@ pub fn sensor_grid(
             cells: sensor.cells(),
             irradiance: cells.iter().map(|c| c[0] * scale).collect(),
             illuminance: cells.iter().map(|c| c[1] * scale).collect(),
+            melanopic_edi: cells.iter().map(|c| c[3] * scale).collect(),
         },
         illuminance_errors: cells.iter().map(|c| variance(c[1], c[2]).sqrt() * scale).collect(),
         average_relative_error: (total > 0.0).then(|| total_variance.sqrt() / total),
@@ -318,19 +396,46 @@ pub fn write_sensors(
     dir: &Path,
     source: SensorSource<'_>,
 ) -> Result<Vec<SensorReport>, RenderError> {
+    let lit = LitSensors {
+        sensors: &scene.sensors,
+        light_power: scene.lights.power(),
+        floor_lux: scene.settings.sensor_floor_lux,
+        inputs: &scene.inputs,
+    };
+    write_lit_sensors(&lit, dir, source)
+}
+
+/// What writing sensors needs of a scene (a merge has the parts, not the scene).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LitSensors<'a> {
+    /// The sensors.
+    pub sensors: &'a SensorSet,
+    /// The lights' total power (W).
+    pub light_power: f64,
+    /// `settings.sensor_floor_lux`.
+    pub floor_lux: f64,
+    /// Files no output may replace.
+    pub inputs: &'a [PathBuf],
+}
+
+/// [`write_sensors`] from what it needs.
+pub(crate) fn write_lit_sensors(
+    lit: &LitSensors<'_>,
+    dir: &Path,
+    source: SensorSource<'_>,
+) -> Result<Vec<SensorReport>, RenderError> {
     let sums = source.film.sensor_sums(1.0);
     let mut reports = Vec::new();
-    for index in 0..scene.sensors.sensors().len() {
-        let estimate =
-            sensor_grid(&scene.sensors, index, &sums, scene.lights.power(), source.beams);
-        let worst = worst_cell_error(&estimate, scene.settings.sensor_floor_lux);
+    for index in 0..lit.sensors.sensors().len() {
+        let estimate = sensor_grid(lit.sensors, index, &sums, lit.light_power, source.beams);
+        let worst = worst_cell_error(&estimate, lit.floor_lux);
         let SensorEstimate {
             grid,
             average_relative_error: average_error,
             median_cell_relative_error: median,
             ..
         } = estimate;
-        let files = write_sensor_files(dir, &grid, &scene.inputs).map_err(|message| {
+        let files = write_sensor_files(dir, &grid, lit.inputs).map_err(|message| {
             RenderError::File { path: dir.join(format!("{}.*", grid.name)), message }
         })?;
         let summary = grid.summary();
@@ -343,6 +448,8 @@ pub fn write_sensors(
             maximum_lux: summary.maximum_lux,
             uniformity: summary.uniformity,
             average_w_m2: summary.average_w_m2,
+            average_melanopic_edi_lux: summary.average_melanopic_edi_lux,
+            melanopic_der: summary.melanopic_der,
             average_relative_error: average_error,
             median_cell_relative_error: median,
             beams: source.beams,
@@ -364,8 +471,17 @@ pub fn sensor_summary(r: &SensorReport) -> String {
         .average_relative_error
         .map_or("no light arrived".to_owned(), |e| format!("average +/- {:.2}%", e * 100.0));
     format!(
-        "sensor {}: average {:.1} lx, min {:.1} lx, max {:.1} lx, U0 {:.2} ({error}, {} by {} beams)",
-        r.name, r.average_lux, r.minimum_lux, r.maximum_lux, r.uniformity, r.filled_by, r.beams
+        "sensor {}: average {:.1} lx, min {:.1} lx, max {:.1} lx, U0 {:.2}, melanopic EDI {:.1} lx \
+         (DER {:.3}) ({error}, {} by {} beams)",
+        r.name,
+        r.average_lux,
+        r.minimum_lux,
+        r.maximum_lux,
+        r.uniformity,
+        r.average_melanopic_edi_lux,
+        r.melanopic_der,
+        r.filled_by,
+        r.beams
     )
 }
 
@@ -401,25 +517,25 @@ pub(crate) fn render_sensors(
             film: &output.film,
             beams: output.beams,
             seconds: output.seconds,
-            filled_by: "image beams (light tracer)",
+            filled_by: FILLED_BY_IMAGE,
             target: None,
         };
         return write_sensors(scene, dir, source);
     }
     let light = sensor_integrator(scene) == SensorIntegrator::Light;
-    let target = scene.settings.sensor_target_error;
-    let (film, beams, seconds) = match (target, light) {
-        (Some(t), _) => sensor_pass_to_target(scene, light, t, plan.threads, effects)?,
-        (None, true) => sensor_pass(scene, &sensor_plan(scene, plan.threads), effects)?,
-        (None, false) => {
-            let passes = scene.settings.sensor_spp.unwrap_or(DEFAULT_SENSOR_SPP);
-            sensor_pass_path(scene, passes, plan.threads, effects)?
-        }
+    if let Some(t) = scene.settings.sensor_target_error {
+        let (film, beams, seconds) = sensor_pass_to_target(scene, light, t, plan.threads, effects)?;
+        let filled_by = if light { FILLED_BY_LIGHT_PASS } else { FILLED_BY_PATH_PASS };
+        let source = SensorSource { film: &film, beams, seconds, filled_by, target: Some(t) };
+        return write_sensors(scene, dir, source);
+    }
+    let (pass, filled_by) = fixed_sensor_pass(scene, plan.threads, effects, None)?;
+    let source = SensorSource {
+        film: &pass.output.film,
+        beams: pass.output.beams / pass.items_per_sample.max(1),
+        seconds: pass.output.seconds,
+        filled_by,
+        target: None,
     };
-    let filled_by = if light {
-        "sensor pass (light tracer)"
-    } else {
-        "points sampled on the sensor (path tracer)"
-    };
-    write_sensors(scene, dir, SensorSource { film: &film, beams, seconds, filled_by, target })
+    write_sensors(scene, dir, source)
 }

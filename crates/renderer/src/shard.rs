@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 use spectrace_tracer::{Film, MemoryLimit, RenderOutput, RenderPlan, TraceStats};
 
 use crate::integrators::sampler_of;
+use crate::part_receivers::MergedReceivers;
 use crate::report::report;
+use crate::say::tell;
 use crate::write::{planned_outputs, write_sidecar};
 use crate::{
     PartialFilm, RenderError, RenderReport, normalisation, write_atomically, write_outputs,
@@ -34,14 +36,18 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
     let mut first = read_part(first_path)?;
     let size = (first.output.film.width(), first.output.film.height());
     check_merge_memory(size, first.output.film.has_pass_layer())?;
-    planned_outputs(out_dir, &first.name, &first.output_settings, None, parts, Vec::new())?;
+    let mut receivers = MergedReceivers::new(std::mem::take(&mut first.receivers));
+    let sensor_files = receivers.planned_files(out_dir);
+    planned_outputs(out_dir, &first.name, &first.output_settings, None, parts, sensor_files)?;
     let mut merged = take_output(&mut first)?;
     // Which part holds each chunk: coverage is checked by chunk identity, not by count.
     let mut owner: BTreeMap<u64, usize> = merged.chunks.iter().map(|&c| (c, 0)).collect();
     let mut seconds = vec![merged.seconds];
     for (index, path) in parts.iter().enumerate().skip(1) {
         let part = read_part(path)?;
-        if let Some(what) = difference(&first, &part, size) {
+        let what = difference(&first, &part, size)
+            .or_else(|| (!receivers.same_kind(&part.receivers)).then_some("sensors or observers"));
+        if let Some(what) = what {
             return Err(RenderError::Options(format!(
                 "{}: belongs to another render: its {what} differs from {}",
                 path.display(),
@@ -50,10 +56,12 @@ pub fn merge_parts(parts: &[PathBuf], out_dir: &Path) -> Result<RenderReport, Re
         }
         claim_chunks(&mut owner, &part.output, index, parts)?;
         add_part(&mut merged, &part.output, path)?;
+        receivers.add(&part.receivers, index, parts)?;
         seconds.push(part.output.seconds);
     }
     check_coverage(&first.plan, &owner)?;
-    write_merged(out_dir, &first, &merged, &seconds)
+    receivers.check_coverage()?;
+    write_merged(out_dir, &first, &merged, &seconds, (&receivers, parts))
 }
 
 /// Reads and validates one part, naming the file in errors.
@@ -154,7 +162,10 @@ fn add_part(
 
 /// Checks that the parts cover every chunk of `plan`: time budgets and targets stop early, so
 /// only they may leave chunks out.
-fn check_coverage(plan: &RenderPlan, owner: &BTreeMap<u64, usize>) -> Result<(), RenderError> {
+pub(crate) fn check_coverage(
+    plan: &RenderPlan,
+    owner: &BTreeMap<u64, usize>,
+) -> Result<(), RenderError> {
     if plan.time_budget.is_some() || plan.target_error.is_some() {
         return Ok(());
     }
@@ -176,6 +187,7 @@ fn write_merged(
     first: &PartialFilm,
     merged: &RenderOutput,
     seconds: &[f64],
+    (receivers, parts): (&MergedReceivers, &[PathBuf]),
 ) -> Result<RenderReport, RenderError> {
     let (w, h) = (merged.film.width(), merged.film.height());
     let numerator = normalisation(first.integrator, first.light_power, u64::from(w) * u64::from(h));
@@ -196,6 +208,15 @@ fn write_merged(
         if total_seconds > 0.0 { merged.beams as f64 / total_seconds } else { 0.0 };
     let error_decides = first.plan.target_error.is_some();
     report.sampler = sampler_of(first.sampler, first.integrator, error_decides).name().to_owned();
+    let (sensors, observers) = receivers.finish(out_dir, merged, first.light_power, parts)?;
+    for r in &sensors {
+        report.outputs.extend(r.files.iter().cloned());
+    }
+    for r in &observers {
+        tell!("{}", crate::observer_summary(r));
+    }
+    report.sensors = sensors;
+    report.observers = observers;
     write_sidecar(out_dir, &first.name, &report)?;
     Ok(report)
 }

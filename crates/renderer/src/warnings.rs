@@ -26,10 +26,15 @@ pub(crate) fn render_warnings(
         );
     }
     warnings.extend(beams_warning(scene, choice, plan));
-    if !scene.sensors.is_empty() && plan.shard.is_some() {
+    if !scene.sensors.is_empty()
+        && plan.shard.is_some()
+        && scene.settings.sensor_target_error.is_some()
+        && choice != IntegratorChoice::Light
+    {
         warnings.push(
-            "sensors are written by unsharded renders only (merge-parts writes the image): \
-             render without --shard for the sensors' files"
+            "settings.sensor_target_error: a sharded render runs the fixed sensor pass \
+             (sensor_spp samples per cell, or sensor_beams) split over its shards, since a pass \
+             to a target decides its rounds from the whole pass; render unsharded for the target"
                 .to_owned(),
         );
     }

@@ -50,6 +50,7 @@ pub mod data;
 mod error;
 mod illuminant;
 mod inverse;
+mod melanopic;
 mod mixture;
 mod photometric;
 mod reflectance;
@@ -66,6 +67,7 @@ pub use cie::{
 };
 pub use error::SpectrumError;
 pub use illuminant::{CieIlluminant, KNOWN_ILLUMINANTS, daylight};
+pub use melanopic::{MELANOPIC_EFFICACY_D65, melanopic_action, melanopic_edi_per_watt};
 pub use mixture::{Component, MAX_TABLE_PANELS, Mixture};
 pub use photometric::{
     PEAK_LUMINOUS_EFFICACY, lumens_per_watt, luminous_efficacy, watts_from_lumens,

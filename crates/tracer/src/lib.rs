@@ -45,6 +45,7 @@ mod film;
 mod integrators;
 mod light_sampler;
 mod object_light;
+mod observer;
 mod render;
 mod sampler;
 mod scene;
@@ -72,19 +73,21 @@ pub use integrators::bdpt::{Bdpt, BdptSettings, BdptWavelengths};
 pub use integrators::light_tracer::{
     LightTracer, LightTracerSettings, MAX_DEPTH, image_scale, trace_chunk, trace_chunk_until,
 };
+pub use integrators::observer::ObserverTracer;
 pub use integrators::pass::{SampleCounts, camera_image};
 pub use integrators::path_tracer::{PathTracer, PathTracerSettings};
-pub use integrators::sensor_path::SensorPathTracer;
+pub use integrators::sensor_path::{Response, SensorPathTracer};
 pub use integrators::{
     ChunkWork, INTEGRATORS, Integrator, IntegratorSettings, RegisteredIntegrator, build_integrator,
     registered,
 };
+pub use observer::{MAX_OBSERVERS, OBSERVER_QUANTITIES, Observer, check_observers};
 
 // The film, the render loop and its error estimate.
 pub use film::{
     ByMeasure, ErrorEstimate, ErrorMeasure, ExactSum, Film, FilmError, FilmWriter, MAX_PIXELS,
-    MAX_TRUSTED_UNCERTAINTY, MIN_BATCHES, Moments, RELMSE_EPSILON, Splat, relative_error,
-    spectral_xyz,
+    MAX_TRUSTED_UNCERTAINTY, MIN_BATCHES, Moments, RELMSE_EPSILON, SENSOR_SLOTS, Splat,
+    relative_error, spectral_xyz,
 };
 pub use render::{
     DEFAULT_CHUNK_BEAMS, FALLBACK_MEMORY_LIMIT, MemoryLimit, Progress, RenderOutput, RenderPlan,

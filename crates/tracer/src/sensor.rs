@@ -201,9 +201,12 @@ impl IrradianceSensor {
 }
 
 /// What the film keeps per sensor cell, summed over the crossings (relative beam weights, before
-/// the lights' power over the beam count): `[radiant, luminous, luminous^2]`, where `luminous`
-/// is the weight times `683 ybar(lambda)` (lm/W) and its square serves the error estimate.
-pub type SensorSums = [f64; 3];
+/// the lights' power over the beam count): `[radiant, luminous, luminous^2, melanopic]`, where
+/// `luminous` is the weight times `683 ybar(lambda)` (lm/W), its square serves the error
+/// estimate, and `melanopic` is the weight times the melanopic EDI per watt
+/// ([`spectrace_spectrum::melanopic_edi_per_watt`], CIE S 026), so that it becomes melanopic
+/// equivalent daylight illuminance (lux) as `luminous` becomes illuminance.
+pub type SensorSums = [f64; 4];
 
 /// The sensors of a scene, their cells numbered consecutively (sensor 0's cells first).
 #[derive(Debug, Clone, Default, PartialEq)]

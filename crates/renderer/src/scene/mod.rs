@@ -114,6 +114,8 @@ pub struct Scene {
     pub inputs: Vec<PathBuf>,
     /// The illuminance sensors.
     pub sensors: SensorSet,
+    /// The observers (eye positions).
+    pub observers: Vec<spectrace_tracer::Observer>,
     /// The approximations made when the scene was imported from another renderer's file
     /// (`file:line: what`); empty for a native scene.
     pub notes: Vec<String>,
@@ -230,11 +232,14 @@ impl Scene {
                     let (c, u, v) = (s.corner(), s.edge_u(), s.edge_v());
                     [c, c + u, c + v, c + u + v]
                 }))
+                .chain(file.observers.iter().map(|o| o.position()))
                 .collect();
             file_lights.push(parts.environment(map, &receivers)?);
         }
         let lights = parts.add_lights(file_lights, object_lights)?;
         let sensors = sensor_set(file.sensors, path)?;
+        spectrace_tracer::check_observers(&file.observers)
+            .map_err(|e| scene_error(path, "observers", e))?;
         let world = World::with_base_dir(parts.shapes, base)
             .map_err(|e| scene_error(path, "objects", e.to_string()))?;
         let canonical_json = serde_json::to_string(&value).unwrap_or_default();
@@ -254,6 +259,7 @@ impl Scene {
             output: file.output,
             inputs: parts.inputs,
             sensors,
+            observers: file.observers,
             notes: Vec::new(),
         })
     }

@@ -11,7 +11,8 @@ use spectrace_materials::Material;
 use spectrace_tracer::IrradianceSensor;
 use spectrace_tracer::{
     BdptWavelengths, CameraWavelengths, DEFAULT_CHUNK_BEAMS, EffectsMode, EnvironmentMap,
-    ErrorMeasure, IntegratorChoice, Kernel, MAX_DEPTH, ObjectEmission, PinholeCamera, SamplerKind,
+    ErrorMeasure, IntegratorChoice, Kernel, MAX_DEPTH, ObjectEmission, Observer, PinholeCamera,
+    SamplerKind,
 };
 
 use super::{SceneError, scene_error};
@@ -45,6 +46,10 @@ pub struct SceneFile {
     /// Illuminance sensors beside the camera (`{"type": "IrradianceSensor", ...}`).
     #[serde(default)]
     pub sensors: Vec<IrradianceSensor>,
+    /// Eye positions with a line of sight (`spectrace_tracer::Observer`): vertical, cylindrical
+    /// and semi-cylindrical illuminance, melanopic EDI and the unified glare rating there.
+    #[serde(default)]
+    pub observers: Vec<Observer>,
 }
 
 /// One object: a shape and what its surface does.
@@ -107,6 +112,8 @@ pub struct Settings {
     pub sensor_beams: Option<u64>,
     /// Samples per sensor cell of a path-tracer sensor pass (default 64).
     pub sensor_spp: Option<u64>,
+    /// Samples per quantity of each observer (default [`DEFAULT_OBSERVER_SPP`]).
+    pub observer_spp: Option<u64>,
     /// Run the sensor pass until every cell at or above `sensor_floor_lux` has a relative
     /// standard error of at most this (e.g. `0.01`), instead of `sensor_spp` / `sensor_beams`.
     pub sensor_target_error: Option<f64>,
@@ -165,6 +172,7 @@ impl Default for Settings {
             chunk_beams: DEFAULT_CHUNK_BEAMS,
             sensor_beams: None,
             sensor_spp: None,
+            observer_spp: None,
             sensor_target_error: None,
             sensor_floor_lux: DEFAULT_SENSOR_FLOOR_LUX,
             sensor_integrator: SensorIntegrator::Auto,
@@ -196,6 +204,10 @@ pub enum SensorIntegrator {
 
 /// Samples per sensor cell of a path-tracer sensor pass when a scene does not say.
 pub const DEFAULT_SENSOR_SPP: u64 = 64;
+
+/// Samples per quantity of an observer when `settings.observer_spp` is not given: observers
+/// are few points, so their figures can afford about 1% noise.
+pub const DEFAULT_OBSERVER_SPP: u64 = 16_384;
 
 /// Camera samples per pixel when a scene does not say (`settings.spp`).
 pub const DEFAULT_SPP: u64 = 64;
@@ -332,6 +344,9 @@ pub(super) fn check_settings(file: &SceneFile, path: &Path) -> Result<(), SceneE
     }
     if s.sensor_spp == Some(0) {
         return Err(error("settings.sensor_spp", "must be at least 1".to_owned()));
+    }
+    if s.observer_spp == Some(0) {
+        return Err(error("settings.observer_spp", "must be at least 1".to_owned()));
     }
     if s.sensor_beams == Some(0) {
         return Err(error("settings.sensor_beams", "must be at least 1".to_owned()));

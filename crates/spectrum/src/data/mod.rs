@@ -11,4 +11,5 @@
 
 pub mod cie1931;
 pub mod illuminants;
+pub mod melanopic;
 pub mod reference;

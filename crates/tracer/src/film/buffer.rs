@@ -5,18 +5,19 @@ use spectrace_spectrum::Xyz;
 
 use super::exact::*;
 use super::raster::{FilmError, film_pixels, pixel_index, raster_bytes, same_size};
-use super::{ExactSum, Splat};
+use super::{ExactSum, SENSOR_SLOTS, Splat, sensor_to_fixed};
 
 /// A film of `width x height` pixels, each accumulating X, Y, Z exactly, followed by the cells
-/// of the scene's sensors (if any), each accumulating `[radiant, luminous, luminous^2]` the same
-/// way (see [`crate::SensorSums`]); optionally a second layer of pixel sums, the *pass layer*,
+/// of the scene's sensors (if any), each taking [`SENSOR_SLOTS`] sums the same way (see
+/// [`crate::SensorSums`]); optionally a second layer of pixel sums, the *pass layer*,
 /// for contributions normalised per pass rather than per pixel sample (see
 /// [`Film::with_pass_layer`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Film {
     pub(super) width: u32,
     pub(super) height: u32,
-    /// `[X, Y, Z]` per pixel, row-major from the top-left pixel, then the sensor cells.
+    /// `[X, Y, Z]` per pixel, row-major from the top-left pixel, then the sensor cells
+    /// (two each: `[radiant, luminous, luminous^2]`, `[melanopic, 0, 0]`).
     pub(super) sums: Vec<[ExactSum; 3]>,
     /// The pass layer: `[X, Y, Z]` per pixel of contributions normalised per pass (empty when
     /// the film has none).
@@ -47,7 +48,7 @@ impl Film {
         Ok(Self {
             width,
             height,
-            sums: vec![[ExactSum::default(); 3]; n + cells as usize],
+            sums: vec![[ExactSum::default(); 3]; n + SENSOR_SLOTS * cells as usize],
             pass_sums: Vec::new(),
             rejected: 0,
             accepted: 0,
@@ -100,30 +101,50 @@ impl Film {
     /// The number of sensor cells after the pixels.
     pub fn sensor_cells(&self) -> u32 {
         // A film read from a forged part file may hold fewer sums than its size says.
-        self.sums.len().saturating_sub(self.pixels()) as u32
+        (self.sums.len().saturating_sub(self.pixels()) / SENSOR_SLOTS) as u32
+    }
+
+    /// Sums after the pixels: [`SENSOR_SLOTS`] per sensor cell in a film a render made (a
+    /// film read from a file may hold any number; [`Film::sensor_cells`] rounds down).
+    pub fn sums_after_pixels(&self) -> usize {
+        self.sums.len().saturating_sub(self.pixels())
     }
 
     fn pixels(&self) -> usize {
         self.width as usize * self.height as usize
     }
 
-    /// The sensor cells' sums, `[radiant, luminous, luminous^2]` each, multiplied by `scale`
-    /// (the first two) and `scale^2` (the squares).
+    /// The sensor cells' sums, `[radiant, luminous, luminous^2, melanopic]` each, multiplied by
+    /// `scale` (the square by `scale^2`).
     pub fn sensor_sums(&self, scale: f64) -> Vec<crate::SensorSums> {
         self.sums
             .get(self.pixels()..)
             .unwrap_or_default()
-            .iter()
-            .map(|c| [c[0].value() * scale, c[1].value() * scale, c[2].value() * scale * scale])
+            .chunks_exact(SENSOR_SLOTS)
+            .map(|c| {
+                let [a, b] = [c[0], c[1]].map(|s| s.map(ExactSum::value));
+                [a[0] * scale, a[1] * scale, a[2] * scale * scale, b[0] * scale]
+            })
             .collect()
     }
 
-    /// Adds `[radiant, luminous, luminous^2]` to sensor cell `cell`; `false` (and a rejection)
-    /// for a cell beyond the film's or values out of range.
+    /// Adds `[radiant, luminous, luminous^2, melanopic]` to sensor cell `cell`, all or nothing:
+    /// `false` (and a rejection) for a cell beyond the film's or values out of range.
     pub fn add_sensor(&mut self, cell: u32, sums: crate::SensorSums) -> bool {
-        let index = self.pixels() + cell as usize;
-        match (index < self.sums.len(), xyz_to_fixed(Xyz::new(sums[0], sums[1], sums[2]))) {
-            (true, Some(fixed)) => self.add_fixed(index, fixed),
+        let index = self.pixels() + SENSOR_SLOTS * cell as usize;
+        match (index + 1 < self.sums.len(), sensor_to_fixed(sums)) {
+            (true, Some([a, b])) => {
+                let fits = |i: usize, f: [i128; 3]| {
+                    (0..3).all(|c| self.sums[i][c].0.checked_add(f[c]).is_some())
+                };
+                if fits(index, a) && fits(index + 1, b) {
+                    // Both fit: each slot counts as an accepted sum, as through a FilmWriter.
+                    self.add_fixed(index, a) && self.add_fixed(index + 1, b)
+                } else {
+                    self.rejected += 1;
+                    false
+                }
+            }
             _ => {
                 self.rejected += 1;
                 false

@@ -22,6 +22,19 @@ mod splat;
 mod writer;
 
 pub use buffer::Film;
+
+/// Sums a sensor cell takes in the film: `[radiant, luminous, luminous^2]` and
+/// `[melanopic, 0, 0]` (see [`crate::SensorSums`]).
+pub const SENSOR_SLOTS: usize = 2;
+
+/// A sensor cell's sums in fixed point, one triple per slot; `None` if any is out of range.
+#[inline]
+pub(crate) fn sensor_to_fixed(s: crate::SensorSums) -> Option<[[i128; 3]; SENSOR_SLOTS]> {
+    use spectrace_spectrum::Xyz;
+    let a = exact::xyz_to_fixed(Xyz::new(s[0], s[1], s[2]))?;
+    let b = exact::xyz_to_fixed(Xyz::new(s[3], 0.0, 0.0))?;
+    Some([a, b])
+}
 pub use exact::ExactSum;
 pub use measure::{ByMeasure, ErrorMeasure, RELMSE_EPSILON, relative_error};
 pub use moments::{ErrorEstimate, MAX_TRUSTED_UNCERTAINTY, MIN_BATCHES, Moments};

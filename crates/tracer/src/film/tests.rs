@@ -118,20 +118,20 @@ fn the_quick_fixed_point_conversion_is_within_rounding_of_the_exact_one() {
 fn sensor_cells_sum_apart_from_the_pixels_and_merge_exactly() {
     let mut direct = Film::with_sensor_cells(3, 2, 4).unwrap();
     assert_eq!(direct.sensor_cells(), 4);
-    assert!(direct.add_sensor(3, [1.5, 2.0, 4.0]));
-    assert!(!direct.add_sensor(4, [1.0, 1.0, 1.0]), "beyond the cells");
-    assert!(!direct.add_sensor(0, [f64::NAN, 0.0, 0.0]));
+    assert!(direct.add_sensor(3, [1.5, 2.0, 4.0, 0.75]));
+    assert!(!direct.add_sensor(4, [1.0, 1.0, 1.0, 1.0]), "beyond the cells");
+    assert!(!direct.add_sensor(0, [0.0, 0.0, 0.0, f64::NAN]));
     assert_eq!(direct.rejected(), 2);
     assert!(direct.add(2, 1, Xyz::new(1.0, 1.0, 1.0)));
     // The image holds only the pixels; the cells come back scaled (squares by scale^2).
     assert_eq!(direct.to_xyz(1.0).len(), 6);
-    assert_eq!(direct.sensor_sums(2.0)[3], [3.0, 4.0, 16.0]);
+    assert_eq!(direct.sensor_sums(2.0)[3], [3.0, 4.0, 16.0, 1.5]);
     // Through a buffered writer: bit for bit the same.
     let shared = Mutex::new(Film::with_sensor_cells(3, 2, 4).unwrap());
     {
         let mut w = FilmWriter::new(&shared);
-        assert!(w.splat_sensor(3, [1.5, 2.0, 4.0]));
-        assert!(!w.splat_sensor(4, [1.0, 1.0, 1.0]));
+        assert!(w.splat_sensor(3, [1.5, 2.0, 4.0, 0.75]));
+        assert!(!w.splat_sensor(4, [1.0, 1.0, 1.0, 1.0]));
         assert!(w.splat(2, 1, Xyz::new(1.0, 1.0, 1.0)));
     }
     let shared = shared.into_inner().unwrap();
@@ -142,7 +142,7 @@ fn sensor_cells_sum_apart_from_the_pixels_and_merge_exactly() {
     assert!(other.merge(&direct).is_err());
     let mut twice = direct.clone();
     twice.merge(&direct).unwrap();
-    assert_eq!(twice.sensor_sums(1.0)[3], [3.0, 4.0, 8.0]);
+    assert_eq!(twice.sensor_sums(1.0)[3], [3.0, 4.0, 8.0, 1.5]);
 }
 
 #[test]
@@ -154,13 +154,13 @@ fn the_pass_layer_sums_apart_from_the_pixels_and_merges_exactly() {
     assert!(direct.add_pass(2, 1, Xyz::new(4.0, 4.0, 4.0)));
     assert!(!direct.add_pass(3, 0, Xyz::new(1.0, 1.0, 1.0)), "outside the film");
     assert!(!direct.add_pass(0, 0, Xyz::new(f64::INFINITY, 1.0, 1.0)));
-    assert!(direct.add_sensor(0, [7.0, 7.0, 49.0]));
-    assert_eq!((direct.rejected(), direct.accepted()), (2, 4));
+    assert!(direct.add_sensor(0, [7.0, 7.0, 49.0, 3.0]));
+    assert_eq!((direct.rejected(), direct.accepted()), (2, 5));
     // Whole passes: both layers together, exactly; the sensor cell stays apart.
     let image = direct.to_xyz(2.0);
     assert_eq!(image[1], Xyz::new(3.0, 4.5, 6.25));
     assert_eq!(image[5], Xyz::new(8.0, 8.0, 8.0));
-    assert_eq!(direct.sensor_sums(1.0)[0], [7.0, 7.0, 49.0]);
+    assert_eq!(direct.sensor_sums(1.0)[0], [7.0, 7.0, 49.0, 3.0]);
     // Each layer normalised on its own.
     let layers = direct.to_xyz_layers(|i| if i == 1 { 10.0 } else { 0.0 }, 100.0);
     assert_eq!(layers[1], Xyz::new(60.0, 45.0, 42.5));
@@ -183,7 +183,7 @@ fn the_pass_layer_sums_apart_from_the_pixels_and_merges_exactly() {
         assert!(w.splat_pass(2, 1, Xyz::new(4.0, 4.0, 4.0)));
         assert!(!w.splat_pass(3, 0, Xyz::new(1.0, 1.0, 1.0)));
         assert!(!w.splat_pass(0, 0, Xyz::new(f64::INFINITY, 1.0, 1.0)));
-        assert!(w.splat_sensor(0, [7.0, 7.0, 49.0]));
+        assert!(w.splat_sensor(0, [7.0, 7.0, 49.0, 3.0]));
         w.end_chunk(0, 6);
     }
     let shared = shared.into_inner().unwrap();

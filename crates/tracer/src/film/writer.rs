@@ -32,7 +32,7 @@ pub struct FilmWriter<'a> {
     film: &'a Mutex<Film>,
     width: u32,
     height: u32,
-    /// Sensor cells after the pixels.
+    /// Sensor cells after the pixels ([`super::SENSOR_SLOTS`] sums each).
     sensor_cells: u32,
     /// The film has a pass layer (its sums follow the sensor cells).
     pass_layer: bool,
@@ -144,7 +144,8 @@ impl FilmWriter<'_> {
                 // The pass layer follows the pixels and the sensor cells (at most 2^26 + 2^22
                 // entries in all: fits u32).
                 let pixels = self.width * self.height;
-                let offset = if pass && self.pass_layer { pixels + self.sensor_cells } else { 0 };
+                let sensor_sums = super::SENSOR_SLOTS as u32 * self.sensor_cells;
+                let offset = if pass && self.pass_layer { pixels + sensor_sums } else { 0 };
                 self.entries.push((index as u32 + offset, fixed));
                 true
             }
@@ -168,13 +169,15 @@ impl Splat for FilmWriter<'_> {
     }
 
     fn splat_sensor(&mut self, cell: u32, sums: crate::SensorSums) -> bool {
-        match (cell < self.sensor_cells, xyz_to_fixed(Xyz::new(sums[0], sums[1], sums[2]))) {
-            (true, Some(fixed)) => {
-                if self.entries.len() >= Self::CAPACITY {
+        match (cell < self.sensor_cells, super::sensor_to_fixed(sums)) {
+            (true, Some([a, b])) => {
+                if self.entries.len() + 1 >= Self::CAPACITY {
                     self.flush();
                 }
-                // Sensor cells follow the pixels (at most 2^25 + 2^22 entries: fits u32).
-                self.entries.push((self.width * self.height + cell, fixed));
+                // Sensor cells follow the pixels (at most 2^25 + 2^23 entries: fits u32).
+                let index = self.width * self.height + super::SENSOR_SLOTS as u32 * cell;
+                self.entries.push((index, a));
+                self.entries.push((index + 1, b));
                 true
             }
             _ => {

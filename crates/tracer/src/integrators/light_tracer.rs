@@ -27,7 +27,7 @@ use serde::{Deserialize, Serialize};
 use spectrace_geometry::Ray;
 use spectrace_lights::{Beam, LightSource, uniform};
 use spectrace_materials::Transport;
-use spectrace_spectrum::lumens_per_watt;
+use spectrace_spectrum::{lumens_per_watt, melanopic_edi_per_watt};
 
 use super::common::{
     Direction, SampleLayout, ScatterSamples, VertexSamples, choose_lobe, connect_light_to_camera,
@@ -377,8 +377,8 @@ impl BeamTracer<'_, '_> {
     }
 
     /// Adds a path segment's bundle (reaching `reach`, or infinity) to every sensor cell it
-    /// crosses on the front side: the radiant weight, the luminous weight (times `683 ybar`)
-    /// and its square.
+    /// crosses on the front side: the radiant weight, the luminous weight (times `683 ybar`),
+    /// its square and the melanopic weight (see [`crate::SensorSums`]).
     #[inline]
     fn fill_sensors<S: Splat + ?Sized>(
         &self,
@@ -394,7 +394,9 @@ impl BeamTracer<'_, '_> {
             let radiant: f64 = weights.iter().sum();
             let luminous: f64 =
                 lambdas.iter().zip(weights).map(|(&l, &w)| w * lumens_per_watt(l)).sum();
-            film.splat_sensor(cell, [radiant, luminous, luminous * luminous]);
+            let melanopic: f64 =
+                lambdas.iter().zip(weights).map(|(&l, &w)| w * melanopic_edi_per_watt(l)).sum();
+            film.splat_sensor(cell, [radiant, luminous, luminous * luminous, melanopic]);
         });
     }
 }

@@ -41,6 +41,7 @@ use crate::{
 pub(crate) mod bdpt;
 pub(crate) mod common;
 pub(crate) mod light_tracer;
+pub(crate) mod observer;
 pub(crate) mod pass;
 pub(crate) mod path_tracer;
 pub(crate) mod sensor_path;

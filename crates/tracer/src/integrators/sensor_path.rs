@@ -22,7 +22,7 @@ use crate::{ChunkSampler, HERO, LightTracerScene, PathTracer, Splat, TraceStats}
 /// stratified, each weighted by one over its density, so the radiant and the luminous sums are
 /// both unbiased over the lights' whole range. The sensor blocks nothing: rays start at `x`.
 /// The film keeps `E x cell area / P` per sample (`P` the lights' power) in the cell's
-/// `[radiant, luminous, luminous^2]`, so that the light tracer's normalisation (`P / N / area`,
+/// [`crate::SensorSums`], so that the light tracer's normalisation (`P / N / area`,
 /// with `N` the passes) gives the mean irradiance.
 #[derive(Debug, Clone)]
 pub struct SensorPathTracer<'a> {
@@ -42,13 +42,12 @@ impl<'a> SensorPathTracer<'a> {
         Self { tracer, sensors, spectrum }
     }
 
-    /// One sample of the cell `cell` (numbered over all sensors): `[radiant, luminous]`
-    /// irradiance times the cell's area over the lights' power.
-    fn sample_cell(&self, cell: u32, rng: &mut dyn rand::Rng, stats: &mut TraceStats) -> [f64; 2] {
-        let scene = self.tracer.scene();
+    /// One sample of the cell `cell` (numbered over all sensors): `[radiant, luminous,
+    /// melanopic]` irradiance times the cell's area over the lights' power.
+    fn sample_cell(&self, cell: u32, rng: &mut dyn rand::Rng, stats: &mut TraceStats) -> [f64; 3] {
         let sensors = self.sensors.sensors();
         let Some(index) = (0..sensors.len()).rev().find(|&i| self.sensors.offset(i) <= cell) else {
-            return [0.0; 2];
+            return [0.0; 3];
         };
         let sensor = &sensors[index];
         let local = cell - self.sensors.offset(index);
@@ -58,51 +57,154 @@ impl<'a> SensorPathTracer<'a> {
         let x = sensor.corner()
             + sensor.edge_u() * ((f64::from(iu) + a) / f64::from(nu))
             + sensor.edge_v() * ((f64::from(iv) + b) / f64::from(nv));
-        let n = sensor.front();
-        // Wavelengths from the lights' spectrum, stratified.
-        let u = uniform(rng);
-        let mut lambdas = [0.0; HERO];
-        let mut weights = [0.0; HERO];
-        for j in 0..HERO {
-            let stratum = ((j as f64 + u) / HERO as f64).min(spectrace_sampling::ONE_MINUS_EPSILON);
-            let lambda = self.spectrum.sample_lambda(stratum);
-            let q = self.spectrum.value(lambda);
-            lambdas[j] = lambda;
-            weights[j] = if q > 0.0 { 1.0 / (HERO as f64 * q) } else { 0.0 };
-        }
-        let mut irradiance = [0.0; HERO];
-        // Point and spot lights, exactly.
-        for &id in scene.delta_lights() {
-            let Some(s) = sample_light(scene, id, x, [0.5, 0.5]) else { continue };
-            let cos = -s.direction.dot(n);
-            if !(cos > 0.0) || !unoccluded(scene, End::Point(x), End::Light(id, s.position)) {
-                continue;
-            }
-            let Some(spd) = scene.light_spd(id) else { continue };
-            let e = s.intensity * cos / (s.distance * s.distance);
-            for j in 0..HERO {
-                irradiance[j] += e * spd.value(lambdas[j]);
-            }
-        }
-        // Everything else along one cosine-weighted direction: E = pi L.
-        let local_dir = spectrace_sampling::sample_cosine_hemisphere([uniform(rng), uniform(rng)]);
-        let direction = spectrace_sampling::Frame::from_normal(n).to_world(local_dir).normalize();
-        let ray = Ray { origin: x, direction };
-        let radiance = self.tracer.radiance(ray, &lambdas, &mut weights, rng, stats);
-        for j in 0..HERO {
-            irradiance[j] += std::f64::consts::PI * radiance[j];
-        }
-        let scale = sensor.cell_area() / LightSource::power(scene.lights);
-        let (mut radiant, mut luminous) = (0.0, 0.0);
-        for j in 0..HERO {
-            if weights[j] > 0.0 && irradiance[j] != 0.0 {
-                radiant += irradiance[j] * weights[j];
-                luminous +=
-                    irradiance[j] * weights[j] * spectrace_spectrum::lumens_per_watt(lambdas[j]);
-            }
-        }
-        [radiant * scale, luminous * scale]
+        let gathered =
+            gather(&self.tracer, &*self.spectrum, x, Response::Planar(sensor.front()), rng, stats);
+        gathered.map(|g| g * sensor.cell_area())
     }
+}
+
+/// How a receiver at a point weighs light by the direction it arrives from: its irradiance is
+/// `integral of L_i(w) r(w) dw` over the sphere of directions `w` the light travels along
+/// (pointing *into* the receiver), and every response here integrates to `pi` over a uniform
+/// sphere of radiance 1 (`E = pi L`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Response {
+    /// A plane with the unit front normal `n`: `r = max(0, -w . n)` (horizontal illuminance for
+    /// `n` up, vertical illuminance for a horizontal `n`).
+    Planar(glam::DVec3),
+    /// A plane as [`Response::Planar`], counting everything but the point and spot lights seen
+    /// directly: the indirect (and area-light) part, the background of a glare rating.
+    PlanarExceptDeltaLights(glam::DVec3),
+    /// A small cylinder with the unit vertical axis `up` (cylindrical illuminance, EN 12464-1):
+    /// the flux on its curved surface over that surface's area, `r = sin theta / pi` with
+    /// `theta` the angle between `-w` and `up`.
+    Cylindrical(glam::DVec3),
+    /// The curved half of such a cylinder facing the horizontal unit direction `facing`
+    /// (semi-cylindrical illuminance, EN 12464-1 / CIE 136): `r = sin theta (1 + cos phi) / pi`
+    /// with `phi` the horizontal angle between `-w` and `facing`.
+    SemiCylindrical {
+        /// The cylinder's vertical axis.
+        up: glam::DVec3,
+        /// The horizontal direction its curved half faces.
+        facing: glam::DVec3,
+    },
+}
+
+impl Response {
+    /// The response `r` to light arriving from the unit direction `from` (pointing from the
+    /// receiver towards where the light comes from, `-w`).
+    pub fn weight(self, from: glam::DVec3) -> f64 {
+        use std::f64::consts::PI;
+        match self {
+            Response::Planar(n) | Response::PlanarExceptDeltaLights(n) => from.dot(n).max(0.0),
+            Response::Cylindrical(up) => horizontal(from, up).length() / PI,
+            Response::SemiCylindrical { up, facing } => {
+                let h = horizontal(from, up);
+                let (sin_theta, along) = (h.length(), h.dot(facing));
+                // sin theta (1 + cos phi) = sin theta + (horizontal part . facing).
+                (sin_theta + along).max(0.0) / PI
+            }
+        }
+    }
+
+    /// A direction towards the light (`-w`) drawn with density `r(w) / pi` (two uniforms from
+    /// `rng` for a plane, three for a cylinder), and the estimator's factor `r / pdf` (`pi`
+    /// where the density is exact).
+    fn sample(self, rng: &mut dyn rand::Rng) -> (glam::DVec3, f64) {
+        use spectrace_sampling::{Frame, sample_cosine_hemisphere};
+        use std::f64::consts::PI;
+        let u = [uniform(rng), uniform(rng)];
+        let lobe = |axis: glam::DVec3| {
+            Frame::from_normal(axis).to_world(sample_cosine_hemisphere(u)).normalize()
+        };
+        match self {
+            Response::Planar(n) | Response::PlanarExceptDeltaLights(n) => (lobe(n), PI),
+            // A cylinder's response is the mean of vertical planes' over the horizontal
+            // directions: a uniform azimuth, then a cosine lobe about it, has density
+            // sin theta / pi^2 exactly.
+            Response::Cylindrical(up) | Response::SemiCylindrical { up, .. } => {
+                let frame = Frame::from_normal(up);
+                let psi = 2.0 * PI * uniform(rng);
+                let axis = frame.to_world(glam::DVec3::new(psi.cos(), psi.sin(), 0.0)).normalize();
+                let from = lobe(axis);
+                let pdf = horizontal(from, up).length() / (PI * PI);
+                let factor = if pdf > 0.0 { self.weight(from) / pdf } else { 0.0 };
+                (from, factor)
+            }
+        }
+    }
+
+    /// Whether point and spot lights seen directly count.
+    fn counts_delta_lights(self) -> bool {
+        !matches!(self, Response::PlanarExceptDeltaLights(_))
+    }
+}
+
+/// The part of the unit `v` perpendicular to the unit `up`.
+fn horizontal(v: glam::DVec3, up: glam::DVec3) -> glam::DVec3 {
+    v - up * v.dot(up)
+}
+
+/// One sample of the irradiance at `x` with the response `response`, over the lights' power:
+/// `[radiant, luminous, melanopic]` (W/m^2, lux, melanopic EDI lux, each divided by `P`).
+///
+/// Point and spot lights (which no ray can hit) add exactly `I(w) r(w) / d^2` when visible;
+/// everything else arrives along one direction drawn with density `r / pi` (see
+/// [`Response::sample`]), `E = pi L` in expectation, with `L` the path tracer's radiance
+/// estimate along that ray (emitters it hits count fully, since nothing else samples them at
+/// `x`). Wavelengths are drawn from the lights' own spectrum, [`HERO`] of them stratified, each
+/// weighted by one over its density, so every sum is unbiased over the lights' whole range.
+pub(crate) fn gather(
+    tracer: &PathTracer<'_>,
+    spectrum: &dyn spectrace_spectrum::SpectralPowerDistribution,
+    x: glam::DVec3,
+    response: Response,
+    rng: &mut dyn rand::Rng,
+    stats: &mut TraceStats,
+) -> [f64; 3] {
+    let scene = tracer.scene();
+    let u = uniform(rng);
+    let mut lambdas = [0.0; HERO];
+    let mut weights = [0.0; HERO];
+    for j in 0..HERO {
+        let stratum = ((j as f64 + u) / HERO as f64).min(spectrace_sampling::ONE_MINUS_EPSILON);
+        let lambda = spectrum.sample_lambda(stratum);
+        let q = spectrum.value(lambda);
+        lambdas[j] = lambda;
+        weights[j] = if q > 0.0 { 1.0 / (HERO as f64 * q) } else { 0.0 };
+    }
+    let mut irradiance = [0.0; HERO];
+    for &id in scene.delta_lights().iter().filter(|_| response.counts_delta_lights()) {
+        let Some(s) = sample_light(scene, id, x, [0.5, 0.5]) else { continue };
+        let r = response.weight(-s.direction);
+        if !(r > 0.0) || !unoccluded(scene, End::Point(x), End::Light(id, s.position)) {
+            continue;
+        }
+        let Some(spd) = scene.light_spd(id) else { continue };
+        let e = s.intensity * r / (s.distance * s.distance);
+        for j in 0..HERO {
+            irradiance[j] += e * spd.value(lambdas[j]);
+        }
+    }
+    let (direction, factor) = response.sample(rng);
+    if factor > 0.0 {
+        let ray = Ray { origin: x, direction };
+        let radiance = tracer.radiance(ray, &lambdas, &mut weights, rng, stats);
+        for j in 0..HERO {
+            irradiance[j] += factor * radiance[j];
+        }
+    }
+    let scale = 1.0 / LightSource::power(scene.lights);
+    let mut sums = [0.0; 3];
+    for j in 0..HERO {
+        if weights[j] > 0.0 && irradiance[j] != 0.0 {
+            let e = irradiance[j] * weights[j] * scale;
+            sums[0] += e;
+            sums[1] += e * spectrace_spectrum::lumens_per_watt(lambdas[j]);
+            sums[2] += e * spectrace_spectrum::melanopic_edi_per_watt(lambdas[j]);
+        }
+    }
+    sums
 }
 
 impl PassEstimator for SensorPathTracer<'_> {
@@ -138,9 +240,9 @@ impl PassEstimator for SensorPathTracer<'_> {
         stats: &mut TraceStats,
     ) {
         let cell = item as u32;
-        let [radiant, luminous] = self.sample_cell(cell, rng, stats);
-        if radiant != 0.0 || luminous != 0.0 {
-            film.splat_sensor(cell, [radiant, luminous, luminous * luminous]);
+        let [radiant, luminous, melanopic] = self.sample_cell(cell, rng, stats);
+        if radiant != 0.0 || luminous != 0.0 || melanopic != 0.0 {
+            film.splat_sensor(cell, [radiant, luminous, luminous * luminous, melanopic]);
         }
     }
 }
