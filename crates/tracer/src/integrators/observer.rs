@@ -80,7 +80,7 @@ impl PassEstimator for ObserverTracer<'_> {
         let Some(observer) = self.observers.get((item / RECEIVERS) as usize) else { return };
         let response = observer.responses()[(item % RECEIVERS) as usize];
         let [radiant, luminous, melanopic] =
-            gather(&self.tracer, &*self.spectrum, observer.position(), response, rng, stats);
+            gather(&self.tracer, &*self.spectrum, observer.position(), (response, 1.0), rng, stats);
         if radiant != 0.0 || luminous != 0.0 || melanopic != 0.0 {
             film.splat_sensor(item as u32, [radiant, luminous, luminous * luminous, melanopic]);
         }

@@ -57,9 +57,8 @@ impl<'a> SensorPathTracer<'a> {
         let x = sensor.corner()
             + sensor.edge_u() * ((f64::from(iu) + a) / f64::from(nu))
             + sensor.edge_v() * ((f64::from(iv) + b) / f64::from(nv));
-        let gathered =
-            gather(&self.tracer, &*self.spectrum, x, Response::Planar(sensor.front()), rng, stats);
-        gathered.map(|g| g * sensor.cell_area())
+        let receiver = (Response::Planar(sensor.front()), sensor.cell_area());
+        gather(&self.tracer, &*self.spectrum, x, receiver, rng, stats)
     }
 }
 
@@ -145,8 +144,8 @@ fn horizontal(v: glam::DVec3, up: glam::DVec3) -> glam::DVec3 {
     v - up * v.dot(up)
 }
 
-/// One sample of the irradiance at `x` with the response `response`, over the lights' power:
-/// `[radiant, luminous, melanopic]` (W/m^2, lux, melanopic EDI lux, each divided by `P`).
+/// One sample of the irradiance at `x` with the response `response`, times `area` over the
+/// lights' power `P`: `[radiant, luminous, melanopic]` (W/m^2, lux, melanopic EDI lux).
 ///
 /// Point and spot lights (which no ray can hit) add exactly `I(w) r(w) / d^2` when visible;
 /// everything else arrives along one direction drawn with density `r / pi` (see
@@ -158,7 +157,7 @@ pub(crate) fn gather(
     tracer: &PathTracer<'_>,
     spectrum: &dyn spectrace_spectrum::SpectralPowerDistribution,
     x: glam::DVec3,
-    response: Response,
+    (response, area): (Response, f64),
     rng: &mut dyn rand::Rng,
     stats: &mut TraceStats,
 ) -> [f64; 3] {
@@ -194,17 +193,17 @@ pub(crate) fn gather(
             irradiance[j] += factor * radiance[j];
         }
     }
-    let scale = 1.0 / LightSource::power(scene.lights);
+    let scale = area / LightSource::power(scene.lights);
     let mut sums = [0.0; 3];
     for j in 0..HERO {
         if weights[j] > 0.0 && irradiance[j] != 0.0 {
-            let e = irradiance[j] * weights[j] * scale;
+            let e = irradiance[j] * weights[j];
             sums[0] += e;
             sums[1] += e * spectrace_spectrum::lumens_per_watt(lambdas[j]);
             sums[2] += e * spectrace_spectrum::melanopic_edi_per_watt(lambdas[j]);
         }
     }
-    sums
+    sums.map(|v| v * scale)
 }
 
 impl PassEstimator for SensorPathTracer<'_> {
