@@ -42,10 +42,11 @@ fn table_lumens(p: &CandelaPlanes) -> f64 {
     sum * 360.0 / span.max(f64::MIN_POSITIVE)
 }
 
-/// The flux (lm) of a full type B table from the file's own grid, as floodlight photometry
-/// computes it: each cell's mean of its four corners times its solid angle
-/// `dV (sin H_b - sin H_a)` (`H` within the measuring plane, `V` the plane's turn).
-fn type_b_zonal_lumens(f: &IesFile) -> f64 {
+/// The flux (lm) of a full type B (or A) table from the file's own grid, as floodlight
+/// photometry computes it: each cell's mean of its four corners times its solid angle
+/// `dV (sin H_b - sin H_a)` (`H` within the measuring plane, `V` the plane's turn; for type A
+/// the roles are exchanged).
+fn polar_zonal_lumens(f: &IesFile) -> f64 {
     let (hs, vs) = (&f.horizontal, &f.vertical);
     assert!(hs[0] == -90.0 && vs[0] == -90.0, "a full table");
     let mut sum = 0.0;
@@ -53,9 +54,14 @@ fn type_b_zonal_lumens(f: &IesFile) -> f64 {
         for j in 0..vs.len() - 1 {
             let c = &f.candela;
             let mean = (c[i][j] + c[i + 1][j] + c[i][j + 1] + c[i + 1][j + 1]) / 4.0;
+            // Type B: V turns the plane, H lies within it; type A the other way round.
+            let (plane, within) = match f.photometry {
+                Photometry::A => ((hs[i + 1] - hs[i]), (vs[j], vs[j + 1])),
+                _ => ((vs[j + 1] - vs[j]), (hs[i], hs[i + 1])),
+            };
             sum += mean
-                * (vs[j + 1] - vs[j]).to_radians()
-                * (hs[i + 1].to_radians().sin() - hs[i].to_radians().sin());
+                * plane.to_radians()
+                * (within.1.to_radians().sin() - within.0.to_radians().sin());
         }
     }
     sum
@@ -101,7 +107,7 @@ fn every_real_luminaire_file_loads_with_the_flux_of_its_table() {
             let f = IesFile::parse(&text, &name).unwrap();
             let table = match f.photometry {
                 Photometry::C => table_lumens(&f.candela_planes()),
-                Photometry::B => type_b_zonal_lumens(&f),
+                Photometry::B | Photometry::A => polar_zonal_lumens(&f),
             };
             table * f.ballast_factor
         } else {

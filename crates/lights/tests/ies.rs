@@ -116,15 +116,16 @@ fn malformed_files_are_refused_with_their_line_and_cause() {
             && e.contains("vertical angles must increase strictly: 40 after 45"),
         "{e}"
     );
-    // Type A, said clearly; a type C table read as type B has angles out of type B's range,
-    // named with their line.
+    // A type C table read as type B or A has angles out of their range, named with their line.
     let e = error(&LM63_2002.replace("5 3 1 2", "5 3 2 2"));
     assert!(
         e.starts_with("bad.ies:13:") && e.contains("type B horizontal angles end at 90"),
         "{e}"
     );
     let e = error(&LM63_2002.replace("5 3 1 2", "5 3 3 2"));
-    assert!(e.contains("type A"), "{e}");
+    assert!(e.contains("type A horizontal angles end at 90"), "{e}");
+    let e = error(&LM63_2002.replace("5 3 1 2", "5 3 4 2"));
+    assert!(e.contains("photometric type = 4"), "{e}");
     // Tilt data in another file: nothing is opened.
     let e = error(&LM63_2002.replace("TILT=NONE", "TILT=/etc/passwd"));
     assert!(e.starts_with("bad.ies:9:") && e.contains("another file is not read"), "{e}");

@@ -572,3 +572,95 @@ fn type_b_tables_turn_about_their_horizontal_axis() {
         assert!(a > 0.0, "H {h}, V {v} is in front");
     }
 }
+
+/// A type A (automotive and signal light) file of asymmetric made-up intensities. Its vertical
+/// planes share the vertical axis, as type C's, but its vertical angles are elevations (`V =
+/// -90` straight down, along `nadir`) and its horizontal angles turn clockwise seen from above
+/// from the photometric horizontal `c0` (LM-63-2002 section 3): the direction of `(H, V)` is
+/// `cos V (cos H c0 + sin H (c0 x up)) + sin V up` with `up = -nadir`. The light gives the
+/// file's value there; the flux is the zonal sum `sum avg4 dH (sin V_b - sin V_a)`; a table
+/// given for `H >= 0` only is the mirrored full one; the back half-space gets no light.
+#[test]
+fn type_a_tables_turn_about_the_vertical_axis_clockwise() {
+    let hs = [-90.0, -40.0, 0.0, 30.0, 90.0];
+    let vs = [-90.0, -20.0, 0.0, 45.0, 90.0];
+    let value = |h: f64, v: f64| 100.0 + 3.0 * (h + 90.0) + 0.5 * (v + 90.0) + 0.01 * h * v;
+    // At the zenith and the nadir (V = +-90) every plane meets: one value whatever H.
+    let at = |h: f64, v: f64| value(if v.abs() == 90.0 { 0.0 } else { h }, v);
+    let file = |hs: &[f64]| {
+        let mut t = String::from("IESNA:LM-63-2002\n[TEST] type A\nTILT=NONE\n");
+        t += &format!("1 -1 1 {} {} 3 2 0.1 0.2 0.05\n1 1 20\n", vs.len(), hs.len());
+        t += &vs.map(|v| v.to_string()).join(" ");
+        t += "\n";
+        t += &hs.iter().map(|h| h.to_string()).collect::<Vec<_>>().join(" ");
+        t += "\n";
+        for &h in hs {
+            let row: Vec<String> = vs.iter().map(|&v| at(h, v).to_string()).collect();
+            t += &row.join(" ");
+            t += "\n";
+        }
+        t
+    };
+    let (nadir, c0) = (DVec3::NEG_Y, DVec3::X);
+    let light = |text: &str| {
+        let f = spectrace_lights::photometry::IesFile::parse(text, "signal.ies").unwrap();
+        IesLight::new(
+            f,
+            DVec3::ZERO,
+            nadir,
+            c0,
+            std::sync::Arc::new(spectrace_lights::spectrum::CieIlluminant::new("A").unwrap()),
+            1.0,
+            Default::default(),
+        )
+        .unwrap()
+    };
+    let full = light(&file(&hs));
+    let up = -nadir;
+    let direction = |h: f64, v: f64| {
+        let (h, v) = (h.to_radians(), v.to_radians());
+        (c0 * h.cos() + c0.cross(up) * h.sin()) * v.cos() + up * v.sin()
+    };
+    // Clockwise from above: H = +90 is +z when c0 is +x and up is +y.
+    assert!((direction(90.0, 0.0) - DVec3::Z).length() < 1e-12);
+    for &h in hs.iter().filter(|h| h.abs() < 90.0) {
+        for &v in vs.iter().filter(|v| v.abs() < 90.0) {
+            let want = value(h, v);
+            let got = full.candela_towards(direction(h, v));
+            assert!((got - want).abs() < 1e-9 * want, "H {h}, V {v}: {got} vs {want}");
+        }
+    }
+    let down = full.candela_towards(nadir);
+    assert!((down - value(0.0, -90.0)).abs() < 1e-9 * down, "photometric zero: {down}");
+    assert_eq!(full.candela_towards(-c0), 0.0, "behind the photometric horizontal is dark");
+    let mut zonal = 0.0;
+    for i in 0..hs.len() - 1 {
+        for j in 0..vs.len() - 1 {
+            let avg = (at(hs[i], vs[j])
+                + at(hs[i + 1], vs[j])
+                + at(hs[i], vs[j + 1])
+                + at(hs[i + 1], vs[j + 1]))
+                / 4.0;
+            zonal += avg
+                * (hs[i + 1] - hs[i]).to_radians()
+                * (vs[j + 1].to_radians().sin() - vs[j].to_radians().sin());
+        }
+    }
+    assert!((full.lumens() - zonal).abs() < 1e-6 * zonal, "{} vs {zonal}", full.lumens());
+    // A laterally symmetric table given from H = 0: the mirrored full one.
+    let half = light(&file(&[0.0, 30.0, 90.0]));
+    for (h, v) in [(30.0, 45.0), (60.0, -20.0)] {
+        let a = half.candela_towards(direction(h, v));
+        let b = half.candela_towards(direction(-h, v));
+        assert!((a - b).abs() < 1e-9 * a, "mirror H {h}, V {v}: {a} vs {b}");
+        assert!(a > 0.0, "H {h}, V {v} is in front");
+    }
+    // The scene-file form keeps the keys as given.
+    let json = serde_json::to_value(&full).unwrap();
+    assert_eq!(json["nadir"], serde_json::json!([0.0, -1.0, 0.0]));
+    // The opening (width 0.1, length 0.2, height 0.05) faces the photometric horizontal: seen
+    // from straight ahead it shows its width x length face, as a lamp's lens.
+    let ahead = full.glare_view(c0 * 10.0).unwrap();
+    assert!((ahead.projected_area - 0.1 * 0.2).abs() < 1e-12, "{ahead:?}");
+    assert!((ahead.intensity - value(0.0, 0.0)).abs() < 1e-9, "{ahead:?}");
+}

@@ -18,7 +18,8 @@
 //! Numbers after the `TILT` line may be split over lines at will and separated by blanks or
 //! commas. Lumens per lamp of `-1` mean *absolute photometry* (the candela values are the
 //! luminaire's own, no lamp rating). Photometry types C (1) and B (2, floodlights: see
-//! [`IesFile::type_b_planes`]) are read; type A (3) is refused with a message saying so. A `TILT=<file>` naming another file is refused (the
+//! [`IesFile::type_b_planes`]) and A (3, automotive and signal lights: see
+//! [`IesFile::type_a_planes`]) are read. A `TILT=<file>` naming another file is refused (the
 //! reader opens nothing); `TILT=INCLUDE` is read and kept.
 //!
 //! Checks, each an error naming the file, the line and the cause: a `TILT` line is required;
@@ -74,6 +75,10 @@ pub enum Photometry {
     /// measuring plane about it, horizontal angles are measured within the plane from the
     /// photometric axis (floodlights).
     B,
+    /// Type A (3): a vertical polar axis, as type C, but vertical angles are elevations from
+    /// the horizontal (-90 straight down, 0 the photometric horizontal) and horizontal angles
+    /// turn clockwise seen from above (automotive and signal lights; LM-63-2002 section 3).
+    A,
 }
 
 /// The luminous dimensions' unit.
@@ -285,12 +290,7 @@ impl IesFile {
         let photometry = match kind {
             1.0 => Photometry::C,
             2.0 => Photometry::B,
-            3.0 => {
-                return Err(err(
-                    line,
-                    "photometric type 3 (type A): only types C (1) and B (2) are read".to_owned(),
-                ));
-            }
+            3.0 => Photometry::A,
             _ => {
                 return Err(err(
                     line,
@@ -321,7 +321,8 @@ impl IesFile {
         increasing(&horizontal, "horizontal angles", &err)?;
         match photometry {
             Photometry::C => check_type_c(&vertical, &horizontal, &err)?,
-            Photometry::B => check_type_b(&vertical, &horizontal, &err)?,
+            Photometry::B => check_types_a_b("B", &vertical, &horizontal, &err)?,
+            Photometry::A => check_types_a_b("A", &vertical, &horizontal, &err)?,
         }
         let mut candela = Vec::with_capacity(n_horizontal);
         for (h, &(angle, _)) in horizontal.iter().enumerate() {
@@ -481,6 +482,10 @@ impl IesFile {
                 let (horizontal, vertical, candela) = self.type_b_planes();
                 CandelaPlanes { horizontal, vertical, candela, lamp_lumens }
             }
+            Photometry::A => {
+                let (horizontal, vertical, candela) = self.type_a_planes();
+                CandelaPlanes { horizontal, vertical, candela, lamp_lumens }
+            }
         }
     }
 
@@ -493,42 +498,70 @@ impl IesFile {
     /// `(C', cos gamma') = (V, sin H)`, the grid the measurement was made on, so the flux is
     /// the file's exact zonal sum.
     pub fn type_b_planes(&self) -> (Vec<f64>, Vec<f64>, Vec<Vec<f64>>) {
-        // Mirror a half table: rows over H, columns over V.
-        let mirror = |angles: &[f64]| -> Vec<f64> {
-            if angles[0] == 0.0 {
-                angles.iter().rev().map(|a| -a).chain(angles[1..].iter().copied()).collect()
-            } else {
-                angles.to_vec()
-            }
-        };
-        let source = |angles: &[f64], i: usize| -> usize {
-            if angles[0] == 0.0 { i.abs_diff(angles.len() - 1) } else { i }
-        };
-        let hs = mirror(&self.horizontal);
-        let vs = mirror(&self.vertical);
-        let value = |h: usize, v: usize| {
-            self.candela[source(&self.horizontal, h)][source(&self.vertical, v)]
-        };
-        // gamma' increasing: H from 90 down to -90.
-        let gammas: Vec<f64> = hs.iter().rev().map(|h| 90.0 - h).collect();
-        let column = |v: usize| -> Vec<f64> { (0..hs.len()).rev().map(|h| value(h, v)).collect() };
-        // The plane at V = 0, interpolated where the file has none.
-        let zero = vs.partition_point(|&v| v < 0.0);
-        let mut planes: Vec<(f64, Vec<f64>)> = Vec::new();
-        if vs[zero] != 0.0 {
-            let (a, b) = (zero - 1, zero);
-            let t = -vs[a] / (vs[b] - vs[a]);
-            let (ca, cb) = (column(a), column(b));
-            planes.push((0.0, ca.iter().zip(&cb).map(|(x, y)| x + t * (y - x)).collect()));
-        }
-        planes.extend((zero..vs.len()).map(|v| (vs[v], column(v))));
-        const EDGE: f64 = 1e-6;
-        planes.push((90.0 + EDGE, vec![0.0; gammas.len()]));
-        planes.push((270.0 - EDGE, vec![0.0; gammas.len()]));
-        planes.extend((0..zero).map(|v| (360.0 + vs[v], column(v))));
-        let (horizontal, candela) = planes.into_iter().unzip();
-        (horizontal, gammas, candela)
+        let value = |v: usize, h: usize| self.candela[h][v];
+        polar_planes(&self.vertical, &self.horizontal, value)
     }
+
+    /// A type A table as type C planes about its polar axis pointing *up*: a direction of type
+    /// A angles `(H, V)` (`H` the vertical plane's turn, clockwise seen from above, from the
+    /// photometric horizontal; `V` the elevation within it) lies at `gamma' = 90 - V` from the
+    /// zenith, in the plane `C' = H` (`H` below 0 as `360 + H`), which turns clockwise seen
+    /// from above when the light's `nadir` is the zenith. It is [`Self::type_b_planes`] with
+    /// the two angles' roles exchanged: type A's planes share the vertical axis, type B's a
+    /// horizontal one. A table given from 0 only is mirrored; the unmeasured back half is
+    /// dark; the intensity is bilinear in `(H, sin V)`, so the flux is the file's zonal sum.
+    pub fn type_a_planes(&self) -> (Vec<f64>, Vec<f64>, Vec<Vec<f64>>) {
+        let value = |h: usize, v: usize| self.candela[h][v];
+        polar_planes(&self.horizontal, &self.vertical, value)
+    }
+}
+
+/// The type C planes of a table measured in planes through a polar axis (types A and B):
+/// `planes` the angles turning the measuring plane about the axis, `within` the angles within
+/// a plane from the photometric axis towards the `+90` end of the polar axis, `value(p, w)`
+/// the candela at `planes[p]`, `within[w]`. A direction at `(p, w)` lies at `gamma' = 90 - w`
+/// from the polar axis's `+90` end, in the plane `C' = p` (negative `p` as `360 + p`), the
+/// photometric axis being `C' = 0, gamma' = 90`. Either angle list starting at 0 is a half
+/// table, mirrored first; the unmeasured back half (`C'` from 90 to 270) is dark: planes of zero
+/// just inside it (1e-6 degrees).
+fn polar_planes(
+    planes: &[f64],
+    within: &[f64],
+    value: impl Fn(usize, usize) -> f64,
+) -> (Vec<f64>, Vec<f64>, Vec<Vec<f64>>) {
+    // Mirror a half table.
+    let mirror = |angles: &[f64]| -> Vec<f64> {
+        if angles[0] == 0.0 {
+            angles.iter().rev().map(|a| -a).chain(angles[1..].iter().copied()).collect()
+        } else {
+            angles.to_vec()
+        }
+    };
+    let source = |angles: &[f64], i: usize| -> usize {
+        if angles[0] == 0.0 { i.abs_diff(angles.len() - 1) } else { i }
+    };
+    let hs = mirror(within);
+    let vs = mirror(planes);
+    let value = |h: usize, v: usize| value(source(planes, v), source(within, h));
+    // gamma' increasing: H from 90 down to -90.
+    let gammas: Vec<f64> = hs.iter().rev().map(|h| 90.0 - h).collect();
+    let column = |v: usize| -> Vec<f64> { (0..hs.len()).rev().map(|h| value(h, v)).collect() };
+    // The plane at V = 0, interpolated where the file has none.
+    let zero = vs.partition_point(|&v| v < 0.0);
+    let mut planes: Vec<(f64, Vec<f64>)> = Vec::new();
+    if vs[zero] != 0.0 {
+        let (a, b) = (zero - 1, zero);
+        let t = -vs[a] / (vs[b] - vs[a]);
+        let (ca, cb) = (column(a), column(b));
+        planes.push((0.0, ca.iter().zip(&cb).map(|(x, y)| x + t * (y - x)).collect()));
+    }
+    planes.extend((zero..vs.len()).map(|v| (vs[v], column(v))));
+    const EDGE: f64 = 1e-6;
+    planes.push((90.0 + EDGE, vec![0.0; gammas.len()]));
+    planes.push((270.0 - EDGE, vec![0.0; gammas.len()]));
+    planes.extend((0..zero).map(|v| (360.0 + vs[v], column(v))));
+    let (horizontal, candela) = planes.into_iter().unzip();
+    (horizontal, gammas, candela)
 }
 
 /// The type C angle ranges: vertical in [0, 180], horizontal in [0, 360], starting at 0 (or 90
@@ -574,9 +607,10 @@ fn check_type_c(
     Ok(())
 }
 
-/// The type B angle ranges: both within [-90, 90], each starting at -90 (or at 0 for a table
-/// symmetric about its plane 0) and ending at 90.
-fn check_type_b(
+/// The type A and B angle ranges (LM-63-2002 section 5.13): both within [-90, 90], each
+/// starting at -90 (or at 0 for a table symmetric about its plane 0) and ending at 90.
+fn check_types_a_b(
+    kind: &str,
     vertical: &[(f64, usize)],
     horizontal: &[(f64, usize)],
     err: &impl Fn(usize, String) -> PhotometryError,
@@ -588,14 +622,14 @@ fn check_type_b(
             return Err(err(
                 line,
                 format!(
-                    "first {what} angle {first}: type B {what} angles start at -90 (or 0 for a symmetric table)"
+                    "first {what} angle {first}: type {kind} {what} angles start at -90 (or 0 for a symmetric table)"
                 ),
             ));
         }
         if last != 90.0 {
             return Err(err(
                 last_line,
-                format!("last {what} angle {last}: type B {what} angles end at 90"),
+                format!("last {what} angle {last}: type {kind} {what} angles end at 90"),
             ));
         }
     }

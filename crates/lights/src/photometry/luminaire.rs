@@ -6,8 +6,8 @@
 //! |---|---|---|---|
 //! | `file` | path | required | the photometric file, relative to the scene file's folder |
 //! | `position` | m | required | the luminaire's photometric centre |
-//! | `nadir` | | `[0, -1, 0]` | direction of vertical angle 0 (straight down from the luminaire); for an IES type B file, the photometric axis |
-//! | `c0` | | `[1, 0, 0]` | direction of C-plane 0 (made perpendicular to `nadir`; must not be parallel to it); for an IES type B file, the `H = +90` end of the polar axis |
+//! | `nadir` | | `[0, -1, 0]` | direction of vertical angle 0 (straight down from the luminaire); for an IES type B file, the photometric axis; for type A, straight down (`V = -90`) |
+//! | `c0` | | `[1, 0, 0]` | direction of C-plane 0 (made perpendicular to `nadir`; must not be parallel to it); for an IES type B file, the `H = +90` end of the polar axis; for type A, the photometric horizontal (`H = 0, V = 0`) |
 //! | `spd` | SPD | see below | spectrum of the light |
 //! | `cct` | K | | instead of `spd`: a blackbody at this colour temperature |
 //! | `multiplier` | | 1 | scales every candela value (and so the flux) |
@@ -64,7 +64,7 @@
 //! horizontal face of a flat or box-shaped opening counts on the side(s) the table sends light
 //! to: seen from below when some measured value below the horizontal is positive, from above
 //! when some value above it is (an uplight); a type B table's opening faces its photometric
-//! axis.
+//! axis, a type A table's its photometric horizontal.
 //!
 //! # What is not modelled
 //! The luminaire emits from a point (far-field photometry): its luminous opening serves the
@@ -749,9 +749,11 @@ impl IesLight {
         let planes = ies.candela_planes();
         // A type B table's planes turn about its horizontal polar axis, `c0`; its photometric
         // axis, where a type C table's nadir is, is `nadir`.
+        // A type A table's planes turn about the vertical axis pointing up: `-nadir`.
         let placement = match ies.photometry {
             super::Photometry::C => placement,
             super::Photometry::B => (placement.0, placement.2, placement.1),
+            super::Photometry::A => (placement.0, -placement.1, placement.2),
         };
         let (luminaire, mut repr) = Luminaire::placed(
             "IesLight",
@@ -774,6 +776,12 @@ impl IesLight {
             super::Photometry::B => {
                 // The scene-file form keeps the keys as given.
                 std::mem::swap(&mut repr.nadir, &mut repr.c0);
+                PlacedOpening::new(ies.luminous_opening(), [c90, nadir, c0], true, false)
+            }
+            super::Photometry::A => {
+                repr.nadir = -repr.nadir;
+                // As type B's: its width x length face towards the photometric horizontal
+                // (the orientation's C0), as a lamp's lens.
                 PlacedOpening::new(ies.luminous_opening(), [c90, nadir, c0], true, false)
             }
         };
