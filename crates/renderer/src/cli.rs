@@ -86,9 +86,15 @@ enum Command {
         /// Seed of every random stream (overrides settings.seed).
         #[arg(long, allow_negative_numbers = true, value_parser = parse_seed)]
         seed: Option<u64>,
-        /// Render only the work chunks whose index is K mod N and write a partial film (K/N).
+        /// Render only the work chunks whose index is K mod N and write a partial film (K/N);
+        /// `auto` takes K and N from a Slurm, Kubernetes or AWS Batch array job
+        /// (docs/cluster.md).
         #[arg(long, value_parser = parse_shard)]
-        shard: Option<(u64, u64)>,
+        shard: Option<ShardArg>,
+        /// The number of shards N, for `--shard auto` under Kubernetes (which does not say
+        /// it); elsewhere it must agree with the scheduler's.
+        #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+        shards: Option<u64>,
         /// Effects analysis: auto, off or direct_only (overrides effects.mode).
         #[arg(long, value_parser = parse_effects)]
         effects: Option<EffectsMode>,
@@ -244,7 +250,25 @@ fn parse_seed(s: &str) -> Result<u64, String> {
         .map_err(|_| format!("`{s}`: must be a whole number from 0 to {}", u64::MAX))
 }
 
-fn parse_shard(s: &str) -> Result<(u64, u64), String> {
+/// `--shard`: `K/N`, or `auto` (from the scheduler's environment).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum ShardArg {
+    /// `K/N` as given.
+    Given(u64, u64),
+    /// `auto`.
+    Auto,
+}
+
+fn parse_shard(s: &str) -> Result<ShardArg, String> {
+    if s.trim() == "auto" {
+        return Ok(ShardArg::Auto);
+    }
+    let (k, n) = parse_shard_k_n(s)?;
+    Ok(ShardArg::Given(k, n))
+}
+
+/// `--shard K/N` as the pair.
+fn parse_shard_k_n(s: &str) -> Result<(u64, u64), String> {
     let (k, n) = s.split_once('/').ok_or_else(|| format!("`{s}`: expected K/N, e.g. 0/4"))?;
     let k: u64 = k.trim().parse().map_err(|_| format!("`{s}`: K is not a number"))?;
     let n: u64 = n.trim().parse().map_err(|_| format!("`{s}`: N is not a number"))?;
@@ -398,6 +422,7 @@ where
             threads,
             seed,
             shard,
+            shards,
             effects,
             quiet,
             restrict_paths,
@@ -408,6 +433,28 @@ where
             error_image,
             kernel,
         } => {
+            let shard = match (shard, shards) {
+                (None, None) => None,
+                (Some(ShardArg::Given(k, n)), None) => Some((k, n)),
+                (Some(ShardArg::Given(k, n)), Some(s)) if s == n => Some((k, n)),
+                (Some(ShardArg::Given(_, n)), Some(s)) => {
+                    tell!("error: --shards {s} disagrees with --shard's N = {n}");
+                    return ExitCode::from(2);
+                }
+                (Some(ShardArg::Auto), shards) => {
+                    match crate::shard_from_environment(|v| std::env::var(v).ok(), shards) {
+                        Ok(shard) => Some(shard),
+                        Err(e) => {
+                            tell!("error: {e}");
+                            return ExitCode::from(2);
+                        }
+                    }
+                }
+                (None, Some(_)) => {
+                    tell!("error: --shards N goes with --shard auto (or --shard K/N)");
+                    return ExitCode::from(2);
+                }
+            };
             let options = RenderOptions {
                 kernel,
                 error_measure,

@@ -35,6 +35,7 @@
 
 mod bench;
 pub mod cli;
+mod cluster;
 mod convert;
 mod files;
 mod import;
@@ -63,6 +64,7 @@ pub use bench::{
     EffectsBenchmarkRow, IntegratorBenchmarkRow, IntegratorTiming, effects_benchmark,
     integrator_benchmark, render_xyz,
 };
+pub use cluster::shard_from_environment;
 pub use convert::convert;
 pub use files::{
     MAX_OUTPUT_NAME_BYTES, MAX_PART_BYTES, MAX_SCENE_BYTES, check_no_input_replaced,
