@@ -83,6 +83,21 @@ pub fn probe(
     })
 }
 
+/// The memory a render of a `width x height` image may use: [`MemoryLimit::system`] less what
+/// converting the image for writing takes after the render (the film stays allocated then).
+pub(crate) fn render_memory_limit(width: u32, height: u32) -> MemoryLimit {
+    let system = MemoryLimit::system();
+    let writing = OUTPUT_BYTES_PER_PIXEL * u64::from(width) * u64::from(height);
+    MemoryLimit {
+        bytes: system.bytes.saturating_sub(writing),
+        source: format!(
+            "{}, less {} to convert the image for writing",
+            system.source,
+            spectrace_geometry::human_bytes(writing)
+        ),
+    }
+}
+
 /// [`probe`] with any estimator: its work items (beams, or camera samples spread over the
 /// image) are traced one per chunk until one puts visible light on the film.
 ///
@@ -102,17 +117,7 @@ pub fn probe_with(
     if u64::from(width) * u64::from(height) > spectrace_tracer::MAX_PIXELS {
         return Err(camera_error(FilmError::InvalidSize(width, height)));
     }
-    // The film stays allocated while the image is converted for writing: count that too.
-    let system = MemoryLimit::system();
-    let writing = OUTPUT_BYTES_PER_PIXEL * u64::from(width) * u64::from(height);
-    let limit = MemoryLimit {
-        bytes: system.bytes.saturating_sub(writing),
-        source: format!(
-            "{}, less {} to convert the image for writing",
-            system.source,
-            spectrace_geometry::human_bytes(writing)
-        ),
-    };
+    let limit = render_memory_limit(width, height);
     plan.check_memory(width, height, &limit).map_err(camera_error)?;
     let started = Instant::now();
     let limit = plan.time_budget.map_or(PROBE_SECONDS, |t| (t / 10.0).min(PROBE_SECONDS));

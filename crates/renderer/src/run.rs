@@ -119,7 +119,10 @@ fn fit_estimate(
         return Ok((plan, None));
     }
     let (w, h) = (scene.camera.width(), scene.camera.height());
-    let limit = MemoryLimit::system();
+    // With some slack: the process takes a little more address space before the probe checks
+    // the plan again.
+    let limit = crate::probe::render_memory_limit(w, h);
+    let limit = MemoryLimit { bytes: limit.bytes.saturating_sub(64 << 20), ..limit };
     let without = RenderPlan { error_estimate: false, ..plan };
     let estimate_bytes = plan.memory_bytes(w, h).saturating_sub(without.memory_bytes(w, h));
     // A part file holds the film (up to 48 bytes per pixel) and the moments (72).
@@ -131,6 +134,19 @@ fn fit_estimate(
         )
     } else if plan.check_memory(w, h, &limit).is_err() && without.check_memory(w, h, &limit).is_ok()
     {
+        // Each thread keeps a chunk tally for the estimate: with fewer threads it may fit.
+        let threads = plan.worker_threads();
+        if let Some(fits) = plan.with_threads_fitting(w, h, &limit) {
+            let warning = format!(
+                "{} threads instead of {threads}: the error estimate keeps a chunk tally of {} \
+                 bytes per pixel for each thread, and more do not fit in the memory a render \
+                 may use ({})",
+                fits.threads,
+                spectrace_tracer::CHUNK_TALLY_BYTES_PER_PIXEL,
+                limit.source
+            );
+            return Ok((fits, Some(warning)));
+        }
         format!(
             "its moments for a {w}x{h} image ({} more) do not fit in the memory a render may \
              use ({})",

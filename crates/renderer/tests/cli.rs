@@ -60,3 +60,35 @@ fn closed_output_streams_do_not_panic() {
     assert_eq!(out.code(), Some(0), "{out}");
     assert!(written, "the image was not written");
 }
+
+/// The largest film the scene format allows, with 4 threads, under a 4 GB address-space limit
+/// (`ulimit -v`): the memory plan sees the limit and either renders (without the error
+/// estimate's moments, which do not fit) or refuses with the figures; never an abort
+/// ("memory allocation of ... failed", exit 134), as before the plan read the limit.
+#[test]
+fn the_largest_film_under_an_address_space_limit_renders_or_is_refused_never_aborts() {
+    let dir = std::env::temp_dir().join(format!("spectrace-ulimit-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = r#"{"camera": {"position": [0, 1, 5], "look_at": [0, 0, 0], "fov": 40,
+                               "width": 8192, "height": 4096},
+      "objects": [{"shape": {"type": "Rectangle", "corner": [-5, 0, -5], "edge_u": [0, 0, 10],
+                   "edge_v": [10, 0, 0]}, "material": {"type": "Diffuse", "reflectance": 0.5}}],
+      "lights": [{"type": "PointLight", "position": [0, 2, 0], "power": 100,
+                  "spd": {"type": "CieIlluminant", "name": "D65"}}],
+      "output": {"png": false}}"#;
+    std::fs::write(dir.join("big.json"), scene).unwrap();
+    let script = format!(
+        "ulimit -v 4000000 && exec {:?} render big.json --beams 20000 --threads 4 \
+         --integrator light --quiet --out out",
+        env!("CARGO_BIN_EXE_spectrace")
+    );
+    let out = Command::new("bash").arg("-c").arg(script).current_dir(&dir).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    let _ = std::fs::remove_dir_all(&dir);
+    match out.status.code() {
+        Some(0) => assert!(err.contains("no error estimate") && err.contains("ulimit -v"), "{err}"),
+        Some(2) => assert!(err.contains("ulimit -v") && err.contains("needs"), "{err}"),
+        other => panic!("exit {other:?}: {err}"),
+    }
+}

@@ -85,13 +85,13 @@ pub use observer::{MAX_OBSERVERS, OBSERVER_QUANTITIES, Observer, check_observers
 
 // The film, the render loop and its error estimate.
 pub use film::{
-    ByMeasure, ErrorEstimate, ErrorMeasure, ExactSum, Film, FilmError, FilmWriter, MAX_PIXELS,
-    MAX_TRUSTED_UNCERTAINTY, MIN_BATCHES, Moments, RELMSE_EPSILON, SENSOR_SLOTS, Splat,
-    relative_error, spectral_xyz,
+    ByMeasure, CHUNK_TALLY_BYTES_PER_PIXEL, ErrorEstimate, ErrorMeasure, ExactSum, Film, FilmError,
+    FilmWriter, MAX_PIXELS, MAX_TRUSTED_UNCERTAINTY, MIN_BATCHES, Moments, RELMSE_EPSILON,
+    SENSOR_SLOTS, Splat, relative_error, spectral_xyz,
 };
 pub use render::{
-    DEFAULT_CHUNK_BEAMS, FALLBACK_MEMORY_LIMIT, MemoryLimit, Progress, RenderOutput, RenderPlan,
-    render, render_observed,
+    DEFAULT_CHUNK_BEAMS, FALLBACK_MEMORY_LIMIT, MemoryLimit, Progress, RESERVED_THREADS,
+    RenderOutput, RenderPlan, THREAD_ADDRESS_RESERVE, render, render_observed,
 };
 pub use sampler::{ChunkSampler, SamplerKind};
 pub use stats::TraceStats;

@@ -61,26 +61,88 @@ pub struct MemoryLimit {
 }
 
 impl MemoryLimit {
-    /// Three quarters of the memory the system can give without swapping (`MemAvailable` in
-    /// `/proc/meminfo`), or [`FALLBACK_MEMORY_LIMIT`] where that cannot be read. The film is
-    /// written at random places all through the render, so it must stay resident (a swapped film
-    /// would crawl); the remaining quarter is for the scene, the image conversion after the render
-    /// and the rest of the system.
+    /// The least of what the system allows a render, from what Linux says (each figure read
+    /// fresh; [`FALLBACK_MEMORY_LIMIT`] where none can be read):
+    /// - three quarters of the memory the system can give without swapping (`MemAvailable` in
+    ///   `/proc/meminfo`): the film is written at random places all through the render, so it
+    ///   must stay resident (a swapped film would crawl); the remaining quarter is for the
+    ///   scene, the image conversion after the render and the rest of the system;
+    /// - three quarters of what the process's cgroup may still use (`memory.max` less
+    ///   `memory.current` under `/sys/fs/cgroup`), a container's limit;
+    /// - the address-space limit (`ulimit -v`, `Max address space` in `/proc/self/limits`)
+    ///   less the address space already in use (`VmSize` in `/proc/self/status`) and
+    ///   [`THREAD_ADDRESS_RESERVE`] for each of up to [`RESERVED_THREADS`] threads (their
+    ///   stacks and allocator arenas take address space, if little memory).
     pub fn system() -> Self {
-        match std::fs::read_to_string("/proc/meminfo").ok().as_deref().and_then(mem_available) {
-            Some(available) => Self {
-                bytes: available / 4 * 3,
-                source: format!(
-                    "3/4 of the {} available according to /proc/meminfo",
-                    spectrace_geometry::human_bytes(available)
-                ),
-            },
-            None => Self {
-                bytes: FALLBACK_MEMORY_LIMIT,
-                source: "the fallback limit: the available memory could not be read".to_owned(),
-            },
+        let read = |path: &str| std::fs::read_to_string(path).ok();
+        let mut best: Option<Self> = None;
+        let mut consider = |bytes: u64, source: String| {
+            if best.as_ref().is_none_or(|b| bytes < b.bytes) {
+                best = Some(Self { bytes, source });
+            }
+        };
+        if let Some(available) = read("/proc/meminfo").as_deref().and_then(mem_available) {
+            let source = format!(
+                "3/4 of the {} available according to /proc/meminfo",
+                spectrace_geometry::human_bytes(available)
+            );
+            consider(available / 4 * 3, source);
         }
+        let (max, current) =
+            (read("/sys/fs/cgroup/memory.max"), read("/sys/fs/cgroup/memory.current"));
+        if let Some(free) = cgroup_free(max.as_deref(), current.as_deref()) {
+            let source = format!(
+                "3/4 of the {} the process's cgroup may still use (memory.max)",
+                spectrace_geometry::human_bytes(free)
+            );
+            consider(free / 4 * 3, source);
+        }
+        let (limits, status) = (read("/proc/self/limits"), read("/proc/self/status"));
+        if let Some((free, limit)) = address_space_free(limits.as_deref(), status.as_deref()) {
+            let source = format!(
+                "the address-space limit (ulimit -v) of {}, less what is in use and {} for \
+                 threads",
+                spectrace_geometry::human_bytes(limit),
+                spectrace_geometry::human_bytes(THREAD_ADDRESS_RESERVE * RESERVED_THREADS)
+            );
+            consider(free, source);
+        }
+        best.unwrap_or_else(|| Self {
+            bytes: FALLBACK_MEMORY_LIMIT,
+            source: "the fallback limit: the available memory could not be read".to_owned(),
+        })
     }
+}
+
+/// Address space a thread may take beyond the render's own buffers: its stack (2 MiB) and an
+/// allocator arena (glibc reserves 64 MiB of address space for each).
+pub const THREAD_ADDRESS_RESERVE: u64 = 66 << 20;
+
+/// Threads [`MemoryLimit::system`] reserves address space for under an address-space limit.
+pub const RESERVED_THREADS: u64 = 16;
+
+/// What a cgroup v2 may still use: `memory.max` (a number, or `max`: no limit) less
+/// `memory.current`.
+fn cgroup_free(max: Option<&str>, current: Option<&str>) -> Option<u64> {
+    let max: u64 = max?.trim().parse().ok()?;
+    let current: u64 = current.and_then(|c| c.trim().parse().ok()).unwrap_or(0);
+    Some(max.saturating_sub(current))
+}
+
+/// Under an address-space limit: the address space left for a render (the soft limit of `Max
+/// address space` in a `/proc/self/limits` text, less `VmSize` of a `/proc/self/status` text and
+/// the threads' reserve) and the limit; `None` without a limit.
+fn address_space_free(limits: Option<&str>, status: Option<&str>) -> Option<(u64, u64)> {
+    let line = limits?.lines().find(|l| l.starts_with("Max address space"))?;
+    let soft = line.trim_start_matches("Max address space").split_whitespace().next()?;
+    let limit: u64 = soft.parse().ok()?; // "unlimited" does not parse: no limit
+    let in_use = status
+        .and_then(|s| s.lines().find(|l| l.starts_with("VmSize:")))
+        .and_then(|l| l.split_whitespace().nth(1)?.parse::<u64>().ok())
+        .map_or(0, |kib| kib.saturating_mul(1024));
+    let free =
+        limit.saturating_sub(in_use).saturating_sub(THREAD_ADDRESS_RESERVE * RESERVED_THREADS);
+    Some((free, limit))
 }
 
 /// `MemAvailable` of a `/proc/meminfo` text, in bytes.
@@ -193,6 +255,21 @@ impl RenderPlan {
         limit: &MemoryLimit,
     ) -> Result<u64, FilmError> {
         self.check_memory_with(width, height, self.time_budget.is_some(), limit)
+    }
+
+    /// This plan with the most threads, at most its own, whose render of a `width x height`
+    /// image fits in `limit` (each thread keeps a chunk tally for the error estimate); `None`
+    /// when not even one thread fits.
+    pub fn with_threads_fitting(
+        &self,
+        width: u32,
+        height: u32,
+        limit: &MemoryLimit,
+    ) -> Option<Self> {
+        (1..=self.worker_threads())
+            .rev()
+            .map(|threads| RenderPlan { threads, ..*self })
+            .find(|p| p.check_memory(width, height, limit).is_ok())
     }
 
     /// [`RenderPlan::check_memory`] with or without a film pass layer.
@@ -555,6 +632,28 @@ mod tests {
         assert_eq!(mem_available("MemTotal: 8 kB\nMemAvailable:   3 kB\n"), Some(3072));
         assert_eq!(mem_available("MemTotal: 8 kB\n"), None);
         assert!(MemoryLimit::system().bytes > 0);
+        // With the estimate, each thread's tally takes 29 bytes per pixel: a limit that holds
+        // the film, the moments and three tallies gives three threads.
+        let eight = RenderPlan { threads: 8, error_estimate: true, ..p };
+        let one = RenderPlan { threads: 1, ..eight }.memory_bytes(1000, 1000);
+        let three = RenderPlan { threads: 3, ..eight }.memory_bytes(1000, 1000);
+        let room = MemoryLimit { bytes: three + 1000, source: "test".to_owned() };
+        assert_eq!(eight.with_threads_fitting(1000, 1000, &room).map(|p| p.threads), Some(3));
+        let tight = MemoryLimit { bytes: one - 1, source: "test".to_owned() };
+        assert_eq!(eight.with_threads_fitting(1000, 1000, &tight), None);
+        // The limits Linux reports, as its files write them.
+        let limits = "Limit                     Soft Limit           Hard Limit           Units\n\
+                      Max address space         4096000000           unlimited            bytes\n";
+        let status = "Name:\tspectrace\nVmSize:\t  100000 kB\n";
+        let reserve = THREAD_ADDRESS_RESERVE * RESERVED_THREADS;
+        assert_eq!(
+            address_space_free(Some(limits), Some(status)),
+            Some((4_096_000_000 - 102_400_000 - reserve, 4_096_000_000))
+        );
+        let unlimited = limits.replace("4096000000", "unlimited");
+        assert_eq!(address_space_free(Some(&unlimited), Some(status)), None);
+        assert_eq!(cgroup_free(Some("max\n"), Some("5\n")), None);
+        assert_eq!(cgroup_free(Some("1000\n"), Some("300\n")), Some(700));
     }
 }
 

@@ -4,7 +4,7 @@ use serde::{Deserialize, Serialize};
 use spectrace_spectrum::Xyz;
 
 use super::exact::*;
-use super::raster::{FilmError, film_pixels, pixel_index, raster_bytes, same_size};
+use super::raster::{FilmError, film_pixels, pixel_index, raster_bytes, same_size, try_filled};
 use super::{ExactSum, SENSOR_SLOTS, Splat, sensor_to_fixed};
 
 /// A film of `width x height` pixels, each accumulating X, Y, Z exactly, followed by the cells
@@ -48,7 +48,11 @@ impl Film {
         Ok(Self {
             width,
             height,
-            sums: vec![[ExactSum::default(); 3]; n + SENSOR_SLOTS * cells as usize],
+            sums: try_filled(
+                n + SENSOR_SLOTS * cells as usize,
+                [ExactSum::default(); 3],
+                "the film's pixel sums",
+            )?,
             pass_sums: Vec::new(),
             rejected: 0,
             accepted: 0,
@@ -69,7 +73,8 @@ impl Film {
     /// As [`Film::new`].
     pub fn with_pass_layer(width: u32, height: u32, cells: u32) -> Result<Self, FilmError> {
         let mut film = Self::with_sensor_cells(width, height, cells)?;
-        film.pass_sums = vec![[ExactSum::default(); 3]; film.pixels()];
+        film.pass_sums =
+            try_filled(film.pixels(), [ExactSum::default(); 3], "the film's pass layer")?;
         Ok(film)
     }
 

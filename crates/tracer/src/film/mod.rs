@@ -23,6 +23,10 @@ mod writer;
 
 pub use buffer::Film;
 
+/// Bytes per pixel of the chunk tally each rendering thread keeps for the error estimate (its
+/// sums and the list of pixels touched), counted by [`crate::RenderPlan::memory_bytes`].
+pub const CHUNK_TALLY_BYTES_PER_PIXEL: u64 = moments::ChunkTally::BYTES_PER_PIXEL;
+
 /// Sums a sensor cell takes in the film: `[radiant, luminous, luminous^2]` and
 /// `[melanopic, 0, 0]` (see [`crate::SensorSums`]).
 pub const SENSOR_SLOTS: usize = 2;

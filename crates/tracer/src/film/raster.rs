@@ -45,6 +45,37 @@ pub enum FilmError {
         /// Where the limit comes from.
         limit_source: String,
     },
+    /// The system refused memory the plan had counted on (another process took it, or a limit
+    /// the plan could not see); nothing was rendered.
+    #[error(
+        "could not allocate {} for {what}: the system refused it; lower the camera's resolution or --threads, or free memory",
+        human_bytes(*bytes)
+    )]
+    OutOfMemory {
+        /// What the memory was for.
+        what: &'static str,
+        /// Bytes asked for.
+        bytes: u64,
+    },
+}
+
+/// `n` copies of `value` in a vector whose memory is reserved fallibly, so that a refusal is an
+/// error naming `what` instead of an abort.
+///
+/// # Errors
+/// [`FilmError::OutOfMemory`].
+pub(crate) fn try_filled<T: Clone>(
+    n: usize,
+    value: T,
+    what: &'static str,
+) -> Result<Vec<T>, FilmError> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n).map_err(|_| FilmError::OutOfMemory {
+        what,
+        bytes: (n as u64).saturating_mul(std::mem::size_of::<T>() as u64),
+    })?;
+    v.resize(n, value);
+    Ok(v)
 }
 
 /// The pixel count of a `width x height` film (or of its error-estimate moments).

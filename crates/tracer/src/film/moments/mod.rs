@@ -45,7 +45,7 @@ use serde::{Deserialize, Serialize};
 use spectrace_spectrum::Xyz;
 
 use super::measure::{ByMeasure, ErrorMeasure, RELMSE_EPSILON};
-use super::raster::{FilmError, film_pixels, raster_bytes, same_size};
+use super::raster::{FilmError, film_pixels, raster_bytes, same_size, try_filled};
 
 /// Chunks (batches) a render needs before its error estimate is trusted to stop it.
 pub const MIN_BATCHES: u64 = 16;
@@ -139,8 +139,8 @@ impl Moments {
         Ok(Self {
             width,
             height,
-            sums: vec![[0.0; 9]; n],
-            first: vec![[0.0; 6]; n],
+            sums: try_filled(n, [0.0; 9], "the error estimate's moments")?,
+            first: try_filled(n, [0.0; 6], "the error estimate's moments")?,
             chunks: 0,
             items: 0,
             first_chunks: [0; 2],
