@@ -28,8 +28,10 @@
 //! errors), `plan` (estimator, effects, plan, normalisation), `integrators` (the estimators, from
 //! the tracer's registry), `probe`, `warnings`, `run`
 //! ([`render_scene`] in named steps), `progress`, `write` and `output` (the files and their
-//! encoding), `report` (the sidecar), `sensors` and `sensor_output`, `part` and `shard` (part
-//! files and [`merge_parts`]), `bench`, [`pilot`], [`measured`] (`auto` chosen by a pilot of
+//! encoding), `report` (the sidecar), `sensors` and `sensor_output`, `observers` (eye
+//! positions: cylindrical illuminance, melanopic EDI, UGR), `part`, `part_receivers` and `shard`
+//! (part files, the sensors' and observers' shares, and [`merge_parts`]), `cluster` (`--shard
+//! auto` from a scheduler's environment), `bench`, [`pilot`], [`measured`] (`auto` chosen by a pilot of
 //! each complete estimator), [`cli`], and `files` (bounded reads, atomic writes). Everything
 //! public is re-exported here, at the crate's root.
 
