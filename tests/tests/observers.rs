@@ -353,3 +353,25 @@ fn sensors_and_observers_of_sharded_renders_merge_bit_for_bit() {
     assert!(e.to_string().contains("chunks"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A laser of zero width is a line no eye can sample: a render with observers says their
+/// figures miss its light.
+#[test]
+fn observers_beside_a_thin_laser_are_warned_about() {
+    let dir = folder("laser");
+    let floor = r#"{"shape": {"type": "Rectangle", "corner": [-5, 0, -5], "edge_u": [0, 0, 10],
+                    "edge_v": [10, 0, 0]}, "material": {"type": "Diffuse", "reflectance": 0.5}}"#;
+    let laser = r#"{"type": "Laser", "position": [0, 1, 0], "direction": [0, -1, 0], "power": 1,
+                    "spd": {"type": "CieIlluminant", "name": "D65"}}"#;
+    let scene = scene(&dir, floor, laser, "");
+    let options = spectrace_renderer::RenderOptions {
+        beams: Some(2000),
+        spp: Some(1),
+        out_dir: dir.join("out"),
+        ..Default::default()
+    };
+    let report = spectrace_renderer::render_scene(&scene, &options).unwrap();
+    let warned = report.warnings.iter().any(|w| w.starts_with("observers: lasers"));
+    assert!(warned, "{:?}", report.warnings);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -73,17 +73,14 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
     let (plan, estimate_warning) = fit_estimate(scene, plan)?;
     warnings.extend(estimate_warning);
     let effects = decide_effects(scene, options.effects);
-    for (i, l) in scene.lights.lights().iter().enumerate() {
-        let summary = l.photometric_summary();
-        // Measured luminaires always say what their file holds; the rest only when verbose.
-        if options.verbose || summary.is_some() {
+    if options.verbose {
+        for (i, l) in scene.lights.lights().iter().enumerate() {
+            // A measured luminaire also says what its file holds: lamps and light output ratio.
+            let file = l.photometric_summary().map(|s| format!(" ({s})")).unwrap_or_default();
             let r = LightReport::of(l.as_ref());
             let (w, lm) = (r.watts.unwrap_or(f64::INFINITY), r.lumens.unwrap_or(f64::INFINITY));
-            let file = summary.map(|s| format!(" ({s})")).unwrap_or_default();
             tell!("lights[{i}]: {} of {w:.6} W, {lm:.2} lm{file}", r.kind);
         }
-    }
-    if options.verbose {
         tell!("{}", effects.summary());
         tell!("integrator: {reason}");
     }
@@ -350,8 +347,10 @@ fn write_render(
         }
     }
     let observers = crate::render_observers(scene, setup.plan.threads, setup.effects)?;
-    for r in &observers {
-        tell!("{}", crate::observer_summary(r));
+    if options.verbose {
+        for r in &observers {
+            tell!("{}", crate::observer_summary(r));
+        }
     }
     let mut report = finished.report(output, written);
     report.sensors = sensors;

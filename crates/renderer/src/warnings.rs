@@ -25,6 +25,13 @@ pub(crate) fn render_warnings(
                 .to_owned(),
         );
     }
+    if !scene.observers.is_empty() && !scene.lights_sampled_from_points() {
+        warnings.push(
+            "observers: lasers of zero width and beam-only lights cannot be sampled from a \
+             point, so the observers' figures miss their light"
+                .to_owned(),
+        );
+    }
     warnings.extend(beams_warning(scene, choice, plan));
     if !scene.sensors.is_empty()
         && plan.shard.is_some()
