@@ -11,6 +11,10 @@
 //!   counted by callgrind (`xtask/scripts/callgrind.sh`): the cost measure of refactors.
 //! - `cargo xtask budget [BUDGET]`: how closely the path tracer and BDPT keep a `--time` budget
 //!   when one pass takes longer (`xtask/scripts/time-budget.sh`, the Cornell box at 1600 x 1600).
+//! - `cargo xtask cluster-test [SCENE]`: a real single-node Slurm (slurmctld and slurmd on
+//!   localhost, with munge) runs `docs/cluster`'s array of 8 render shards and its dependent merge
+//!   (`xtask/scripts/cluster-test.sh`), then compares the merged outputs with one process's, byte
+//!   for byte. Needs root and Debian's `slurm-wlm` and `munge`. Never run by CI.
 //! - `cargo xtask ci`: runs `.ci/run` itself (rustfmt, clippy, the tests, the fuzz run, the
 //!   status page), so the two can never differ.
 //! - `cargo xtask render [SCENE] [options]`: builds the renderer in release mode and renders a
@@ -109,6 +113,7 @@ fn main() -> ExitCode {
         "ci" => ci(),
         "callgrind" => callgrind(&args[1..]),
         "budget" => budget(&args[1..]),
+        "cluster-test" => cluster_test(&args[1..]),
         "help" | "-h" | "--help" => {
             print_help();
             ExitCode::SUCCESS
@@ -383,6 +388,30 @@ fn budget(args: &[String]) -> ExitCode {
         Ok(s) if s.success() => ExitCode::SUCCESS,
         Ok(s) => {
             eprintln!("the time-budget script failed ({s})");
+            ExitCode::FAILURE
+        }
+        Err(e) => {
+            eprintln!("could not run bash: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// `cargo xtask cluster-test [SCENE]`: `xtask/scripts/cluster-test.sh` with the release
+/// `spectrace`: a real single-node Slurm run of `docs/cluster`'s recipes (an array of 8 shards
+/// and a dependent merge), compared byte for byte with one process. Needs root and Debian's
+/// `slurm-wlm` and `munge`; never run by CI.
+fn cluster_test(args: &[String]) -> ExitCode {
+    let binary = match build_release(&SPECTRACE) {
+        Ok(b) => b,
+        Err(code) => return code,
+    };
+    let script = workspace_root().join("xtask/scripts/cluster-test.sh");
+    eprintln!("$ bash {} {} {}", script.display(), binary.display(), args.join(" "));
+    match Command::new("bash").arg(&script).arg(&binary).args(args).status() {
+        Ok(s) if s.success() => ExitCode::SUCCESS,
+        Ok(s) => {
+            eprintln!("the cluster test failed ({s})");
             ExitCode::FAILURE
         }
         Err(e) => {
