@@ -490,6 +490,61 @@ fn lumens_scale_the_table_to_the_luminaires_flux() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// An IES file of photometric type `kind` (2: B, 3: A) with vertical angles `vs`, horizontal
+/// angles `hs` and the candela `at(h, v)`, a 0.1 x 0.2 x 0.05 m opening, absolute photometry.
+fn polar_file(kind: u8, hs: &[f64], vs: &[f64], at: &dyn Fn(f64, f64) -> f64) -> String {
+    let mut t = format!("IESNA:LM-63-2002\n[TEST] type {kind}\nTILT=NONE\n");
+    t += &format!("1 -1 1 {} {} {kind} 2 0.1 0.2 0.05\n1 1 20\n", vs.len(), hs.len());
+    let line = |a: &[f64]| a.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(" ") + "\n";
+    t += &line(vs);
+    t += &line(hs);
+    for &h in hs {
+        t += &line(&vs.iter().map(|&v| at(h, v)).collect::<Vec<_>>());
+    }
+    t
+}
+
+/// The light of an IES `text` at the origin, `nadir` -y and `c0` +x, of illuminant A.
+fn polar_light(text: &str) -> IesLight {
+    let f = spectrace_lights::photometry::IesFile::parse(text, "polar.ies").unwrap();
+    let a = spectrace_lights::spectrum::CieIlluminant::new("A").unwrap();
+    IesLight::new(
+        f,
+        DVec3::ZERO,
+        DVec3::NEG_Y,
+        DVec3::X,
+        std::sync::Arc::new(a),
+        1.0,
+        Default::default(),
+    )
+    .unwrap()
+}
+
+/// The zonal flux of a polar table: each cell's mean of its four corners `at(h, v)` times its
+/// solid angle `d(plane) (sin within_b - sin within_a)`, where the planes turn by `H` (type A)
+/// or by `V` (type B) and the other angle lies within them.
+fn zonal(hs: &[f64], vs: &[f64], at: &dyn Fn(f64, f64) -> f64, planes_turn_by_h: bool) -> f64 {
+    let mut sum = 0.0;
+    for i in 0..hs.len() - 1 {
+        for j in 0..vs.len() - 1 {
+            let avg = (at(hs[i], vs[j])
+                + at(hs[i + 1], vs[j])
+                + at(hs[i], vs[j + 1])
+                + at(hs[i + 1], vs[j + 1]))
+                / 4.0;
+            let (plane, within) = if planes_turn_by_h {
+                (hs[i + 1] - hs[i], (vs[j], vs[j + 1]))
+            } else {
+                (vs[j + 1] - vs[j], (hs[i], hs[i + 1]))
+            };
+            sum += avg
+                * plane.to_radians()
+                * (within.1.to_radians().sin() - within.0.to_radians().sin());
+        }
+    }
+    sum
+}
+
 /// A type B (floodlight) file of asymmetric made-up intensities. Its table is read about its
 /// horizontal polar axis `c0`, the photometric axis along `nadir`: the direction of type B
 /// angles `(H, V)` is `sin H c0 + cos H (cos V nadir + sin V (nadir x c0))`, where the light
@@ -501,39 +556,10 @@ fn type_b_tables_turn_about_their_horizontal_axis() {
     let hs = [-90.0, -40.0, 0.0, 30.0, 90.0];
     let vs = [-90.0, -20.0, 0.0, 45.0, 90.0];
     let value = |h: f64, v: f64| 100.0 + 3.0 * (h + 90.0) + 0.5 * (v + 90.0) + 0.01 * h * v;
-    let file = |hs: &[f64]| {
-        let mut t = String::from("IESNA:LM-63-2002\n[TEST] type B\nTILT=NONE\n");
-        t += &format!("1 -1 1 {} {} 2 2 0.4 0.2 0\n1 1 100\n", vs.len(), hs.len());
-        t += &vs.map(|v| v.to_string()).join(" ");
-        t += "\n";
-        t += &hs.iter().map(|h| h.to_string()).collect::<Vec<_>>().join(" ");
-        t += "\n";
-        for &h in hs {
-            // The pole (H = +-90) is one direction whatever V.
-            let row: Vec<String> = vs
-                .iter()
-                .map(|&v| value(h, if h.abs() == 90.0 { 0.0 } else { v }).to_string())
-                .collect();
-            t += &row.join(" ");
-            t += "\n";
-        }
-        t
-    };
+    // The pole (H = +-90) is one direction whatever V.
+    let at = |h: f64, v: f64| value(h, if h.abs() == 90.0 { 0.0 } else { v });
     let (nadir, c0) = (DVec3::NEG_Y, DVec3::X);
-    let light = |text: &str| {
-        let f = spectrace_lights::photometry::IesFile::parse(text, "flood.ies").unwrap();
-        IesLight::new(
-            f,
-            DVec3::ZERO,
-            nadir,
-            c0,
-            std::sync::Arc::new(spectrace_lights::spectrum::CieIlluminant::new("A").unwrap()),
-            1.0,
-            Default::default(),
-        )
-        .unwrap()
-    };
-    let full = light(&file(&hs));
+    let full = polar_light(&polar_file(2, &hs, &vs, &at));
     let direction = |h: f64, v: f64| {
         let (h, v) = (h.to_radians(), v.to_radians());
         c0 * h.sin() + (nadir * v.cos() + nadir.cross(c0) * v.sin()) * h.cos()
@@ -548,23 +574,10 @@ fn type_b_tables_turn_about_their_horizontal_axis() {
         }
     }
     assert_eq!(full.candela_towards(-nadir), 0.0, "the back of a floodlight is dark");
-    let mut zonal = 0.0;
-    for i in 0..hs.len() - 1 {
-        for j in 0..vs.len() - 1 {
-            let c = |h: f64, v: f64| value(h, if h.abs() == 90.0 { 0.0 } else { v });
-            let avg = (c(hs[i], vs[j])
-                + c(hs[i + 1], vs[j])
-                + c(hs[i], vs[j + 1])
-                + c(hs[i + 1], vs[j + 1]))
-                / 4.0;
-            zonal += avg
-                * (vs[j + 1] - vs[j]).to_radians()
-                * (hs[i + 1].to_radians().sin() - hs[i].to_radians().sin());
-        }
-    }
+    let zonal = zonal(&hs, &vs, &at, false);
     assert!((full.lumens() - zonal).abs() < 1e-6 * zonal, "{} vs {zonal}", full.lumens());
     // A symmetric table given from H = 0: the same light as its mirrored full table.
-    let half = light(&file(&[0.0, 30.0, 90.0]));
+    let half = polar_light(&polar_file(2, &[0.0, 30.0, 90.0], &vs, &at));
     for (h, v) in [(-30.0, 45.0), (30.0, 45.0), (-60.0, -20.0), (60.0, -20.0)] {
         let a = half.candela_towards(direction(h, v));
         let b = half.candela_towards(direction(-h, v));
@@ -587,35 +600,8 @@ fn type_a_tables_turn_about_the_vertical_axis_clockwise() {
     let value = |h: f64, v: f64| 100.0 + 3.0 * (h + 90.0) + 0.5 * (v + 90.0) + 0.01 * h * v;
     // At the zenith and the nadir (V = +-90) every plane meets: one value whatever H.
     let at = |h: f64, v: f64| value(if v.abs() == 90.0 { 0.0 } else { h }, v);
-    let file = |hs: &[f64]| {
-        let mut t = String::from("IESNA:LM-63-2002\n[TEST] type A\nTILT=NONE\n");
-        t += &format!("1 -1 1 {} {} 3 2 0.1 0.2 0.05\n1 1 20\n", vs.len(), hs.len());
-        t += &vs.map(|v| v.to_string()).join(" ");
-        t += "\n";
-        t += &hs.iter().map(|h| h.to_string()).collect::<Vec<_>>().join(" ");
-        t += "\n";
-        for &h in hs {
-            let row: Vec<String> = vs.iter().map(|&v| at(h, v).to_string()).collect();
-            t += &row.join(" ");
-            t += "\n";
-        }
-        t
-    };
     let (nadir, c0) = (DVec3::NEG_Y, DVec3::X);
-    let light = |text: &str| {
-        let f = spectrace_lights::photometry::IesFile::parse(text, "signal.ies").unwrap();
-        IesLight::new(
-            f,
-            DVec3::ZERO,
-            nadir,
-            c0,
-            std::sync::Arc::new(spectrace_lights::spectrum::CieIlluminant::new("A").unwrap()),
-            1.0,
-            Default::default(),
-        )
-        .unwrap()
-    };
-    let full = light(&file(&hs));
+    let full = polar_light(&polar_file(3, &hs, &vs, &at));
     let up = -nadir;
     let direction = |h: f64, v: f64| {
         let (h, v) = (h.to_radians(), v.to_radians());
@@ -633,22 +619,10 @@ fn type_a_tables_turn_about_the_vertical_axis_clockwise() {
     let down = full.candela_towards(nadir);
     assert!((down - value(0.0, -90.0)).abs() < 1e-9 * down, "photometric zero: {down}");
     assert_eq!(full.candela_towards(-c0), 0.0, "behind the photometric horizontal is dark");
-    let mut zonal = 0.0;
-    for i in 0..hs.len() - 1 {
-        for j in 0..vs.len() - 1 {
-            let avg = (at(hs[i], vs[j])
-                + at(hs[i + 1], vs[j])
-                + at(hs[i], vs[j + 1])
-                + at(hs[i + 1], vs[j + 1]))
-                / 4.0;
-            zonal += avg
-                * (hs[i + 1] - hs[i]).to_radians()
-                * (vs[j + 1].to_radians().sin() - vs[j].to_radians().sin());
-        }
-    }
+    let zonal = zonal(&hs, &vs, &at, true);
     assert!((full.lumens() - zonal).abs() < 1e-6 * zonal, "{} vs {zonal}", full.lumens());
     // A laterally symmetric table given from H = 0: the mirrored full one.
-    let half = light(&file(&[0.0, 30.0, 90.0]));
+    let half = polar_light(&polar_file(3, &[0.0, 30.0, 90.0], &vs, &at));
     for (h, v) in [(30.0, 45.0), (60.0, -20.0)] {
         let a = half.candela_towards(direction(h, v));
         let b = half.candela_towards(direction(-h, v));

@@ -11,6 +11,7 @@ use std::fmt;
 
 mod ies;
 mod ldt;
+mod lumens;
 mod luminaire;
 
 /// The luminous opening shape the readers give ([`IesFile::luminous_opening`],
@@ -18,9 +19,8 @@ mod luminaire;
 pub use crate::glare::LuminousOpening;
 pub use ies::{IesFile, IesVersion, MAX_ANGLES, Photometry, Tilt, Units};
 pub use ldt::{LampSet, LdtFile, LdtSymmetry, MAX_LAMP_SETS};
-pub use luminaire::{
-    CandelaDistribution, EulumdatLight, IesLight, LuminaireLumens, MAX_PHOTOMETRIC_BYTES,
-};
+pub use lumens::LuminaireLumens;
+pub use luminaire::{CandelaDistribution, EulumdatLight, IesLight, MAX_PHOTOMETRIC_BYTES};
 
 /// Where a photometric file went wrong: the file's name as given, the line (1-based) and the
 /// cause.
