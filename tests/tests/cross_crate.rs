@@ -9,6 +9,7 @@ mod hostile;
 mod import;
 mod integrators;
 mod kernels;
+mod many_lights;
 mod measured_auto;
 mod observers;
 mod photometry;

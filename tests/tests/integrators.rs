@@ -18,6 +18,8 @@
 //! | `thin_lens` | `coloured_spot` through a thin lens (5 cm radius, focused on the plane) | none | all | all | all | path | auto | 12 | 4 | 3% |
 //! | `cornell_box` | box open at the front, area light under its ceiling (seen), 16x16 | none | all | all | all | path | off | 12 | 3 | 5% |
 //! | `five_lights` | `coloured_spot` plus two point, a rectangle and a disk light | none | all | all | all | path | auto | 12 | 4 | 5% |
+//! | `five_lights_tree` | `five_lights`, next-event estimation choosing one light per vertex by a light tree (`settings.light_sampler`) | none | all | all | all | path | auto | 12 | 4 | 5% |
+//! | `five_lights_power` | `five_lights`, one light per vertex by power | none | all | all | all | path | auto | 12 | 4 | 5% |
 //! | `glass_under_area_light` | glass and diffuse spheres on a floor under an area light, 32x32 | none | not through glass | all | all | path | auto | 12 | 4 | 5% |
 //! | `glass_caustic` | glass sphere under the fading spot: a caustic on the floor, 16x16 | none | not through glass | no delta-light caustic | all | bdpt | off | 12 | 3 | 5% |
 //! | `sunlit_sphere` | a sky's parallel light on a diffuse sphere and floor, 16x16 | none | all | all | all | path | auto | 12 | 4 | 5% |
@@ -621,7 +623,14 @@ fn cornell_box() -> Row {
 /// samples every point or spot light and chooses among the area lights by power; MIS on emission
 /// must use that choice's probability. A mix of both kinds checks it.
 pub(crate) fn five_lights() -> Row {
-    let json = SPOT_OVER_PLANE.replace(
+    five_lights_choosing(None)
+}
+
+/// [`five_lights`] with next-event estimation choosing one light of all per vertex as
+/// `settings.light_sampler` says (`"tree"`: by a light tree, whose probability depends on the
+/// vertex, as MIS on emission must then; `"power"`: by power).
+fn five_lights_choosing(light_sampler: Option<&'static str>) -> Row {
+    let mut json = SPOT_OVER_PLANE.replace(
         r#""power": 50, "spd": {"type": "Blackbody", "kelvin": 3000}}]"#,
         r#""power": 50, "spd": {"type": "Blackbody", "kelvin": 3000}},
            {"type": "PointLight", "position": [-1, 0.8, 0.5], "power": 10, "spd": {"type": "CieIlluminant", "name": "D65"}},
@@ -631,13 +640,27 @@ pub(crate) fn five_lights() -> Row {
            {"type": "DiskLight", "center": [0.8, 0.3, 0.8], "normal": [-1, -0.2, -1], "radius": 0.1, "power": 8,
             "spd": {"type": "Uniform", "min_nm": 380, "max_nm": 720}}]"#,
     );
+    if let Some(kind) = light_sampler {
+        let settings = format!(r#","settings": {{"light_sampler": "{kind}"}}}}"#);
+        json = format!("{}{settings}", json.trim_end().trim_end_matches('}'));
+    }
     Row {
-        name: "five_lights",
+        name: match light_sampler {
+            None => "five_lights",
+            Some("tree") => "five_lights_tree",
+            Some(_) => "five_lights_power",
+        },
         scene: scene(&json),
         auto: IntegratorChoice::Path,
         effects: EffectsMode::Auto,
         closed_form: None,
-        cells: [all(300_000), all(32 * 32 * 8), all(32 * 32 * 8)],
+        // One light per vertex instead of all three delta lights: twice the samples for the
+        // path tracer to stay as sharp.
+        cells: [
+            all(300_000),
+            all(32 * 32 * if light_sampler.is_some() { 16 } else { 8 }),
+            all(32 * 32 * 8),
+        ],
         glass: None,
         seeds: 12,
         sharp: 0.05,
@@ -855,6 +878,22 @@ fn matrix_cornell_box() {
 fn matrix_five_lights() {
     let row = five_lights();
     assert_eq!(row.scene.lights.lights().len(), 5);
+    check_row(&row);
+}
+
+#[test]
+fn matrix_five_lights_tree() {
+    let row = five_lights_choosing(Some("tree"));
+    let tracer = tracer_scene(&row.scene);
+    assert_eq!(tracer.next_event().kind(), spectrace_tracer::LightSamplerKind::Tree);
+    check_row(&row);
+}
+
+#[test]
+fn matrix_five_lights_power() {
+    let row = five_lights_choosing(Some("power"));
+    let tracer = tracer_scene(&row.scene);
+    assert_eq!(tracer.next_event().kind(), spectrace_tracer::LightSamplerKind::Power);
     check_row(&row);
 }
 

@@ -378,6 +378,8 @@ fn scene_errors_name_the_file_position_and_field() {
     assert!(e.contains("settings.camera_wavelengths"), "{e}");
     let e = load_error(&with(r#"{"kernel": "simd"}"#));
     assert!(e.contains("settings.kernel") && e.contains("simd") && e.contains("batched"), "{e}");
+    let e = load_error(&with(r#"{"light_sampler": "bvh"}"#));
+    assert!(e.contains("settings.light_sampler") && e.contains("bvh") && e.contains("tree"), "{e}");
     let glowing = POINT_OVER_PLANE.replace(
         r#""material": {"type": "Diffuse", "reflectance": 0.5}"#,
         r#""material": {"type": "Diffuse", "reflectance": 0.5}, "emission": {"power": -3, "spd": {"type": "Uniform"}}"#,

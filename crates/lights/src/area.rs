@@ -40,8 +40,8 @@ use crate::geometry::{finite_point, positive, unit_direction};
 use crate::sky::rectangle_normal;
 use crate::source::{power_from_keys, uniform};
 use crate::{
-    Beam, EmissionSample, LightError, LightFlags, LightSample, LightSource, LightSurface, SpdLight,
-    WavelengthSampling,
+    Beam, EmissionSample, LightBounds, LightError, LightFlags, LightSample, LightSource,
+    LightSurface, SpdLight, WavelengthSampling,
 };
 
 /// A cosine-weighted direction around `frame.n()`, flipped to the back face with probability 1/2
@@ -278,6 +278,11 @@ impl LightSource for RectangleLight {
     fn flags(&self) -> Option<LightFlags> {
         Some(LightFlags::default())
     }
+    fn light_bounds(&self) -> Option<LightBounds> {
+        let (c, u, v) = (self.corner, self.edge_u, self.edge_v);
+        let points = [c, c + u, c + v, c + u + v];
+        Some(LightBounds::surface(&points, self.frame.n(), self.power(), self.two_sided))
+    }
     fn emission_density(&self, _origin: DVec3, direction: DVec3) -> f64 {
         lambertian_density(self.frame.n(), self.two_sided, direction)
     }
@@ -431,6 +436,13 @@ impl LightSource for DiskLight {
     crate::delegate_to_spd_light!(emission);
     fn flags(&self) -> Option<LightFlags> {
         Some(LightFlags::default())
+    }
+    fn light_bounds(&self) -> Option<LightBounds> {
+        // The disk's box: along each axis, radius times the sine of its angle to the normal.
+        let n = self.frame.n();
+        let extent = (DVec3::ONE - n * n).max(DVec3::ZERO).powf(0.5) * self.radius;
+        let points = [self.center - extent, self.center + extent];
+        Some(LightBounds::surface(&points, n, self.power(), self.two_sided))
     }
     fn emission_density(&self, _origin: DVec3, direction: DVec3) -> f64 {
         lambertian_density(self.normal, self.two_sided, direction)

@@ -38,6 +38,7 @@
 
 mod area;
 mod beam;
+mod bounds;
 mod counter;
 mod error;
 mod geometry;
@@ -51,6 +52,7 @@ mod spot;
 
 pub use area::{DiskLight, RectangleLight};
 pub use beam::{Beam, LightId};
+pub use bounds::LightBounds;
 pub use counter::BeamCounter;
 pub use error::LightError;
 pub use glare::{GlareView, LuminousOpening};

@@ -11,7 +11,7 @@ use spectrace_sampling::PiecewiseConstant;
 use spectrace_spectrum::{SpectralPowerDistribution, cmf, integrate_panels, luminous_efficacy};
 
 use crate::photometry::LuminaireLumens;
-use crate::{Beam, BeamCounter, GlareView, LightError};
+use crate::{Beam, BeamCounter, GlareView, LightBounds, LightError};
 
 /// A light source as a beam generator (seed section 2).
 ///
@@ -254,6 +254,14 @@ pub trait LightSource: Send + Sync + Debug {
     /// their file ([`crate::LuminousOpening`]).
     fn glare_view(&self, eye: DVec3) -> Option<GlareView> {
         let _ = eye;
+        None
+    }
+
+    /// Where the light emits, which way and how strongly ([`LightBounds`]), for a light tree
+    /// that chooses among many lights by their importance to a receiving point. `None` (the
+    /// default) for lights without finite bounds (skies, environments) or that do not say: a
+    /// tree chooses those by power beside it, so every light stays reachable.
+    fn light_bounds(&self) -> Option<LightBounds> {
         None
     }
 }
@@ -556,7 +564,7 @@ impl SpdLight {
     /// As [`SpdLight::new`] for the new SPD.
     pub fn map_spd(&mut self, f: &SpdMap<'_>) -> Result<bool, LightError> {
         let Some(spd) = f(self.spd.as_ref()) else { return Ok(false) };
-        *self = Self::new(self.light, Arc::from(spd), self.power, self.sampling)?;
+        *self = Self::new(self.light, spd, self.power, self.sampling)?;
         Ok(true)
     }
 }
@@ -564,7 +572,7 @@ impl SpdLight {
 /// A function that maps an SPD to its replacement, or `None` to keep it (see
 /// [`LightSource::map_spd`]).
 pub type SpdMap<'a> =
-    dyn Fn(&dyn SpectralPowerDistribution) -> Option<Box<dyn SpectralPowerDistribution>> + 'a;
+    dyn Fn(&dyn SpectralPowerDistribution) -> Option<Arc<dyn SpectralPowerDistribution>> + 'a;
 
 /// Draws a uniform in `[0, 1)` from a generator (53 random bits).
 #[inline]

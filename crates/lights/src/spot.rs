@@ -61,7 +61,7 @@ use spectrace_spectrum::SpectralPowerDistribution;
 use crate::geometry::{finite_point, positive, unit_direction};
 use crate::source::{power_from_keys, uniform};
 use crate::{
-    Beam, EmissionSample, LightError, LightFlags, LightSample, LightSource, SpdLight,
+    Beam, EmissionSample, LightBounds, LightError, LightFlags, LightSample, LightSource, SpdLight,
     WavelengthSampling,
 };
 
@@ -240,6 +240,10 @@ impl LightSource for UniformSpotLight {
     crate::delegate_to_spd_light!(emission);
     fn flags(&self) -> Option<LightFlags> {
         Some(LightFlags { delta_position: true, delta_direction: false })
+    }
+    fn light_bounds(&self) -> Option<LightBounds> {
+        let phi = 4.0 * PI * self.intensity();
+        Some(LightBounds::spot(self.position, self.direction, self.cos_cone(), phi))
     }
     fn emission_density(&self, _origin: DVec3, direction: DVec3) -> f64 {
         if direction.dot(self.direction) >= self.cos_cone() {
@@ -452,6 +456,11 @@ impl LightSource for FadingSpotLight {
     fn flags(&self) -> Option<LightFlags> {
         Some(LightFlags { delta_position: true, delta_direction: false })
     }
+    fn light_bounds(&self) -> Option<LightBounds> {
+        let phi = 4.0 * PI * self.peak_intensity;
+        let cos_cone = self.cone_angle.to_radians().cos();
+        Some(LightBounds::spot(self.position, self.direction, cos_cone, phi))
+    }
     fn emission_density(&self, _origin: DVec3, direction: DVec3) -> f64 {
         let theta = direction.dot(self.direction).clamp(-1.0, 1.0).acos().to_degrees();
         self.peak_density * self.profile(theta)
@@ -600,6 +609,9 @@ impl LightSource for PointLight {
     crate::delegate_to_spd_light!(emission);
     fn flags(&self) -> Option<LightFlags> {
         Some(LightFlags { delta_position: true, delta_direction: false })
+    }
+    fn light_bounds(&self) -> Option<LightBounds> {
+        Some(LightBounds::point(self.position, self.power()))
     }
     fn emission_density(&self, _origin: DVec3, _direction: DVec3) -> f64 {
         1.0 / (4.0 * PI)

@@ -546,3 +546,35 @@ fn light_set_sample_light_follows_its_pmf() {
     assert_eq!(set.emitted_radiance(DVec3::ZERO, DVec3::Z), 0.0);
     assert!(set.light(LightId(3)).unwrap().surface().is_some());
 }
+
+/// Every light of the zoo with a [`spectrace_lights::LightBounds`] bounds what it emits: its
+/// emission points lie in the box, and wherever it sends light (a positive `sample_towards`)
+/// the bound's importance is positive, so that a light tree never misses light it could find.
+/// Unbounded lights (lasers, skies) say so.
+#[test]
+fn light_bounds_hold_what_the_light_emits() {
+    let mut rng = Pcg64::seed_from_u64(21);
+    for (name, light) in zoo() {
+        let Some(bounds) = light.light_bounds() else {
+            assert!(name.contains("Laser") || name.contains("Sky"), "{name} has no bounds");
+            continue;
+        };
+        assert!(bounds.is_valid(), "{name}: {bounds:?}");
+        let slack = 1e-9 * (1.0 + bounds.max.abs().max_element());
+        for _ in 0..2000 {
+            if let Some(e) = light.sample_emission(uniforms(&mut rng)) {
+                let p = e.position;
+                assert!(
+                    p.cmpge(bounds.min - slack).all() && p.cmple(bounds.max + slack).all(),
+                    "{name}: {p} outside {bounds:?}"
+                );
+            }
+            // Receivers anywhere within 3 m.
+            let u = uniforms(&mut rng);
+            let receiver = v(6.0 * u[0] - 3.0, 6.0 * u[1] - 3.0, 6.0 * u[2] - 3.0);
+            if light.sample_towards(receiver, [u[3], u[0]]).is_some_and(|s| s.intensity > 0.0) {
+                assert!(bounds.importance(receiver) > 0.0, "{name}: {receiver} is lit");
+            }
+        }
+    }
+}

@@ -1060,7 +1060,11 @@ fn the_experiment_hooks_retune_lights_in_place_and_keep_the_set_consistent() {
     let mut replaced = Vec::new();
     set.modify_lights(&mut |_, light| {
         replaced.push(
-            light.map_spd(&|spd: &dyn SpectralPowerDistribution| spd.piecewise_constant()).unwrap(),
+            light
+                .map_spd(&|spd: &dyn SpectralPowerDistribution| {
+                    spd.piecewise_constant().map(Arc::from)
+                })
+                .unwrap(),
         );
     })
     .unwrap();
@@ -1103,6 +1107,7 @@ fn a_light_without_the_hooks_says_so_by_field() {
     let e = light.set_wavelength_sampling(WavelengthSampling::Observer).unwrap_err();
     assert_eq!(e, LightError::Unsupported { field: "wavelength_sampling" });
     assert!(e.to_string().starts_with("wavelength_sampling: "), "{e}");
-    let e = light.map_spd(&|spd: &dyn SpectralPowerDistribution| spd.piecewise_constant());
+    let e = light
+        .map_spd(&|spd: &dyn SpectralPowerDistribution| spd.piecewise_constant().map(Arc::from));
     assert_eq!(e, Err(LightError::Unsupported { field: "spd" }));
 }

@@ -6,9 +6,9 @@
 //! are said elsewhere.
 
 use spectrace_tracer::{
-    Bdpt, BdptWavelengths, Effects, HERO, INTEGRATORS, Integrator, IntegratorChoice,
-    IntegratorSettings, Kernel, LightTracerScene, SamplerKind, SceneFeatures, build_integrator,
-    registered,
+    AUTO_TREE_ABOVE, Bdpt, BdptWavelengths, Effects, HERO, INTEGRATORS, Integrator,
+    IntegratorChoice, IntegratorSettings, Kernel, LightSamplerKind, LightTracerScene, SamplerKind,
+    SceneFeatures, build_integrator, registered,
 };
 
 use crate::Scene;
@@ -57,6 +57,7 @@ pub fn tracer_scene(scene: &Scene) -> LightTracerScene<'_> {
     LightTracerScene::new(&scene.world, &scene.materials, &scene.lights, &scene.camera)
         .with_emitters(scene.emitters.clone(), scene.object_shapes)
         .with_sampler(scene.settings.sampler)
+        .with_light_sampler(scene.settings.light_sampler)
         .with_sensors(&scene.sensors)
 }
 
@@ -137,6 +138,29 @@ pub(crate) fn sampler_text(
              error itself rather than an upper bound"
         }
         _ => "settings.sampler",
+    };
+    format!("{} ({why})", used.name())
+}
+
+/// How next-event estimation chooses lights in `scene` (`settings.light_sampler` resolved,
+/// never `auto`).
+pub(crate) fn light_sampler_of(scene: &Scene) -> LightSamplerKind {
+    tracer_scene(scene).light_sampler_kind()
+}
+
+/// [`light_sampler_of`] with its reason, for `--verbose`.
+pub(crate) fn light_sampler_text(scene: &Scene) -> String {
+    let used = light_sampler_of(scene);
+    let why = match (scene.settings.light_sampler, used) {
+        (LightSamplerKind::Auto, LightSamplerKind::Tree) => format!(
+            "auto: more than {AUTO_TREE_ABOVE} lights to sample; one per vertex, chosen by a \
+             light tree"
+        ),
+        (LightSamplerKind::Auto, _) => format!(
+            "auto: at most {AUTO_TREE_ABOVE} lights to sample; every point, spot and luminaire \
+             at every vertex"
+        ),
+        _ => "settings.light_sampler".to_owned(),
     };
     format!("{} ({why})", used.name())
 }

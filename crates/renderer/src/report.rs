@@ -39,6 +39,10 @@ pub struct RenderReport {
     /// `"scalar"` (the light tracer and BDPT are scalar).
     #[serde(default = "scalar_kernel")]
     pub kernel: String,
+    /// How next-event estimation chose lights (`settings.light_sampler` resolved): `"each"`,
+    /// `"power"` or `"tree"`.
+    #[serde(default = "each_light_sampler")]
+    pub light_sampler: String,
     /// When BDPT rendered the image: how many wavelengths a sample carried and why
     /// (`settings.bdpt_wavelengths`): `"hero: ..."` (four) or `"beam: ..."` (one).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -125,8 +129,29 @@ pub struct LuminaireReport {
 impl LightReport {
     /// The sidecar's entry for `light`.
     pub fn of(light: &dyn spectrace_lights::LightSource) -> Self {
+        Self::with_efficacy(light, spectrace_spectrum::luminous_efficacy(light.spd().as_ref()))
+    }
+
+    /// The reports of all `lights`, each distinct spectrum object's efficacy computed once.
+    pub fn all(lights: &[Box<dyn spectrace_lights::LightSource>]) -> Vec<Self> {
+        let mut efficacy: std::collections::HashMap<*const (), f64> =
+            std::collections::HashMap::new();
+        lights
+            .iter()
+            .map(|l| {
+                let spd = l.spd();
+                let k = *efficacy
+                    .entry(std::sync::Arc::as_ptr(&spd) as *const ())
+                    .or_insert_with(|| spectrace_spectrum::luminous_efficacy(spd.as_ref()));
+                Self::with_efficacy(l.as_ref(), k)
+            })
+            .collect()
+    }
+
+    /// The report of `light`, whose spectrum has the luminous `efficacy` (lm/W).
+    fn with_efficacy(light: &dyn spectrace_lights::LightSource, efficacy: f64) -> Self {
         let watts = light.power();
-        let lumens = watts * spectrace_spectrum::luminous_efficacy(light.spd().as_ref());
+        let lumens = watts * efficacy;
         let finite = |v: f64| v.is_finite().then_some(v);
         let luminaire = light.photometric_summary().map(|s| LuminaireReport {
             file_lumens: s.file_lumens,
@@ -281,6 +306,11 @@ fn scalar_kernel() -> String {
     Kernel::Scalar.name().to_owned()
 }
 
+/// The light sampler of reports written before `light_sampler` was recorded.
+fn each_light_sampler() -> String {
+    "each".to_owned()
+}
+
 /// The sampler of sidecars written before the field existed.
 fn independent_sampler() -> String {
     SamplerKind::Independent.name().to_owned()
@@ -313,6 +343,7 @@ pub(crate) fn report(
         integrator_reason: String::new(),
         sampler: independent_sampler(),
         kernel: scalar_kernel(),
+        light_sampler: each_light_sampler(),
         bdpt_wavelengths: None,
         beams: output.beams,
         chunks_cut: output.cut.len() as u64,

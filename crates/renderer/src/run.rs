@@ -8,7 +8,13 @@ use spectrace_tracer::{
     Effects, Integrator, IntegratorChoice, Kernel, MemoryLimit, RenderOutput, RenderPlan, render,
 };
 
-use crate::integrators::{bdpt_wavelengths_text, kernel_of, sampler_of, sampler_text, with_kernel};
+/// Lights listed one by one under `--verbose`; the rest are summed on one line.
+const LIGHTS_LISTED: usize = 8;
+
+use crate::integrators::{
+    bdpt_wavelengths_text, kernel_of, light_sampler_of, light_sampler_text, sampler_of,
+    sampler_text, with_kernel,
+};
 use crate::measured::measure_choice;
 
 use crate::plan::scene_normalisation;
@@ -74,13 +80,20 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
     warnings.extend(estimate_warning);
     let effects = decide_effects(scene, options.effects);
     if options.verbose {
-        for (i, l) in scene.lights.lights().iter().enumerate() {
+        let lights = scene.lights.lights();
+        for (i, l) in lights.iter().enumerate().take(LIGHTS_LISTED) {
             // A measured luminaire also says what its file holds: lamps and light output ratio.
             let file = l.photometric_summary().map(|s| format!(" ({s})")).unwrap_or_default();
             let r = LightReport::of(l.as_ref());
             let (w, lm) = (r.watts.unwrap_or(f64::INFINITY), r.lumens.unwrap_or(f64::INFINITY));
             tell!("lights[{i}]: {} of {w:.6} W, {lm:.2} lm{file}", r.kind);
         }
+        if lights.len() > LIGHTS_LISTED {
+            let watts: f64 = lights.iter().skip(LIGHTS_LISTED).map(|l| l.power()).sum();
+            let more = lights.len() - LIGHTS_LISTED;
+            tell!("lights[{LIGHTS_LISTED}..{}]: {more} more lights, {watts:.6} W", lights.len());
+        }
+        tell!("light sampler: {}", light_sampler_text(scene));
         tell!("{}", effects.summary());
         tell!("integrator: {reason}");
     }
@@ -275,11 +288,12 @@ impl Finished<'_> {
             written,
         );
         r.integrator_reason = setup.reason.to_owned();
-        r.lights = scene.lights.lights().iter().map(|l| LightReport::of(l.as_ref())).collect();
+        r.lights = LightReport::all(scene.lights.lights());
         let error_decides = setup.plan.target_error.is_some();
         r.sampler =
             sampler_of(scene.settings.sampler, setup.choice, error_decides).name().to_owned();
         r.kernel = kernel_of(setup.choice, setup.kernel).name().to_owned();
+        r.light_sampler = light_sampler_of(scene).name().to_owned();
         r.bdpt_wavelengths = (setup.choice == IntegratorChoice::Bdpt).then(|| {
             bdpt_wavelengths_text(scene.settings.bdpt_wavelengths, &setup.effects.features)
         });

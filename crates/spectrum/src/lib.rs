@@ -68,7 +68,7 @@ pub use cie::{
 pub use error::SpectrumError;
 pub use illuminant::{CieIlluminant, KNOWN_ILLUMINANTS, daylight};
 pub use melanopic::{MELANOPIC_EFFICACY_D65, melanopic_action, melanopic_edi_per_watt};
-pub use mixture::{Component, MAX_TABLE_PANELS, Mixture};
+pub use mixture::{Component, MAX_TABLE_COMPONENTS, MAX_TABLE_PANELS, Mixture};
 pub use photometric::{
     PEAK_LUMINOUS_EFFICACY, lumens_per_watt, luminous_efficacy, watts_from_lumens,
 };

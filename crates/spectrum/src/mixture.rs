@@ -29,8 +29,11 @@ pub struct Component {
 
 /// A weighted sum of spectra.
 ///
+/// Components that share one spectrum object are merged, their weights added.
+///
 /// Without delta lines it is sampled by its own exact inverse CDF, tabulated by the constructor
-/// (see the `inverse` module; monotone in `u`, one table lookup per sample). With a delta line, or
+/// (see the `inverse` module; monotone in `u`, one table lookup per sample). With a delta line,
+/// with more than [`MAX_TABLE_COMPONENTS`] components, or
 /// when that table would exceed [`MAX_TABLE_PANELS`] panels (components with hundreds of kinks),
 /// it chooses a component in proportion to its weight and samples it with the same uniform,
 /// remapped (exact in distribution, but not monotone in `u`); so it does too if some panel of the
@@ -49,6 +52,30 @@ pub struct Mixture {
 /// Largest inverse-CDF table a mixture builds (about 60 bytes a panel); beyond it the mixture
 /// samples by component.
 pub const MAX_TABLE_PANELS: usize = 512;
+
+/// Most components a mixture builds its inverse-CDF table for: the table evaluates the whole
+/// mixture at every component's kinks, a cost that grows as the square of the components, so a
+/// mixture of more (the spectrum of a light set of many different lamps) samples by component.
+pub const MAX_TABLE_COMPONENTS: usize = 64;
+
+/// The components with those that share one spectrum object (`Arc` identity) merged into the
+/// first of them, their weights added: a light set of thousands of lamps of one spectrum is a
+/// mixture of one component.
+fn merge_shared(components: Vec<Component>) -> Vec<Component> {
+    let mut index: std::collections::HashMap<*const (), usize> = std::collections::HashMap::new();
+    let mut merged: Vec<Component> = Vec::with_capacity(components.len().min(1024));
+    for c in components {
+        let key = Arc::as_ptr(&c.spd) as *const ();
+        match index.get(&key) {
+            Some(&k) => merged[k].weight += c.weight,
+            None => {
+                index.insert(key, merged.len());
+                merged.push(c);
+            }
+        }
+    }
+    merged
+}
 
 /// Scene-file form of [`Mixture`].
 #[derive(Deserialize)]
@@ -86,6 +113,17 @@ impl Mixture {
         let weights: Vec<f64> = components.iter().map(|c| c.weight).collect();
         let choice = Discrete::new(&weights)
             .map_err(|e| SpectrumError::table("Mixture", &[("weights", "components.weight")], e))?;
+        // Merged only once every weight is known to be valid.
+        let (components, choice) = if components.len() > 1 {
+            let merged = merge_shared(components);
+            let weights: Vec<f64> = merged.iter().map(|c| c.weight).collect();
+            let choice = Discrete::new(&weights).map_err(|e| {
+                SpectrumError::table("Mixture", &[("weights", "components.weight")], e)
+            })?;
+            (merged, choice)
+        } else {
+            (components, choice)
+        };
         let range = components
             .iter()
             .zip(&weights)
@@ -97,12 +135,16 @@ impl Mixture {
         Ok(mixture)
     }
 
-    /// The mixture's inverse-CDF table, if it has no delta line and the table stays small.
+    /// The mixture's inverse-CDF table, if it has no delta line, at most
+    /// [`MAX_TABLE_COMPONENTS`] components and the table stays small.
     fn build_inverse(&self) -> Option<InverseCdf> {
         let (min, max) = self.range;
         let active =
             || self.components.iter().enumerate().filter(|(i, _)| self.choice.pmf(*i) > 0.0);
-        if !(min < max) || active().any(|(_, c)| c.spd.is_delta()) {
+        if !(min < max)
+            || active().count() > MAX_TABLE_COMPONENTS
+            || active().any(|(_, c)| c.spd.is_delta())
+        {
             return None;
         }
         // Panel edges at every component's kinks and range ends; the mode at the highest of

@@ -679,3 +679,58 @@ fn piecewise_constant_rebins_tables_and_leaves_formulas_alone() {
     // Too few nodes: the error names the field instead of panicking.
     assert!(Binned::centred_on_nodes(&[500.0], &[1.0]).is_err());
 }
+
+/// Components that share one spectrum object merge into one (the spectrum of a light set of
+/// thousands of lamps of one kind), with the same density as unmerged; a negative weight is
+/// refused before merging could hide it.
+#[test]
+fn mixture_components_sharing_a_spectrum_merge() {
+    use std::sync::Arc;
+    let d65: Arc<dyn SpectralPowerDistribution> = Arc::new(Blackbody::new(6500.0).unwrap());
+    let a: Arc<dyn SpectralPowerDistribution> = Arc::new(Blackbody::new(2856.0).unwrap());
+    let shared = |n: usize| {
+        let mut components: Vec<Component> =
+            (0..n).map(|_| Component { weight: 0.5, spd: d65.clone() }).collect();
+        components.push(Component { weight: 1.0, spd: a.clone() });
+        Mixture::new(components).unwrap()
+    };
+    let many = shared(5000);
+    assert_eq!(many.components().len(), 2);
+    assert!((many.components()[0].weight - 2500.0).abs() < 1e-9);
+    assert!(many.has_inverse_cdf(), "two components: the exact inverse CDF");
+    // The density of 5000 merged components is that of two.
+    let two = Mixture::new(vec![
+        Component { weight: 2500.0, spd: Arc::new(Blackbody::new(6500.0).unwrap()) },
+        Component { weight: 1.0, spd: a.clone() },
+    ])
+    .unwrap();
+    for nm in [380.0, 455.5, 560.0, 700.0] {
+        assert!((many.value(nm) - two.value(nm)).abs() <= 1e-12 * two.value(nm), "{nm}");
+    }
+    let e = Mixture::new(vec![
+        Component { weight: -1.0, spd: d65.clone() },
+        Component { weight: 2.0, spd: d65.clone() },
+    ]);
+    assert!(e.is_err(), "a negative weight merged away");
+}
+
+/// A mixture of more than `MAX_TABLE_COMPONENTS` distinct spectra samples by component: its
+/// table would cost the square of the components to build.
+#[test]
+fn a_mixture_of_many_distinct_spectra_samples_by_component() {
+    let components: Vec<Component> = (0..=MAX_TABLE_COMPONENTS)
+        .map(|i| Component {
+            weight: 1.0,
+            spd: std::sync::Arc::new(Blackbody::new(2000.0 + 50.0 * i as f64).unwrap()),
+        })
+        .collect();
+    let m = Mixture::new(components).unwrap();
+    assert!(!m.has_inverse_cdf());
+    let fewer: Vec<Component> = (0..4)
+        .map(|i| Component {
+            weight: 1.0,
+            spd: std::sync::Arc::new(Blackbody::new(2000.0 + 50.0 * f64::from(i)).unwrap()),
+        })
+        .collect();
+    assert!(Mixture::new(fewer).unwrap().has_inverse_cdf());
+}

@@ -44,6 +44,8 @@ mod environment;
 mod film;
 mod integrators;
 mod light_sampler;
+mod light_tree;
+mod next_event;
 mod object_light;
 mod observer;
 mod render;
@@ -60,6 +62,8 @@ pub use camera::{
 };
 pub use environment::{Environment, EnvironmentMap, EnvironmentSpec, MAX_ENVIRONMENT_TEXELS};
 pub use light_sampler::{LightSampler, PowerLightSampler, SampledLight};
+pub use light_tree::LightTree;
+pub use next_event::{AUTO_TREE_ABOVE, LightChoice, LightSamplerKind, NextEventLights};
 pub use object_light::{ObjectEmission, ObjectLight};
 pub use scene::{Emitter, LightTracerScene};
 pub use sensor::{

@@ -7,13 +7,18 @@
 //! A lookup is `O(log n)` to sample (binary search of a cumulative table) and `O(1)` for the
 //! probability of a given light (an index from light to entry), so a scene of thousands of
 //! lights does not cost a scan per vertex. Choosing by power alone ignores where the receiver
-//! is; a spatial sampler (a light tree) would implement the same trait.
+//! is.
 //!
 //! BDPT also chooses lights *given the sample's wavelength*, `pmf(l | lambda) = pmf(l)
 //! spd_l(lambda) / p(lambda)`, so that both ends of a path agree on the density of a light
 //! vertex ([`PowerLightSampler::sample_given`]). Where every light shares one spectrum (one
-//! light, or lights whose spectrum is the same object) that is the power choice itself, `O(1)`
-//! per lookup; otherwise it weighs each light's spectrum at `lambda`, `O(n)`.
+//! light, or lights whose spectrum is the same object: the renderer gives lights with equal
+//! spectra one object) that is the power choice itself, `O(log n)` per lookup; otherwise it
+//! weighs each distinct spectrum at `lambda`, then chooses by power among that spectrum's
+//! lights: `O(spectra + log n)`.
+//!
+//! Next-event estimation's choice among many lights by where they are is the light tree's
+//! (`light_tree`), which implements a choice for a receiving point rather than this trait.
 
 use std::sync::Arc;
 
@@ -53,28 +58,42 @@ pub struct PowerLightSampler {
     entry: Vec<Option<u32>>,
     /// Each admitted light's spectrum (for choices given a wavelength).
     spds: Vec<Arc<dyn SpectralPowerDistribution>>,
-    /// Whether all admitted lights share one spectrum object, so that the choice given a
-    /// wavelength is the power choice.
-    shared_spectrum: bool,
+    /// The admitted lights grouped by spectrum object, in order of first appearance: a choice
+    /// given a wavelength weighs each group's spectrum once.
+    groups: Vec<SpectrumGroup>,
+}
+
+/// The admitted lights that share one spectrum object.
+#[derive(Debug, Clone)]
+struct SpectrumGroup {
+    /// The shared spectrum.
+    spd: Arc<dyn SpectralPowerDistribution>,
+    /// The group's share of the power choice.
+    share: f64,
+    /// Its members (table entries), in table order.
+    members: Vec<usize>,
+    /// The choice among its members by power.
+    choice: Discrete,
 }
 
 impl PowerLightSampler {
     /// A sampler over the lights of `lights` for which `admit` holds, by power.
-    pub fn new(lights: &LightSet, admit: impl Fn(&dyn LightSource) -> bool) -> Self {
+    pub fn new(lights: &LightSet, admit: impl Fn(LightId, &dyn LightSource) -> bool) -> Self {
         let mut entry = vec![None; lights.lights().len()];
         let (mut ids, mut powers, mut spds) = (Vec::new(), Vec::new(), Vec::new());
         for (i, light) in lights.lights().iter().enumerate() {
             let power = light.power();
-            if admit(light.as_ref()) && power > 0.0 && power.is_finite() {
+            let id = LightId(i as u32);
+            if admit(id, light.as_ref()) && power > 0.0 && power.is_finite() {
                 entry[i] = Some(ids.len() as u32);
-                ids.push(LightId(i as u32));
+                ids.push(id);
                 powers.push(power);
                 spds.push(light.spd());
             }
         }
-        let shared_spectrum = spds.windows(2).all(|w| Arc::ptr_eq(&w[0], &w[1]));
         let choice = Discrete::new(&powers).ok();
-        Self { choice, ids, entry, spds, shared_spectrum }
+        let groups = choice.as_ref().map_or_else(Vec::new, |c| spectrum_groups(&spds, &powers, c));
+        Self { choice, ids, entry, spds, groups }
     }
 
     /// Whether no light can be chosen.
@@ -88,56 +107,83 @@ impl PowerLightSampler {
         self.entry.get(id.0 as usize).copied().flatten().map(|k| k as usize)
     }
 
-    /// The weight of table entry `k` given `lambda`: its power probability times its spectrum.
-    #[inline]
-    fn weight_given(&self, choice: &Discrete, k: usize, lambda: f64) -> f64 {
-        choice.pmf(k) * self.spds.get(k).map_or(0.0, |s| s.value(lambda))
-    }
-
     /// The probability of choosing light `id` given the wavelength `lambda` (nm):
     /// `pmf(l) spd_l(lambda) / density`, where `density = sum_k pmf(k) spd_k(lambda)` is the
     /// admitted lights' spectrum at `lambda`, which the caller has (for the whole set, the set's
     /// own SPD): `O(1)`.
     pub fn pmf_given(&self, id: LightId, lambda: f64, density: f64) -> f64 {
         let (Some(choice), Some(k)) = (&self.choice, self.index(id)) else { return 0.0 };
-        if self.shared_spectrum {
+        if self.groups.len() == 1 {
             return choice.pmf(k);
         }
         if density > 0.0 && density.is_finite() {
-            self.weight_given(choice, k, lambda) / density
+            choice.pmf(k) * self.spds.get(k).map_or(0.0, |s| s.value(lambda)) / density
         } else {
             0.0
         }
     }
 
     /// Chooses a light with probability [`pmf_given`](Self::pmf_given) from `u`: `O(1)` where
-    /// the lights share one spectrum, a scan of the lights' spectra at `lambda` otherwise.
+    /// the lights share one spectrum; otherwise a scan of the distinct spectra at `lambda`,
+    /// then a choice by power within the chosen spectrum's lights.
     pub fn sample_given(&self, u: f64, lambda: f64) -> Option<SampledLight> {
-        let choice = self.choice.as_ref()?;
-        if self.shared_spectrum {
+        if self.groups.len() == 1 {
             return self.sample(u);
         }
-        let n = self.ids.len();
-        let total: f64 = (0..n).map(|i| self.weight_given(choice, i, lambda)).sum();
+        let weight = |g: &SpectrumGroup| g.share * g.spd.value(lambda);
+        let total: f64 = self.groups.iter().map(weight).sum();
         if !(total > 0.0 && total.is_finite()) {
             return None;
         }
         let target = u * total;
         let (mut below, mut last) = (0.0, None);
-        for k in 0..n {
-            let w = self.weight_given(choice, k, lambda);
+        for g in &self.groups {
+            let w = weight(g);
             if w > 0.0 {
-                last = Some((k, below, w));
+                last = Some((g, below, w));
                 if target < below + w {
                     break;
                 }
                 below += w;
             }
         }
-        let (k, below, w) = last?;
+        let (g, below, w) = last?;
         let remapped = ((target - below) / w).clamp(0.0, spectrace_sampling::ONE_MINUS_EPSILON);
-        Some(SampledLight { id: self.ids[k], pmf: w / total, u: remapped })
+        let (m, u) = g.choice.sample_remapped(remapped);
+        let k = *g.members.get(m)?;
+        Some(SampledLight { id: self.ids[k], pmf: w / total * g.choice.pmf(m), u })
     }
+}
+
+/// The admitted lights grouped by spectrum object (`Arc` identity), in order of first
+/// appearance, each with its share of `choice` and a choice by power among its members.
+fn spectrum_groups(
+    spds: &[Arc<dyn SpectralPowerDistribution>],
+    powers: &[f64],
+    choice: &Discrete,
+) -> Vec<SpectrumGroup> {
+    let mut index: std::collections::HashMap<*const (), usize> = std::collections::HashMap::new();
+    let mut members: Vec<Vec<usize>> = Vec::new();
+    for (k, spd) in spds.iter().enumerate() {
+        let key = Arc::as_ptr(spd) as *const ();
+        let g = *index.entry(key).or_insert_with(|| {
+            members.push(Vec::new());
+            members.len() - 1
+        });
+        members[g].push(k);
+    }
+    members
+        .into_iter()
+        .filter_map(|m| {
+            let p: Vec<f64> = m.iter().map(|&k| powers[k]).collect();
+            Some(SpectrumGroup {
+                spd: spds[*m.first()?].clone(),
+                share: m.iter().map(|&k| choice.pmf(k)).sum(),
+                choice: Discrete::new(&p).ok()?,
+                members: m,
+            })
+        })
+        .collect()
 }
 
 impl LightSampler for PowerLightSampler {
@@ -180,7 +226,7 @@ mod tests {
     #[test]
     fn power_choice_frequencies_match_the_pmf_and_the_pmf_sums_to_one() {
         let lights = set(THREE);
-        let sampler = PowerLightSampler::new(&lights, |_| true);
+        let sampler = PowerLightSampler::new(&lights, |_, _| true);
         let total: f64 = (0..3).map(|i| sampler.pmf(LightId(i))).sum();
         assert!((total - 1.0).abs() < 1e-12);
         assert!((sampler.pmf(LightId(1)) - 3.0 / 4.5).abs() < 1e-12);
@@ -201,19 +247,19 @@ mod tests {
     #[test]
     fn the_filter_leaves_lights_out_with_pmf_zero() {
         let lights = set(THREE);
-        let sampler = PowerLightSampler::new(&lights, |l| l.power() > 2.0);
+        let sampler = PowerLightSampler::new(&lights, |_, l| l.power() > 2.0);
         assert_eq!(sampler.pmf(LightId(0)), 0.0);
         assert_eq!(sampler.pmf(LightId(2)), 0.0);
         assert_eq!(sampler.pmf(LightId(1)), 1.0);
         assert_eq!(sampler.sample(0.3).unwrap().id, LightId(1));
-        assert!(PowerLightSampler::new(&lights, |_| false).sample(0.5).is_none());
-        assert_eq!(PowerLightSampler::new(&lights, |_| false).pmf(LightId(7)), 0.0);
+        assert!(PowerLightSampler::new(&lights, |_, _| false).sample(0.5).is_none());
+        assert_eq!(PowerLightSampler::new(&lights, |_, _| false).pmf(LightId(7)), 0.0);
     }
 
     #[test]
     fn the_choice_given_a_wavelength_weighs_each_spectrum() {
         let lights = set(THREE);
-        let sampler = PowerLightSampler::new(&lights, |_| true);
+        let sampler = PowerLightSampler::new(&lights, |_, _| true);
         // At 420 nm only lights 0 (1 W over 100 nm) and 2 (0.5 W over 300 nm) emit.
         let (w0, w2) = (1.0 / 100.0, 0.5 / 300.0);
         let expected = [w0 / (w0 + w2), 0.0, w2 / (w0 + w2)];
@@ -240,5 +286,54 @@ mod tests {
             sampler.pmf_given(LightId(1), 800.0, LightSource::spd(&lights).value(800.0)),
             0.0
         );
+    }
+
+    #[test]
+    fn lights_sharing_a_spectrum_are_weighed_once_and_chosen_by_power_among_them() {
+        use spectrace_lights::{PointLight, WavelengthSampling};
+        use spectrace_spectrum::Uniform;
+        let blue: Arc<dyn SpectralPowerDistribution> =
+            Arc::new(Uniform::new(400.0, 500.0).unwrap());
+        let wide: Arc<dyn SpectralPowerDistribution> =
+            Arc::new(Uniform::new(400.0, 700.0).unwrap());
+        let light = |x: f64, power: f64, spd: &Arc<dyn SpectralPowerDistribution>| {
+            let p = PointLight::new(
+                glam::DVec3::new(x, 0.0, 0.0),
+                power,
+                spd.clone(),
+                WavelengthSampling::Importance,
+            );
+            Box::new(p.unwrap()) as Box<dyn LightSource>
+        };
+        let lights = LightSet::new(vec![
+            light(0.0, 1.0, &blue),
+            light(1.0, 2.0, &wide),
+            light(2.0, 3.0, &blue),
+            light(3.0, 4.0, &wide),
+        ])
+        .unwrap();
+        let sampler = PowerLightSampler::new(&lights, |_, _| true);
+        assert_eq!(sampler.groups.len(), 2);
+        let density = LightSource::spd(&lights).value(450.0);
+        // pmf(l) spd_l(450) / density, with spd = 1/100 (blue) or 1/300 (wide) per nm.
+        let w = [1.0 / 100.0, 2.0 / 300.0, 3.0 / 100.0, 4.0 / 300.0];
+        let total: f64 = w.iter().sum();
+        let n = 10_000;
+        let mut counts = [0u32; 4];
+        for k in 0..n {
+            let s = sampler.sample_given((f64::from(k) + 0.5) / f64::from(n), 450.0).unwrap();
+            assert!((s.pmf - sampler.pmf_given(s.id, 450.0, density)).abs() < 1e-12);
+            counts[s.id.0 as usize] += 1;
+        }
+        for (i, w) in w.iter().enumerate() {
+            let pmf = sampler.pmf_given(LightId(i as u32), 450.0, density);
+            assert!((pmf - w / total).abs() < 1e-12, "light {i}");
+            // Two levels of stratification (the spectrum, then the light): within two strata.
+            assert!((f64::from(counts[i]) - f64::from(n) * pmf).abs() <= 2.0, "light {i}");
+        }
+        // Beyond 500 nm only the wide lights emit, by power among them.
+        let s = sampler.sample_given(0.1, 600.0).unwrap();
+        assert_eq!(s.id, LightId(1));
+        assert!((s.pmf - 2.0 / 6.0).abs() < 1e-12);
     }
 }

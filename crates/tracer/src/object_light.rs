@@ -34,7 +34,7 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 use spectrace_geometry::{Ray, Shape};
 use spectrace_lights::{
-    Beam, EmissionSample, LightError, LightFlags, LightSample, LightSource, SpdLight,
+    Beam, EmissionSample, LightBounds, LightError, LightFlags, LightSample, LightSource, SpdLight,
     WavelengthSampling, power_from_keys, uniform,
 };
 use spectrace_sampling::{Frame, sample_cosine_hemisphere_concentric};
@@ -259,6 +259,11 @@ impl LightSource for ObjectLight {
 
     fn flags(&self) -> Option<LightFlags> {
         Some(LightFlags::default())
+    }
+    fn light_bounds(&self) -> Option<LightBounds> {
+        // Any shape: its box, shining every way (its normals are not known to lie in a cone).
+        let b = self.shape.bounds();
+        Some(LightBounds::anywhere(b.min, b.max, self.power()))
     }
 
     fn emission_density(&self, origin: DVec3, direction: DVec3) -> f64 {

@@ -12,7 +12,8 @@ use spectrace_lights::{LightId, LightSet, LightSource};
 use spectrace_materials::{Material, MaterialAt};
 use spectrace_spectrum::SpectralPowerDistribution;
 
-use crate::light_sampler::{LightSampler, PowerLightSampler};
+use crate::light_sampler::PowerLightSampler;
+use crate::next_event::{LightSamplerKind, NextEventLights};
 use crate::{PinholeCamera, SamplerKind, SceneFeatures, SensorSet};
 
 /// What a light tracer traces: geometry, one material per shape, the lights and the camera.
@@ -32,6 +33,9 @@ pub struct LightTracerScene<'a> {
     /// The spectrum of each light of the set, cached (bundled wavelengths are drawn from the
     /// spectrum of the beam's own light).
     spds: Vec<Arc<dyn SpectralPowerDistribution>>,
+    /// The CIE XYZ of each light's spectrum (normalised), cached: a point light seen directly
+    /// splats it once per pass.
+    xyz: Vec<spectrace_spectrum::Xyz>,
     /// Whether each light's colour varies over its beams ([`LightSource::spectral_factor`]).
     varying: Vec<bool>,
     /// What each shape emits, indexed like `materials` (empty: nothing emits).
@@ -50,9 +54,12 @@ pub struct LightTracerScene<'a> {
     /// Fill only the sensors: no connections to the camera (a sensor pass beside a camera
     /// integrator's image).
     sensors_only: bool,
-    /// Next-event estimation's choice among the lights camera paths can sample by area (not
-    /// delta in position or direction), by power.
-    area_lights: PowerLightSampler,
+    /// How next-event estimation chooses lights (`auto` until set).
+    light_sampler: LightSamplerKind,
+    /// Next-event estimation's lights: which it samples at a vertex, and the probability of
+    /// an area light's choice; built when first asked for (a light tree over thousands of
+    /// lights is not free, and many uses of a scene never ask).
+    next_event: std::sync::OnceLock<NextEventLights>,
     /// Every light, by power: the choice of a light vertex given a wavelength (BDPT).
     all_lights: PowerLightSampler,
     /// The delta lights a point can sample: a delta position and a spread of directions (points,
@@ -104,11 +111,9 @@ impl<'a> LightTracerScene<'a> {
         lights: &'a LightSet,
         camera: &'a PinholeCamera,
     ) -> Self {
-        let spds = lights.lights().iter().map(|l| l.spd()).collect();
+        let spds: Vec<_> = lights.lights().iter().map(|l| l.spd()).collect();
+        let xyz = per_spectrum(&spds, spectrace_spectrum::xyz_of);
         let varying = lights.lights().iter().map(|l| !l.uniform_spectrum()).collect();
-        let area_lights = PowerLightSampler::new(lights, |l| {
-            l.flags().is_some_and(|f| !f.delta_position && !f.delta_direction)
-        });
         let parallel_sampled: Vec<bool> = lights
             .lights()
             .iter()
@@ -117,7 +122,7 @@ impl<'a> LightTracerScene<'a> {
                     && sampled_towards_its_beams(l.as_ref())
             })
             .collect();
-        let delta_lights = lights
+        let delta_lights: Vec<LightId> = lights
             .lights()
             .iter()
             .zip(&parallel_sampled)
@@ -134,6 +139,7 @@ impl<'a> LightTracerScene<'a> {
             lights,
             camera,
             spds,
+            xyz,
             varying,
             emitters: Vec::new(),
             surfaces_emit: false,
@@ -142,8 +148,9 @@ impl<'a> LightTracerScene<'a> {
             sampler: SamplerKind::Auto,
             sensors: None,
             sensors_only: false,
-            area_lights,
-            all_lights: PowerLightSampler::new(lights, |_| true),
+            light_sampler: LightSamplerKind::Auto,
+            next_event: std::sync::OnceLock::new(),
+            all_lights: PowerLightSampler::new(lights, |_, _| true),
             delta_lights,
             parallel_sampled,
         }
@@ -169,10 +176,37 @@ impl<'a> LightTracerScene<'a> {
         self.sensors_only
     }
 
-    /// Next-event estimation's light sampler: the lights that camera paths sample by area
-    /// (area lights, glowing objects, luminaires with a surface), by power.
-    pub fn area_lights(&self) -> &PowerLightSampler {
-        &self.area_lights
+    /// Next-event estimation's lights (see [`NextEventLights`]).
+    pub fn next_event(&self) -> &NextEventLights {
+        self.next_event.get_or_init(|| {
+            NextEventLights::new(
+                self.light_sampler,
+                self.lights,
+                &self.delta_lights,
+                sampled_by_area,
+            )
+        })
+    }
+
+    /// How next-event estimation chooses lights here: the scene's setting with `auto` resolved
+    /// by the count of lights it can sample (without building the light tree).
+    pub fn light_sampler_kind(&self) -> LightSamplerKind {
+        if let Some(next_event) = self.next_event.get() {
+            return next_event.kind();
+        }
+        // Delta lights and lights sampled by area are disjoint (their flags differ).
+        let area = self.lights.lights().iter().filter(|l| sampled_by_area(l.as_ref())).count();
+        let count = self.delta_lights.len() + area;
+        self.light_sampler.resolve(count)
+    }
+
+    /// The same scene with next-event estimation choosing lights as `kind` says.
+    pub fn with_light_sampler(mut self, kind: LightSamplerKind) -> Self {
+        if kind != self.light_sampler {
+            self.light_sampler = kind;
+            self.next_event = std::sync::OnceLock::new();
+        }
+        self
     }
 
     /// Every light by power, for choices given a wavelength
@@ -184,7 +218,7 @@ impl<'a> LightTracerScene<'a> {
     /// The delta lights that a point can sample: those with a delta position (points, spots,
     /// measured luminaires) and the parallel lights whose one beam through a point it can find
     /// (skies, lasers of finite width; `sampled_towards_its_beams`). Next-event estimation
-    /// samples each of them at every vertex.
+    /// samples each of them at every vertex when it chooses lights by `each`.
     pub fn delta_lights(&self) -> &[LightId] {
         &self.delta_lights
     }
@@ -291,6 +325,13 @@ impl<'a> LightTracerScene<'a> {
         values
     }
 
+    /// The CIE XYZ of light `id`'s spectrum (its colour when seen directly); zero for an
+    /// unknown light.
+    #[inline]
+    pub fn light_xyz(&self, id: LightId) -> spectrace_spectrum::Xyz {
+        self.xyz.get(id.0 as usize).copied().unwrap_or_default()
+    }
+
     /// The spectrum of light `id` of the set.
     #[inline]
     pub fn light_spd(&self, id: LightId) -> Option<&Arc<dyn SpectralPowerDistribution>> {
@@ -321,11 +362,11 @@ impl<'a> LightTracerScene<'a> {
     }
 
     /// Solid-angle density (at `receiver`) with which next-event estimation (a light chosen by
-    /// [`Self::area_lights`], then a point by its `sample_towards`) picks the emitting point
-    /// `hit`; 0 where the shape does not emit or the light is not among the area lights.
+    /// [`Self::next_event`], then a point by its `sample_towards`) picks the emitting point
+    /// `hit`; 0 where the shape does not emit or the light is not among those it samples.
     pub fn emitter_pdf(&self, receiver: DVec3, hit: &Hit) -> f64 {
         let Some(emitter) = self.emitter(hit.primitive) else { return 0.0 };
-        let pmf = self.area_lights.pmf(emitter.light());
+        let pmf = self.next_event().pmf(receiver, emitter.light());
         if !(pmf > 0.0) {
             return 0.0;
         }
@@ -350,7 +391,19 @@ impl<'a> LightTracerScene<'a> {
             light_spectra_vary: self.lights.lights().iter().any(|l| !l.uniform_spectrum()),
             ..SceneFeatures::default()
         };
-        for (i, light) in self.lights.lights().iter().enumerate() {
+        let has_lines = per_spectrum(&self.spds, |spd| {
+            let (lo, hi) = spd.range();
+            !(hi > lo)
+                || (spectrace_spectrum::integrate_panels(
+                    &|l| spd.value(l),
+                    lo,
+                    hi,
+                    &spd.breakpoints(),
+                ) - 1.0)
+                    .abs()
+                    > 1e-6
+        });
+        for ((i, light), lines) in self.lights.lights().iter().enumerate().zip(has_lines) {
             match light.flags() {
                 None => f.beam_only_lights += 1,
                 Some(flags) if flags.delta_direction => {
@@ -360,17 +413,7 @@ impl<'a> LightTracerScene<'a> {
                 Some(flags) if flags.delta_position => f.delta_position_lights += 1,
                 Some(_) => f.area_lights += 1,
             }
-            let spd = light.spd();
-            let (lo, hi) = spd.range();
-            f.line_spectra |= !(hi > lo)
-                || (spectrace_spectrum::integrate_panels(
-                    &|l| spd.value(l),
-                    lo,
-                    hi,
-                    &spd.breakpoints(),
-                ) - 1.0)
-                    .abs()
-                    > 1e-6;
+            f.line_spectra |= lines;
         }
         for (i, m) in self.materials.iter().enumerate().take(self.object_shapes) {
             f.dispersive |= m.is_dispersive();
@@ -384,6 +427,24 @@ impl<'a> LightTracerScene<'a> {
         }
         f
     }
+}
+
+/// `f` of each spectrum of `spds`, computed once per spectrum object (lights with equal
+/// spectra share one: see the renderer's scene assembly).
+fn per_spectrum<T: Copy>(
+    spds: &[Arc<dyn SpectralPowerDistribution>],
+    f: impl Fn(&dyn SpectralPowerDistribution) -> T,
+) -> Vec<T> {
+    let mut seen: std::collections::HashMap<*const (), T> = std::collections::HashMap::new();
+    spds.iter()
+        .map(|spd| *seen.entry(Arc::as_ptr(spd) as *const ()).or_insert_with(|| f(spd.as_ref())))
+        .collect()
+}
+
+/// Whether next-event estimation samples `light` by area: neither its position nor its
+/// direction is a delta.
+fn sampled_by_area(light: &dyn LightSource) -> bool {
+    light.flags().is_some_and(|f| !f.delta_position && !f.delta_direction)
 }
 
 /// Whether `light` gives a next-event sample ([`LightSource::sample_towards`]) to a point that

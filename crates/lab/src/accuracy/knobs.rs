@@ -71,9 +71,11 @@ pub(super) fn set_piecewise_constant(scene: &mut Scene) -> Result<(usize, usize)
     let mut failure = None;
     scene
         .lights
-        .modify_lights(&mut |id, light| match light
-            .map_spd(&|spd: &dyn SpectralPowerDistribution| spd.piecewise_constant())
-        {
+        .modify_lights(&mut |id, light| match light.map_spd(
+            &|spd: &dyn SpectralPowerDistribution| {
+                spd.piecewise_constant().map(std::sync::Arc::from)
+            },
+        ) {
             Ok(true) => changed += 1,
             Ok(false) => {}
             Err(spectrace_lights::LightError::Unsupported { .. }) => unsupported += 1,

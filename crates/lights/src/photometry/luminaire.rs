@@ -507,6 +507,13 @@ macro_rules! luminaire_light_source {
         fn flags(&self) -> Option<LightFlags> {
             Some(LightFlags { delta_position: true, delta_direction: false })
         }
+        fn light_bounds(&self) -> Option<crate::LightBounds> {
+            // 4 pi times the peak intensity, in watts per steradian.
+            let lumens = self.luminaire.distribution.lumens();
+            let watts_per_candela = if lumens > 0.0 { self.power() / lumens } else { 0.0 };
+            let phi = 2.0 * TAU * self.luminaire.distribution.peak_candela() * watts_per_candela;
+            Some(crate::LightBounds::point(self.luminaire.position, phi))
+        }
         fn emission_density(&self, _origin: DVec3, direction: DVec3) -> f64 {
             self.luminaire.pdf_direction(direction)
         }

@@ -11,7 +11,7 @@ use spectrace_lights::{LightId, LightSurface};
 use spectrace_lights::{LightSet, LightSource};
 use spectrace_materials::Diffuse;
 use spectrace_materials::Material;
-use spectrace_spectrum::Reflectance;
+use spectrace_spectrum::{Reflectance, SpectralPowerDistribution};
 use spectrace_tracer::{Emitter, Environment, EnvironmentMap, ObjectLight};
 use spectrace_tracer::{IrradianceSensor, SensorSet};
 
@@ -141,6 +141,7 @@ impl<'a> Assembly<'a> {
                 "the scene has no lights and no object with an `emission`".to_owned(),
             ));
         }
+        share_equal_spectra(&mut all_lights);
         let lights = LightSet::new(all_lights).map_err(|e| self.error("lights", e.to_string()))?;
         // Glowing objects' lights are the set's last ones.
         let first_glowing = lights.lights().len() - glowing.len();
@@ -221,4 +222,29 @@ fn apply_transform(shape: Shape, t: &Transform) -> Result<Shape, String> {
         map.insert("transform".to_owned(), serde_json::json!({ "matrix": rows }));
     }
     serde_json::from_value(value).map_err(|e| e.to_string())
+}
+
+/// Gives lights whose spectra are equal (the same value in the scene file) one spectrum
+/// object, so that what weighs lights by spectrum (the light set's mixture, BDPT's choice of a
+/// light given a wavelength) weighs each distinct spectrum once: a scene of 20,000 lamps of
+/// one spectrum then costs what one lamp's spectrum costs. Lights that cannot change their
+/// spectrum (a plugin that does not implement `map_spd`) keep their own.
+fn share_equal_spectra(lights: &mut [Box<dyn LightSource>]) {
+    let mut seen: std::collections::HashMap<String, Arc<dyn SpectralPowerDistribution>> =
+        std::collections::HashMap::new();
+    for light in lights.iter_mut() {
+        let spd = light.spd();
+        let Ok(key) = serde_json::to_string(&spd) else { continue };
+        match seen.get(&key) {
+            Some(shared) if !Arc::ptr_eq(shared, &spd) => {
+                let shared = shared.clone();
+                // A light that cannot take it keeps its own (equal) spectrum.
+                let _ = light.map_spd(&|_| Some(shared.clone()));
+            }
+            Some(_) => {}
+            None => {
+                seen.insert(key, spd);
+            }
+        }
+    }
 }

@@ -11,8 +11,8 @@ use spectrace_materials::Material;
 use spectrace_tracer::IrradianceSensor;
 use spectrace_tracer::{
     BdptWavelengths, CameraWavelengths, DEFAULT_CHUNK_BEAMS, EffectsMode, EnvironmentMap,
-    ErrorMeasure, IntegratorChoice, Kernel, MAX_DEPTH, ObjectEmission, Observer, PinholeCamera,
-    SamplerKind,
+    ErrorMeasure, IntegratorChoice, Kernel, LightSamplerKind, MAX_DEPTH, ObjectEmission, Observer,
+    PinholeCamera, SamplerKind,
 };
 
 use super::{SceneError, scene_error};
@@ -158,6 +158,11 @@ pub struct Settings {
     /// reference and the default) or `"batched"` (many paths stage by stage); the image is the
     /// same, bit for bit.
     pub kernel: Kernel,
+    /// How next-event estimation (the path tracer's and the path-traced sensor and observer
+    /// passes') chooses the lights it samples at a vertex: `"auto"` (the default: `"each"` up
+    /// to 16 such lights, `"tree"` beyond), `"each"`, `"power"` or `"tree"` (see
+    /// [`spectrace_tracer::LightSamplerKind`]).
+    pub light_sampler: LightSamplerKind,
 }
 
 impl Default for Settings {
@@ -184,6 +189,7 @@ impl Default for Settings {
             target_error: None,
             error_measure: ErrorMeasure::RelMse,
             kernel: Kernel::Scalar,
+            light_sampler: LightSamplerKind::Auto,
         }
     }
 }

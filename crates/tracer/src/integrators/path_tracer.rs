@@ -66,10 +66,9 @@ use super::common::{
 };
 use super::pass::{PassEstimator, pixel_of, scalar_items};
 use crate::batch::path::render_pass;
-use crate::light_sampler::LightSampler;
 use crate::{
-    CameraWavelengths, ChunkSampler, ChunkWork, Effects, HERO, Kernel, LightTracerScene, Splat,
-    TraceStats,
+    CameraWavelengths, ChunkSampler, ChunkWork, Effects, HERO, Kernel, LightChoice,
+    LightTracerScene, Splat, TraceStats,
 };
 
 /// Settings of the path tracer.
@@ -108,6 +107,8 @@ pub struct PathTracer<'a> {
     /// Per material (by shape index), for fluorescent ones: the sampler of the wavelength light
     /// had before re-emission, guided by the lights' spectrum (empty without fluorescence).
     excitation: Vec<Option<ExcitationSampler>>,
+    /// Through a pinhole: the delta lights' splats seen directly, found on the first pass.
+    pinhole_splats: std::sync::OnceLock<Vec<DeltaSplat>>,
 }
 
 /// A vertex as next-event estimation sees it: the hit, the direction back along the path and
@@ -132,17 +133,6 @@ pub(crate) struct Vertex<'m> {
     pub light: [f64; 2],
     /// The lobe is not specular: next-event estimation samples lights here.
     pub next_event: bool,
-}
-
-/// One light next-event estimation samples: which, with what probability, from what uniforms.
-#[derive(Clone, Copy)]
-pub(crate) struct LightChoice {
-    /// The light.
-    pub id: LightId,
-    /// The probability it was chosen with.
-    pub pmf: f64,
-    /// The uniforms of the point on it.
-    pub u: [f64; 2],
 }
 
 /// A light sample seen from a vertex, waiting for its shadow ray.
@@ -295,8 +285,8 @@ impl<'a> PathTracer<'a> {
         } else {
             Vec::new()
         };
-        let layout = SampleLayout::camera_paths(scene, true, !scene.area_lights().is_empty());
-        Self { scene, settings, effects, layout, excitation }
+        let layout = SampleLayout::camera_paths(scene, true, scene.next_event().chooses());
+        Self { scene, settings, effects, layout, excitation, pinhole_splats: Default::default() }
     }
 
     /// Pixels in the image: the work items of one pass (one chunk).
@@ -372,7 +362,7 @@ impl<'a> PathTracer<'a> {
             };
             if vertex.next_event {
                 let at = Shading { hit: &hit, wo: -p.ray.direction, material: &*vertex.material };
-                self.for_each_light(vertex.light, |light| {
+                self.for_each_light(hit.point, vertex.light, |light| {
                     if let Some(c) = self.connection(p, &at, light)
                         && c.shadow.visible(self.scene)
                     {
@@ -431,17 +421,11 @@ impl<'a> PathTracer<'a> {
         Some(Vertex { material, light: u.light, next_event })
     }
 
-    /// Calls `f` with every light next-event estimation samples at a vertex whose light
-    /// uniforms are `u`: every delta-position light (points, spots) once, with probability 1 and
-    /// the centre of the unit square, and one area light chosen by the scene's light sampler.
+    /// Calls `f` with every light next-event estimation samples at a vertex at `point` whose
+    /// light uniforms are `u` (see [`crate::NextEventLights`]).
     #[inline]
-    pub(crate) fn for_each_light(&self, u: [f64; 2], mut f: impl FnMut(LightChoice)) {
-        for &id in self.scene.delta_lights() {
-            f(LightChoice { id, pmf: 1.0, u: [0.5, 0.5] });
-        }
-        if let Some(chosen) = self.scene.area_lights().sample(u[0]) {
-            f(LightChoice { id: chosen.id, pmf: chosen.pmf, u: [chosen.u, u[1]] });
-        }
+    pub(crate) fn for_each_light(&self, point: DVec3, u: [f64; 2], f: impl FnMut(LightChoice)) {
+        self.scene.next_event().for_each(point, u, f);
     }
 
     /// Next-event estimation's light sample `light` seen from the vertex `at`, weighted by the
@@ -570,7 +554,9 @@ impl<'a> PathTracer<'a> {
     /// importance (a finite pixel value, as the light tracer and BDPT show it). Once per pass,
     /// exactly (the light's colour is its SPD's XYZ integral, not a sampled wavelength), or with
     /// one lens sample per pass for a thin lens; weighted by `share`, the part of the pass done,
-    /// into the film's pass layer.
+    /// into the film's pass layer. Through a pinhole these splats are the same every pass, so
+    /// they are found (a shadow ray each) on the first pass and reused: a scene of thousands of
+    /// point lights does not trace thousands of rays per pass.
     fn splat_delta_lights(
         &self,
         share: f64,
@@ -578,28 +564,44 @@ impl<'a> PathTracer<'a> {
         film: &mut dyn Splat,
         stats: &mut TraceStats,
     ) {
-        let scene = self.scene;
-        let inv_y = 1.0 / *spectrace_spectrum::CIE_Y_INTEGRAL;
-        for &id in scene.delta_lights() {
-            // One lens point per light and pass.
-            let u_lens = self.layout.camera_lens(rng);
-            let (Some(light), Some(spd)) = (scene.lights.light(id), scene.light_spd(id)) else {
-                continue;
-            };
-            let Some(origin) = light.sample_emission([0.5; 4]).map(|e| e.position) else {
-                continue;
-            };
-            let Some((seen, value)) = connect_light_to_camera(scene, id, origin, u_lens) else {
-                continue;
-            };
-            // Relative to the lights' total power, as every sample of this film.
-            let value = value * light.power() / scene.lights.power() * inv_y * share;
-            if film.splat_pass(seen.x, seen.y, spectrace_spectrum::xyz_of(spd.as_ref()) * value) {
+        let mut splat = |(x, y, xyz, value): DeltaSplat| {
+            if film.splat_pass(x, y, xyz * (value * share)) {
                 stats.splats += 1;
             }
+        };
+        if self.layout.camera_lens {
+            for &id in self.scene.delta_lights() {
+                // One lens point per light and pass.
+                let u_lens = self.layout.camera_lens(rng);
+                if let Some(s) = self.delta_splat(id, u_lens) {
+                    splat(s);
+                }
+            }
+        } else {
+            let cached = self.pinhole_splats.get_or_init(|| {
+                let ids = self.scene.delta_lights();
+                ids.iter().filter_map(|&id| self.delta_splat(id, [0.5; 2])).collect()
+            });
+            cached.iter().copied().for_each(splat);
         }
     }
+
+    /// Delta light `id` seen directly through the lens point `u_lens`: its pixel, its colour
+    /// and its value per pass (relative to the lights' total power, as every sample of this
+    /// film); `None` when the camera does not see it.
+    fn delta_splat(&self, id: LightId, u_lens: [f64; 2]) -> Option<DeltaSplat> {
+        let scene = self.scene;
+        let inv_y = 1.0 / *spectrace_spectrum::CIE_Y_INTEGRAL;
+        let light = scene.lights.light(id)?;
+        let origin = light.sample_emission([0.5; 4])?.position;
+        let (seen, value) = connect_light_to_camera(scene, id, origin, u_lens)?;
+        let value = value * light.power() / scene.lights.power() * inv_y;
+        Some((seen.x, seen.y, scene.light_xyz(id), value))
+    }
 }
+
+/// A delta light's splat on the film: pixel, colour (XYZ of its spectrum) and value per pass.
+type DeltaSplat = (u32, u32, spectrace_spectrum::Xyz, f64);
 
 impl PassEstimator for PathTracer<'_> {
     const NAME: &'static str = PathTracer::NAME;

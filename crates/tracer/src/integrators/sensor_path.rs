@@ -173,17 +173,29 @@ pub(crate) fn gather(
         weights[j] = if q > 0.0 { 1.0 / (HERO as f64 * q) } else { 0.0 };
     }
     let mut irradiance = [0.0; HERO];
-    for &id in scene.delta_lights().iter().filter(|_| response.counts_delta_lights()) {
-        let Some(s) = sample_light(scene, id, x, [0.5, 0.5]) else { continue };
-        let r = response.weight(-s.direction);
-        if !(r > 0.0) || !unoccluded(scene, End::Point(x), End::Light(id, s.position)) {
-            continue;
-        }
-        let Some(spd) = scene.light_spd(id) else { continue };
-        let e = s.intensity * r / (s.distance * s.distance);
-        for j in 0..HERO {
-            irradiance[j] += e * spd.value(lambdas[j]);
-        }
+    if response.counts_delta_lights() {
+        // Every delta light under `each`; otherwise one light chosen as next-event estimation
+        // chooses it (an area light chosen here adds nothing: the sampled direction finds it).
+        let next_event = scene.next_event();
+        let u = match next_event.kind() {
+            crate::LightSamplerKind::Each => 0.5,
+            _ => uniform(rng),
+        };
+        next_event.for_each(x, [u, 0.5], |choice| {
+            let id = choice.id;
+            let Some(s) = sample_light(scene, id, x, [0.5, 0.5]).filter(|s| s.delta) else {
+                return;
+            };
+            let r = response.weight(-s.direction);
+            if !(r > 0.0) || !unoccluded(scene, End::Point(x), End::Light(id, s.position)) {
+                return;
+            }
+            let Some(spd) = scene.light_spd(id) else { return };
+            let e = s.intensity * r / (s.distance * s.distance * choice.pmf);
+            for j in 0..HERO {
+                irradiance[j] += e * spd.value(lambdas[j]);
+            }
+        });
     }
     let (direction, factor) = response.sample(rng);
     if factor > 0.0 {
