@@ -141,12 +141,55 @@ impl LightBounds {
     /// cone of normals (beyond the spread, 0). `d` is the distance to the box's centre, at
     /// least half its diagonal, so that a point inside the box does not divide by zero. It is
     /// 0 only where no emitter of the bound can shine on `point`, and finite for finite bounds.
+    /// (For many queries of one bound, [`LightBounds::prepare`] it once.)
     pub fn importance(&self, point: DVec3) -> f64 {
-        let centre = self.centre();
-        let half_diagonal = 0.5 * (self.max - self.min).length();
-        let to = point - centre;
-        let d2 = to.length_squared().max(half_diagonal * half_diagonal).max(f64::MIN_POSITIVE);
-        let distance = to.length();
+        self.prepare().importance(point)
+    }
+
+    /// The bound with what every [`importance`](Self::importance) query needs computed once.
+    pub fn prepare(&self) -> PreparedBounds {
+        PreparedBounds {
+            centre: self.centre(),
+            half_diagonal: 0.5 * (self.max - self.min).length(),
+            axis: self.axis,
+            phi: self.phi,
+            cos_theta_o: self.cos_theta_o,
+            sin_theta_o: (1.0 - self.cos_theta_o * self.cos_theta_o).max(0.0).sqrt(),
+            cos_theta_e: self.cos_theta_e,
+            two_sided: self.two_sided,
+        }
+    }
+}
+
+/// A [`LightBounds`] prepared for importance queries ([`LightBounds::prepare`]): its centre,
+/// half-diagonal and the sine of its cone computed once.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PreparedBounds {
+    centre: DVec3,
+    half_diagonal: f64,
+    axis: DVec3,
+    phi: f64,
+    cos_theta_o: f64,
+    sin_theta_o: f64,
+    cos_theta_e: f64,
+    two_sided: bool,
+}
+
+impl PreparedBounds {
+    /// [`LightBounds::importance`] at `point`.
+    #[inline]
+    pub fn importance(&self, point: DVec3) -> f64 {
+        let half_diagonal = self.half_diagonal;
+        let to = point - self.centre;
+        let distance2 = to.length_squared();
+        let d2 = distance2.max(half_diagonal * half_diagonal).max(f64::MIN_POSITIVE);
+        if self.cos_theta_o <= -1.0 {
+            // Normals every way: theta' is 0 wherever the point is (the general case below
+            // gives cos theta' = 1 too), so only the distance counts.
+            let value = self.phi / d2;
+            return if value.is_finite() { value } else { f64::MAX };
+        }
+        let distance = distance2.sqrt();
         // The angle between the axis and the direction to the point.
         let mut cos_w = if distance > 0.0 { self.axis.dot(to) / distance } else { 1.0 };
         if self.two_sided {
@@ -161,8 +204,7 @@ impl LightBounds {
             (1.0, -1.0)
         };
         // theta' = max(0, theta_w - theta_o - theta_b).
-        let sin_o = (1.0 - self.cos_theta_o * self.cos_theta_o).max(0.0).sqrt();
-        let (sin_x, cos_x) = sub_clamped((sin_w, cos_w), (sin_o, self.cos_theta_o));
+        let (sin_x, cos_x) = sub_clamped((sin_w, cos_w), (self.sin_theta_o, self.cos_theta_o));
         let (_, cos_p) = sub_clamped((sin_x, cos_x), (sin_b, cos_b));
         if cos_p < self.cos_theta_e {
             return 0.0;

@@ -52,7 +52,7 @@ mod spot;
 
 pub use area::{DiskLight, RectangleLight};
 pub use beam::{Beam, LightId};
-pub use bounds::LightBounds;
+pub use bounds::{LightBounds, PreparedBounds};
 pub use counter::BeamCounter;
 pub use error::LightError;
 pub use glare::{GlareView, LuminousOpening};

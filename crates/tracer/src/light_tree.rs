@@ -25,7 +25,7 @@
 use std::f64::consts::PI;
 
 use glam::DVec3;
-use spectrace_lights::{LightBounds, LightId, LightSet};
+use spectrace_lights::{LightBounds, LightId, LightSet, PreparedBounds};
 use spectrace_sampling::{Discrete, ONE_MINUS_EPSILON};
 
 use crate::light_sampler::SampledLight;
@@ -36,11 +36,11 @@ const MEDIAN_DEPTH: usize = 48;
 /// Buckets per axis when the build looks for a split.
 const BUCKETS: usize = 12;
 
-/// A node of the tree: its bounds and either a light or the index of its second child (the
-/// first child follows it).
+/// A node of the tree: its bounds (prepared for importance queries) and either a light or the
+/// index of its second child (the first child follows it).
 #[derive(Debug, Clone)]
 struct Node {
-    bounds: LightBounds,
+    bounds: PreparedBounds,
     kind: NodeKind,
 }
 
@@ -144,12 +144,13 @@ impl LightTree {
     fn build(&mut self, lights: &mut [(LightId, LightBounds)], trail: Trail) -> LightBounds {
         if let [(id, bounds)] = lights {
             self.trails[id.0 as usize] = Some(trail);
-            self.nodes.push(Node { bounds: *bounds, kind: NodeKind::Leaf(*id) });
+            self.nodes.push(Node { bounds: bounds.prepare(), kind: NodeKind::Leaf(*id) });
             return *bounds;
         }
         let at = self.nodes.len();
         // A placeholder, filled once both children are built.
-        self.nodes.push(Node { bounds: lights[0].1, kind: NodeKind::Inner { second: 0 } });
+        self.nodes
+            .push(Node { bounds: lights[0].1.prepare(), kind: NodeKind::Inner { second: 0 } });
         let split = split_point(lights, usize::from(trail.depth));
         let (first, second) = lights.split_at_mut(split);
         let depth = trail.depth + 1;
@@ -157,9 +158,10 @@ impl LightTree {
         let second_index = self.nodes.len() as u32;
         let turn = 1u128 << trail.depth;
         let b = self.build(second, Trail { bits: trail.bits | turn, depth });
+        let union = a.union(&b);
         self.nodes[at] =
-            Node { bounds: a.union(&b), kind: NodeKind::Inner { second: second_index } };
-        self.nodes[at].bounds
+            Node { bounds: union.prepare(), kind: NodeKind::Inner { second: second_index } };
+        union
     }
 
     /// Chooses a light for a receiver at `point` from the uniform `u`; `None` when no light
