@@ -278,7 +278,13 @@ fn the_light_tracer_integrator_is_trace_chunk_normalised_by_power_over_beams() {
         3000,
         &mut direct,
     );
-    let work = spectrace_tracer::ChunkWork { seed: 5, chunk: 2, items: 3000, deadline: None };
+    let work = spectrace_tracer::ChunkWork {
+        seed: 5,
+        chunk: 2,
+        items: 3000,
+        deadline: None,
+        ends_pass: false,
+    };
     let b = tracer.render_chunk(work, &mut through);
     assert!(direct.accepted() > 100, "{}", direct.accepted());
     assert_eq!((a, &direct), (b, &through));
@@ -463,7 +469,10 @@ fn every_shipped_scene_renders_without_rejected_contributions() {
         let report = render_scene(
             &s,
             &RenderOptions {
+                // 30,000 beams for the light tracer, one whole pass for a camera estimator
+                // (30,000 samples would be a band of rows, which may all see the dark).
                 beams: Some(30_000),
+                spp: Some(1),
                 threads: Some(2),
                 out_dir: out,
                 ..RenderOptions::default()
@@ -818,6 +827,34 @@ fn a_closed_mirror_box_keeps_the_beam_count_and_the_time_budget() {
         "{:?}",
         report.warnings
     );
+}
+
+/// The issue-27 probe's deep lossless case: a closed room of reflectance 0.99 with a mirror
+/// sphere and a point light, `max_depth` 8000, 256 x 256 pixels, `--beams 100`. `auto` picks
+/// BDPT (a point light among mirrors), whose pass is 65,536 long samples (about a minute); the
+/// budget now ends inside the first pass: exactly 100 samples, that pass cut, and a warning
+/// for the pixels left without one.
+#[test]
+fn a_beams_budget_below_one_pass_renders_that_many_camera_samples() {
+    let s = scene(
+        r#"{"camera": {"position": [0, 0, 0.5], "look_at": [0, 0, -1], "fov": 60, "width": 256, "height": 256},
+            "objects": [
+              {"shape": {"type": "Sphere", "center": [0, 0, 0], "radius": 2}, "material": {"type": "Diffuse", "reflectance": 0.99}},
+              {"shape": {"type": "Sphere", "center": [0.5, 0, -1], "radius": 0.3}, "material": {"type": "Mirror", "reflectance": 0.99}}],
+            "lights": [{"type": "PointLight", "position": [0, 0.5, 0], "power": 1, "spd": {"type": "CieIlluminant", "name": "D65"}}],
+            "settings": {"max_depth": 8000}}"#,
+    );
+    assert_eq!(spectrace_renderer::choose_integrator(&s, None).0, IntegratorChoice::Bdpt);
+    let out = temp_dir("deep-budget");
+    let options = RenderOptions { beams: Some(100), out_dir: out.clone(), ..Default::default() };
+    let report = render_scene(&s, &options).unwrap();
+    assert_eq!((report.beams, report.chunks_cut), (100, 1));
+    assert!(
+        report.warnings.iter().any(|w| w.contains("65436 of 65536 pixels")),
+        "{:?}",
+        report.warnings
+    );
+    let _ = std::fs::remove_dir_all(&out);
 }
 
 /// A scene's `settings.beams` counts the light tracer's beams; a camera estimator rendering

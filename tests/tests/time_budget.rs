@@ -1,5 +1,6 @@
 //! A time budget that runs out inside a camera pass: the pass stops, its pixels keep their own
-//! sample counts, and the image is still the exact mean per pixel.
+//! sample counts, and the image is still the exact mean per pixel. The same for a `--beams`
+//! budget that is not a whole number of passes: the last pass is cut where the budget ends.
 //!
 //! The renders here cut passes deterministically: a chunk given a deadline that has already
 //! passed stops at the first look at the clock, after its first 64 items (two rows of a 32-pixel
@@ -45,14 +46,16 @@ fn cut_render(row: &Row, choice: IntegratorChoice, whole: u64, cuts: u64, seed: 
         let mut stats = TraceStats::default();
         let mut cut = Vec::new();
         for chunk in 0..whole {
-            let s =
-                tracer.render_chunk(ChunkWork { seed, chunk, items, deadline: None }, &mut film);
+            let s = tracer.render_chunk(
+                ChunkWork { seed, chunk, items, deadline: None, ends_pass: true },
+                &mut film,
+            );
             assert_eq!(s.beams, items, "{}: a pass without a deadline is whole", row.name);
             stats.merge(&s);
         }
         let passed = Instant::now();
         for chunk in whole..whole + cuts {
-            let work = ChunkWork { seed, chunk, items, deadline: Some(passed) };
+            let work = ChunkWork { seed, chunk, items, deadline: Some(passed), ends_pass: true };
             let s = tracer.render_chunk(work, &mut film);
             assert_eq!(s.beams, CUT_ITEMS, "{}: a pass past its deadline stops", row.name);
             stats.merge(&s);
@@ -221,5 +224,68 @@ fn a_budget_that_ends_inside_the_first_pass_cuts_it_and_says_so() {
     part.output.cut = vec![(0, 4096)];
     let err = PartialFilm::decode(&part.encode().unwrap()).unwrap_err();
     assert!(err.contains("output.cut"), "{err}");
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// `--beams N` for a camera estimator: exactly `N` samples, the last pass cut where the budget
+/// ends (2.5 passes here: half the pixels get 3 samples, half 2), every pixel over its own
+/// count; on the lit plane both camera estimators keep the closed form (normalised as whole
+/// passes, half the image would be 20% off: the check has power by construction), and 3 shards
+/// merge to the unsharded image, byte for byte.
+#[test]
+fn a_beams_budget_inside_a_pass_cuts_it_and_keeps_the_closed_form() {
+    use spectrace_renderer::{RenderOptions, merge_parts, render_scene};
+    let row = lit_plane();
+    let (w, h) = (row.scene.camera.width() as usize, row.scene.camera.height() as usize);
+    let pixels = (w * h) as u64;
+    let budget = 5 * pixels / 2;
+    let (pixel, allowance) = row.closed_form.as_ref().unwrap();
+    let expected: Vec<f64> = (0..w * h).map(|p| pixel(&row.scene, p % w, p / w)).collect();
+    let reference = |mask: &[bool]| {
+        let n = mask.iter().filter(|k| **k).count() as f64;
+        let v = expected.iter().zip(mask).filter(|(_, k)| **k).map(|(v, _)| v).sum::<f64>();
+        (v / n, allowance * v / n)
+    };
+    for choice in [IntegratorChoice::Path, IntegratorChoice::Bdpt] {
+        let renders: Vec<_> =
+            (0..row.seeds).map(|k| render_with(&row.scene, choice, budget, 700 + k)).collect();
+        for r in &renders {
+            assert_eq!(r.output.beams, budget, "exactly the budget");
+            assert_eq!(r.output.cut, vec![(2, pixels / 2)], "the third pass, cut at the budget");
+        }
+        let images: Vec<Vec<Xyz>> = renders.into_iter().map(|r| r.image).collect();
+        let worst = worst_block(&row, &images, &reference, true);
+        let (mean, se) = region_stats(&images, &vec![true; w * h]).unwrap();
+        let (want, _) = reference(&vec![true; w * h]);
+        eprintln!(
+            "lit plane, {}: worst block {worst:.2}, mean {:.2} standard errors",
+            choice.name(),
+            (mean - want) / se
+        );
+        assert!((mean - want).abs() <= Z_CLOSED_FORM * se, "{}: {mean} vs {want}", choice.name());
+        assert!(se < row.sharp * mean, "the test must be sharp: {se} of {mean}");
+    }
+    // Shards: the cut pass lands in one of them; merged, the same bytes as one render.
+    let out = crate::rendering::temp_dir("beams-cut");
+    let options = |shard, dir: &str| RenderOptions {
+        beams: Some(budget),
+        threads: Some(2),
+        integrator: Some(IntegratorChoice::Bdpt),
+        shard,
+        out_dir: out.join(dir),
+        ..RenderOptions::default()
+    };
+    let one = render_scene(&row.scene, &options(None, "one")).unwrap();
+    assert_eq!((one.beams, one.chunks_cut), (budget, 1));
+    let parts: Vec<_> = (0..3)
+        .map(|k| {
+            render_scene(&row.scene, &options(Some((k, 3)), "parts")).unwrap();
+            out.join("parts").join(format!("inline.part-{k}-of-3.bin"))
+        })
+        .collect();
+    let merged = merge_parts(&parts, &out.join("merged")).unwrap();
+    assert_eq!((merged.beams, merged.chunks_cut), (budget, 1));
+    let bytes = |dir: &str| std::fs::read(out.join(dir).join("inline.exr")).unwrap();
+    assert!(bytes("one") == bytes("merged"), "the merged image differs from one render's");
     let _ = std::fs::remove_dir_all(&out);
 }

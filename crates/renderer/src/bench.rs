@@ -95,14 +95,17 @@ pub fn render_xyz(
     seed: u64,
     threads: usize,
 ) -> Result<(Vec<spectrace_spectrum::Xyz>, f64, u64), String> {
+    let (choice, _) = choose_integrator(scene, Some(integrator));
+    // Whole passes for a camera integrator: every pixel gets the same samples.
+    let pixels = (u64::from(scene.camera.width()) * u64::from(scene.camera.height())).max(1);
+    let whole = if is_camera_integrator(choice) { paths.div_ceil(pixels) * pixels } else { paths };
     let options = RenderOptions {
-        beams: Some(paths),
+        beams: Some(whole),
         seed: Some(seed),
         threads: Some(threads),
         effects: Some(mode),
         ..RenderOptions::default()
     };
-    let (choice, _) = choose_integrator(scene, Some(integrator));
     let mut plan = plan_with(scene, &options, choice).map_err(|e| e.to_string())?;
     if !is_camera_integrator(choice) {
         // At least ~16 chunks per render, so small sweep points use every thread too; the chunk

@@ -44,7 +44,8 @@ enum Command {
         /// For a Mitsuba scene: set `$NAME` to VALUE (over the file's <default>); repeatable.
         #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_define)]
         define: Vec<(String, String)>,
-        /// Beams for the whole image (overrides settings.beams).
+        /// Beams for the whole image (overrides settings.beams); for path and bdpt, exactly N
+        /// camera samples: whole passes, then the first pixels of one more pass.
         #[arg(long, conflicts_with = "time", allow_negative_numbers = true, value_parser = parse_count)]
         beams: Option<u64>,
         /// Camera samples per pixel for the camera integrators, path and bdpt (overrides

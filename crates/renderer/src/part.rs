@@ -120,13 +120,15 @@ impl PartialFilm {
         let out = &self.output;
         self.receivers.validate()?;
         validate_film(out, self.receivers.image_cells())?;
+        let plan = &self.plan;
+        let passes_may_be_cut = plan.time_budget.is_some() || plan.ends_inside_a_chunk();
         if out.film.has_pass_layer()
-            && (self.plan.time_budget.is_none()
-                || !crate::integrators::is_camera_integrator(self.integrator))
+            && (!passes_may_be_cut || !crate::integrators::is_camera_integrator(self.integrator))
         {
             return bad(
                 "output.film",
-                "has a pass layer, which only a camera estimator's render with a time budget keeps"
+                "has a pass layer, which only a camera estimator's render with a time budget, or \
+                 a budget of samples that ends inside a pass, keeps"
                     .to_owned(),
             );
         }
@@ -254,14 +256,13 @@ pub(crate) fn validate_chunks(plan: &RenderPlan, out: &RenderOutput) -> Result<(
     Ok(())
 }
 
-/// The cut chunks: strictly increasing, each among the chunks and cut (at least one item, fewer
-/// than the chunk's), and only with a time budget.
+/// The cut chunks: strictly increasing, each among the chunks and cut: at least one item and
+/// fewer than the chunk's (only with a time budget), or all of the plan's last chunk where it
+/// is shorter than the others (a camera estimator's pass that the budget of samples ends
+/// inside).
 fn validate_cut(plan: &RenderPlan, out: &RenderOutput) -> Result<(), String> {
     if out.cut.is_empty() {
         return Ok(());
-    }
-    if plan.time_budget.is_none() {
-        return bad("output.cut", "chunks cut short without a time budget".to_owned());
     }
     if let Some(pair) = out.cut.windows(2).find(|p| p[0].0 >= p[1].0) {
         return bad(
@@ -274,11 +275,15 @@ fn validate_cut(plan: &RenderPlan, out: &RenderOutput) -> Result<(), String> {
             return bad("output.cut", format!("chunk {c} is not among the part's chunks"));
         }
         let planned = plan.beams_in_chunk(c);
-        if done == 0 || done >= planned {
+        let budget_ends_inside = done == planned && planned < plan.chunk_beams;
+        if done == 0 || done > planned || (done == planned && !budget_ends_inside) {
             return bad(
                 "output.cut",
                 format!("chunk {c} did {done} of its {planned} items: not a cut chunk"),
             );
+        }
+        if done < planned && plan.time_budget.is_none() {
+            return bad("output.cut", "chunks cut short without a time budget".to_owned());
         }
     }
     Ok(())

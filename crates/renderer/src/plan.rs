@@ -86,8 +86,10 @@ pub fn plan_for(scene: &Scene, options: &RenderOptions) -> Result<RenderPlan, Re
 /// The plan for a given estimator. The light tracer's work items are beams (`--beams`,
 /// `settings.beams`, in chunks of `settings.chunk_beams`). A camera integrator's are camera
 /// samples in passes of one sample per pixel (a chunk is a pass): `--spp` / `settings.spp`
-/// passes, or with only `--beams N` given, `N / pixels` passes rounded up (the same number of
-/// paths).
+/// passes, or with only `--beams N` given, exactly `N` samples: `N / pixels` whole passes and,
+/// for the remainder, the first pixels of one more pass in its scrambled order (each pixel is
+/// normalised by its own count), so that a budget smaller than a pass is kept rather than
+/// rounded up to a whole pass.
 ///
 /// # Errors
 /// As [`plan_for`].
@@ -112,6 +114,8 @@ pub fn plan_with(
         let open_ended = options.time.is_some() || plan.target_error.is_some();
         plan.beams = if open_ended && options.spp.is_none() && options.beams.is_none() {
             (u64::MAX / 2 / pixels) * pixels
+        } else if let (None, Some(beams)) = (options.spp, options.beams) {
+            beams
         } else {
             spp.checked_mul(pixels).ok_or_else(|| {
                 RenderError::Options(format!(

@@ -130,7 +130,8 @@ pub fn probe_with(
     let mut timed_out = false;
     for beam in 0..max_beams {
         // One beam per chunk, so that the probe can stop after any beam.
-        let work = ChunkWork { seed: u64::MAX, chunk: beam, items: 1, deadline: None };
+        let work =
+            ChunkWork { seed: u64::MAX, chunk: beam, items: 1, deadline: None, ends_pass: false };
         stats.merge(&tracer.render_chunk(work, &mut sink));
         if sink.lit {
             break;
@@ -183,7 +184,13 @@ fn light_reaches_the_scene(scene: &Scene, beams: u64) -> bool {
     let effects = crate::decide_effects(scene, None);
     let hit = with_integrator(scene, IntegratorChoice::Light, effects, |tracer| {
         let mut sink = VisibleLight { width: 1, height: 1, lit: false };
-        let work = ChunkWork { seed: u64::MAX - 1, chunk: 0, items: beams, deadline: None };
+        let work = ChunkWork {
+            seed: u64::MAX - 1,
+            chunk: 0,
+            items: beams,
+            deadline: None,
+            ends_pass: false,
+        };
         tracer.render_chunk(work, &mut sink).hits > 0
     });
     scene.lights.reset_count();

@@ -49,9 +49,9 @@ pub struct RenderReport {
     pub bdpt_wavelengths: Option<String>,
     /// Beams traced.
     pub beams: u64,
-    /// Work chunks a time budget cut short (for `path` and `bdpt`, passes whose first pixels, in
-    /// the pass's order, got a sample the others did not: each pixel is normalised by its own
-    /// count).
+    /// Work chunks a time budget cut short, and for `path` and `bdpt` the pass that a
+    /// `--beams` budget ends inside (passes whose first pixels, in the pass's order, got a
+    /// sample the others did not: each pixel is normalised by its own count).
     #[serde(default)]
     pub chunks_cut: u64,
     /// Wall time (s).

@@ -139,8 +139,9 @@ pub(crate) fn black_image_warning(probed: &ProbeOutcome, output: &RenderOutput) 
     })
 }
 
-/// The warning for a camera render whose time budget ran out inside its first pass, so that
-/// some pixels got no camera sample (`None` when every pixel got one, and for the light tracer).
+/// The warning for a camera render whose budget (time, or `--beams` fewer than the pixels) ran
+/// out inside its first pass, so that some pixels got no camera sample (`None` when every
+/// pixel got one, and for the light tracer).
 pub(crate) fn unsampled_warning(output: &RenderOutput, norm: Normalisation) -> Option<String> {
     if !norm.camera || output.cut.is_empty() {
         return None;
@@ -149,10 +150,11 @@ pub(crate) fn unsampled_warning(output: &RenderOutput, norm: Normalisation) -> O
     let unsampled = SampleCounts::of(output, pixels).unsampled();
     (unsampled > 0).then(|| {
         format!(
-            "{unsampled} of {pixels} pixels ({:.1}%) got no camera sample: the time budget ran \
-             out inside the first pass over the image (one pass takes longer than the budget); \
-             they show only light joined to the camera from light paths (BDPT), or black. Give \
-             more time (--time) or lower the resolution",
+            "{unsampled} of {pixels} pixels ({:.1}%) got no camera sample: the budget ran out \
+             inside the first pass over the image (one pass takes longer than --time, or \
+             --beams is fewer than the pixels); they show only light joined to the camera from \
+             light paths (BDPT), or black. Give more time (--time) or samples (--beams, --spp), \
+             or lower the resolution",
             100.0 * unsampled as f64 / pixels.max(1) as f64
         )
     })

@@ -163,6 +163,12 @@ impl RenderPlan {
         self.beams.div_ceil(self.chunk_beams.max(1))
     }
 
+    /// Whether the last chunk is shorter than the others: for a camera estimator, a pass the
+    /// budget of samples ends inside.
+    pub fn ends_inside_a_chunk(&self) -> bool {
+        !self.beams.is_multiple_of(self.chunk_beams.max(1))
+    }
+
     /// Beams in chunk `c` (the last chunk may be short).
     pub fn beams_in_chunk(&self, c: u64) -> u64 {
         let size = self.chunk_beams.max(1);
@@ -334,9 +340,10 @@ pub struct RenderOutput {
     /// a time budget are left out: see [`FilmWriter::discard_chunk`]).
     #[serde(default)]
     pub moments: Option<Moments>,
-    /// The chunks a time budget cut short, sorted, each with the items it did (also listed in
-    /// `chunks`): a camera estimator's image normalises each pixel by its own sample count
-    /// from them ([`crate::camera_image`]).
+    /// The chunks a time budget cut short, and a camera estimator's pass that its budget of
+    /// samples ends inside (the plan's last chunk, shorter than a pass), sorted, each with the
+    /// items it did (also listed in `chunks`): a camera estimator's image normalises each
+    /// pixel by its own sample count from them ([`crate::camera_image`]).
     #[serde(default)]
     pub cut: Vec<(u64, u64)>,
 }
@@ -430,8 +437,11 @@ pub fn render_observed(
 ) -> Result<RenderOutput, FilmError> {
     let started = Instant::now();
     let (w, h) = integrator.resolution();
-    // A pass cut short needs its per-pass splats apart from the per-sample ones.
-    let pass_layer = plan.time_budget.is_some() && integrator.pass_splats();
+    // A pass cut short needs its per-pass splats apart from the per-sample ones: with a time
+    // budget, or when the budget of samples ends inside a pass.
+    let passes = integrator.chunks_are_passes();
+    let partial = passes && plan.ends_inside_a_chunk();
+    let pass_layer = (plan.time_budget.is_some() || partial) && integrator.pass_splats();
     plan.check_memory_with(w, h, pass_layer, &MemoryLimit::system())?;
     let cells = integrator.sensor_cells();
     let film = Mutex::new(if pass_layer {
@@ -483,9 +493,17 @@ pub fn render_observed(
                     let i = next.fetch_add(1, Ordering::Relaxed);
                     let Some(c) = plan.shard_chunk(i) else { break };
                     let n = plan.beams_in_chunk(c);
-                    let work = ChunkWork { seed: plan.seed, chunk: c, items: n, deadline };
+                    let work = ChunkWork {
+                        seed: plan.seed,
+                        chunk: c,
+                        items: n,
+                        deadline,
+                        ends_pass: true,
+                    };
                     let s = integrator.render_chunk(work, &mut writer);
-                    if s.beams < n {
+                    if s.beams < n || (passes && s.beams < plan.chunk_beams) {
+                        // Cut by the deadline, or a pass the budget ends inside: normalised
+                        // pixel by pixel, kept out of the moments (a batch is a whole pass).
                         writer.discard_chunk();
                         cut.push((c, s.beams));
                     } else {
@@ -782,8 +800,10 @@ mod loop_tests {
         assert_eq!(integrator.image_scale(one.beams), 1.0 / 22_700.0);
         // The film's size is the integrator's.
         let mut film = Film::new(5, 2).unwrap();
-        integrator
-            .render_chunk(ChunkWork { seed: 7, chunk: 3, items: 2, deadline: None }, &mut film);
+        integrator.render_chunk(
+            ChunkWork { seed: 7, chunk: 3, items: 2, deadline: None, ends_pass: false },
+            &mut film,
+        );
         assert_eq!(film.to_xyz(1.0)[3], Constant::value(3, 0) + Constant::value(3, 1));
         assert!(render(&Constant { width: 0 }, &plan(1, None), &|_| {}).is_err());
     }

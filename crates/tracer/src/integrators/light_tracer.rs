@@ -147,7 +147,7 @@ pub fn trace_chunk<S: Splat + ?Sized>(
     beams: u64,
     film: &mut S,
 ) -> TraceStats {
-    let work = ChunkWork { seed, chunk, items: beams, deadline: None };
+    let work = ChunkWork { seed, chunk, items: beams, deadline: None, ends_pass: false };
     trace_chunk_until(scene, settings, effects, work, film)
 }
 

@@ -58,6 +58,11 @@ pub struct ChunkWork {
     pub items: u64,
     /// When to stop early (checked between items).
     pub deadline: Option<Instant>,
+    /// For an estimator whose chunks are passes: whether the pass's once-per-pass work follows
+    /// the items done, weighted by the share of the pass they are (a planned pass, whole, cut
+    /// by a time budget or ended by the render's budget of samples); `false` for the probe's
+    /// single items. Ignored by estimators whose chunks are not passes.
+    pub ends_pass: bool,
 }
 
 /// An estimator the render loop drives: it renders chunks of work items into a film and says
@@ -86,6 +91,14 @@ pub trait Integrator: Send + Sync {
     /// render whose chunks may be cut short then gives the film a pass layer
     /// ([`crate::Film::with_pass_layer`]). `false` by default.
     fn pass_splats(&self) -> bool {
+        false
+    }
+
+    /// `true` if a chunk is a pass over the image's pixels (the camera estimators): a chunk
+    /// that does fewer items than a whole pass, whether a time budget cut it or the render's
+    /// budget of samples ends inside it, is then a cut pass, normalised pixel by pixel. `false`
+    /// by default (a light tracer's short last chunk is simply fewer beams).
+    fn chunks_are_passes(&self) -> bool {
         false
     }
 

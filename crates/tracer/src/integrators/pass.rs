@@ -111,11 +111,13 @@ impl<E: PassEstimator> Integrator for E {
     }
 
     /// One pass (see the module docs), cut short after a multiple of
-    /// `DEADLINE_CHECK_ITEMS` items once `work.deadline` has passed.
+    /// `DEADLINE_CHECK_ITEMS` items once `work.deadline` has passed, or a prefix of one when
+    /// the render's budget ends inside it; its once-per-pass work follows when
+    /// `work.ends_pass`.
     fn render_chunk(&self, work: ChunkWork, film: &mut dyn Splat) -> TraceStats {
         let mut stats = self.render_items(work, film);
         let items = self.items().max(1);
-        if work.items >= items {
+        if work.ends_pass && stats.beams > 0 {
             let kind = self.scene().sampler().resolve(true);
             let mut rng = ChunkSampler::new(kind, work.seed, work.chunk);
             let mut pass = TraceStats::default();
@@ -139,6 +141,10 @@ impl<E: PassEstimator> Integrator for E {
 
     fn pass_splats(&self) -> bool {
         PassEstimator::pass_splats(self)
+    }
+
+    fn chunks_are_passes(&self) -> bool {
+        true
     }
 
     fn image(&self, output: &RenderOutput) -> Vec<Xyz> {
@@ -291,7 +297,7 @@ mod tests {
     fn a_whole_pass_visits_every_item_once_from_a_scrambled_start() {
         for chunk in [0, 1, 7, 1000] {
             let mut seen = [0u32; 37];
-            let work = ChunkWork { seed: 0, chunk, items: 37, deadline: None };
+            let work = ChunkWork { seed: 0, chunk, items: 37, deadline: None, ends_pass: true };
             let stats = run_pass(work, 37, |item, _| {
                 seen[item as usize] += 1;
             });
