@@ -204,12 +204,13 @@ impl LightSampler for PowerLightSampler {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     #![allow(clippy::unwrap_used)]
 
     use super::*;
 
-    fn set(json: &str) -> LightSet {
+    /// A light set from a JSON list of lights (the light samplers' tests share it).
+    pub(crate) fn set(json: &str) -> LightSet {
         let lights: Vec<Box<dyn LightSource>> = serde_json::from_str(json).unwrap();
         LightSet::new(lights).unwrap()
     }

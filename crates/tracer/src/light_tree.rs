@@ -342,12 +342,7 @@ mod tests {
     #![allow(clippy::unwrap_used)]
 
     use super::*;
-    use spectrace_lights::LightSource;
-
-    fn set(json: &str) -> LightSet {
-        let lights: Vec<Box<dyn LightSource>> = serde_json::from_str(json).unwrap();
-        LightSet::new(lights).unwrap()
-    }
+    use crate::light_sampler::tests::set;
 
     /// 40 lights of every bounded kind, spread over a 4 m cube, and a sky beside them.
     fn mixed(with_sky: bool) -> LightSet {

@@ -429,7 +429,9 @@ pub fn render(
 ///
 /// # Errors
 /// [`FilmError::InvalidSize`] for a camera whose resolution is not a valid film;
-/// [`FilmError::TooLarge`] when the render would need more memory than it may use.
+/// [`FilmError::TooLarge`] when the render would need more memory than it may use;
+/// [`FilmError::OutOfMemory`] naming what could not be had (the film, the moments, a thread's
+/// tally) when the system refuses memory the plan expected, before any work starts.
 pub fn render_observed(
     integrator: &dyn Integrator,
     plan: &RenderPlan,
@@ -470,13 +472,19 @@ pub fn render_observed(
         Some(live.lock().unwrap_or_else(PoisonError::into_inner).update(&m, target))
     };
     let results: Mutex<Vec<ThreadResult>> = Mutex::new(Vec::new());
+    // Each thread's writer, its memory had (or refused) before any work starts.
+    let writers = (0..plan.worker_threads())
+        .map(|_| match &moments {
+            Some(m) => FilmWriter::with_moments(&film, m),
+            None => Ok(FilmWriter::new(&film)),
+        })
+        .collect::<Result<Vec<_>, FilmError>>()?;
+    let writers = Mutex::new(writers);
     std::thread::scope(|scope| {
         for _ in 0..plan.worker_threads() {
             scope.spawn(|| {
-                let mut writer = match &moments {
-                    Some(m) => FilmWriter::with_moments(&film, m),
-                    None => FilmWriter::new(&film),
-                };
+                let writer = writers.lock().unwrap_or_else(PoisonError::into_inner).pop();
+                let Some(mut writer) = writer else { return };
                 let mut stats = TraceStats::default();
                 let mut mine = Vec::new();
                 let mut cut = Vec::new();
@@ -537,6 +545,7 @@ pub fn render_observed(
             });
         }
     });
+    drop(writers);
     let film = film.into_inner().unwrap_or_else(PoisonError::into_inner);
     let moments = moments.map(|m| m.into_inner().unwrap_or_else(PoisonError::into_inner));
     let mut stats = TraceStats::default();

@@ -177,7 +177,7 @@ fn the_pass_layer_sums_apart_from_the_pixels_and_merges_exactly() {
     let shared = Mutex::new(Film::with_pass_layer(3, 2, 1).unwrap());
     let moments = Mutex::new(Moments::new(3, 2).unwrap());
     {
-        let mut w = FilmWriter::with_moments(&shared, &moments);
+        let mut w = FilmWriter::with_moments(&shared, &moments).unwrap();
         assert!(w.splat(1, 0, Xyz::new(1.0, 2.0, 3.0)));
         assert!(w.splat_pass(1, 0, Xyz::new(0.5, 0.25, 0.125)));
         assert!(w.splat_pass(2, 1, Xyz::new(4.0, 4.0, 4.0)));

@@ -7,6 +7,7 @@ use spectrace_spectrum::Xyz;
 use super::exact::*;
 use super::moments::ChunkTally;
 use super::moments::Moments;
+use super::raster::FilmError;
 use super::raster::pixel_index;
 use super::{Film, Splat};
 
@@ -71,10 +72,17 @@ impl<'a> FilmWriter<'a> {
 
     /// A writer into `film` that also keeps each chunk's sums and folds them into `moments`
     /// at [`FilmWriter::end_chunk`], for the error estimate ([`Moments`]).
-    pub fn with_moments(film: &'a Mutex<Film>, moments: &'a Mutex<Moments>) -> Self {
+    ///
+    /// # Errors
+    /// [`FilmError::OutOfMemory`] when the chunk sums' memory (29 bytes per pixel) cannot be
+    /// had.
+    pub fn with_moments(
+        film: &'a Mutex<Film>,
+        moments: &'a Mutex<Moments>,
+    ) -> Result<Self, FilmError> {
         let mut writer = Self::new(film);
-        writer.tally = Some(ChunkTally::new(moments));
-        writer
+        writer.tally = Some(ChunkTally::new(moments)?);
+        Ok(writer)
     }
 
     /// Ends chunk number `chunk` (its index in the render plan) of `items` work items:

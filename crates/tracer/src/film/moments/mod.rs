@@ -682,13 +682,12 @@ fn srgb_rows() -> [[f64; 3]; 3] {
 }
 
 /// A thread's sums of the chunk it is rendering, folded into shared [`Moments`] when the chunk
-/// ends ([`crate::FilmWriter::end_chunk`]). Dense (24 bytes per pixel, allocated at the first
-/// contribution) with a list of the pixels touched, so a chunk that lights few pixels costs
-/// little to fold.
+/// ends ([`crate::FilmWriter::end_chunk`]). Dense (24 bytes per pixel, reserved fallibly when
+/// the tally is made) with a list of the pixels touched, so a chunk that lights few pixels
+/// costs little to fold.
 #[derive(Debug)]
 pub(crate) struct ChunkTally<'a> {
     moments: &'a Mutex<Moments>,
-    pixels: usize,
     sums: Vec<[f64; 3]>,
     /// Whether each pixel is in `touched`.
     listed: Vec<bool>,
@@ -699,19 +698,26 @@ impl<'a> ChunkTally<'a> {
     /// Bytes a tally takes per pixel at most: the sums and the touched list.
     pub(crate) const BYTES_PER_PIXEL: u64 = 24 + 1 + 4;
 
-    /// A tally folding into `moments`.
-    pub(crate) fn new(moments: &'a Mutex<Moments>) -> Self {
+    /// A tally folding into `moments`, its memory reserved at once ([`Self::BYTES_PER_PIXEL`]
+    /// per pixel, which the render's memory plan counts per thread).
+    ///
+    /// # Errors
+    /// [`FilmError::OutOfMemory`] when the memory cannot be had.
+    pub(crate) fn new(moments: &'a Mutex<Moments>) -> Result<Self, FilmError> {
         let pixels = moments.lock().unwrap_or_else(PoisonError::into_inner).sums.len();
-        Self { moments, pixels, sums: Vec::new(), listed: Vec::new(), touched: Vec::new() }
+        let sums = try_filled(pixels, [0.0; 3], "a thread's error-estimate tally")?;
+        let listed = try_filled(pixels, false, "a thread's error-estimate tally")?;
+        let mut touched = Vec::new();
+        touched.try_reserve_exact(pixels).map_err(|_| FilmError::OutOfMemory {
+            what: "a thread's error-estimate tally",
+            bytes: 4 * pixels as u64,
+        })?;
+        Ok(Self { moments, sums, listed, touched })
     }
 
     /// Adds a contribution to pixel `index` of the current chunk.
     #[inline]
     pub(crate) fn add(&mut self, index: usize, xyz: [f64; 3]) {
-        if self.sums.is_empty() {
-            self.sums = vec![[0.0; 3]; self.pixels];
-            self.listed = vec![false; self.pixels];
-        }
         let (Some(s), Some(listed)) = (self.sums.get_mut(index), self.listed.get_mut(index)) else {
             return;
         };

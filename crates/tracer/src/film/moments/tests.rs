@@ -250,7 +250,7 @@ fn the_relmse_uncertainty_is_how_far_a_skewed_renders_estimate_strays() {
 #[test]
 fn a_tally_lists_each_pixel_once_even_when_its_sum_returns_to_zero() {
     let moments = Mutex::new(Moments::new(4, 1).unwrap());
-    let mut t = ChunkTally::new(&moments);
+    let mut t = ChunkTally::new(&moments).unwrap();
     t.add(1, [1.0, 0.0, 0.0]);
     t.add(1, [-1.0, 0.0, 0.0]);
     t.add(1, [2.0, 0.0, 0.0]);
