@@ -9,7 +9,11 @@
 //! | `F1` ... `F12` | the CIE fluorescent tables (CIE 15:2004 Table T.6, 5 nm) | 380-780 nm |
 //!
 //! JSON: `{"type": "CieIlluminant", "name": "D65"}`. Each is normalised to integral 1 over its
-//! range, like every SPD.
+//! range, like every SPD. Each is built once per process and shared by every light that names
+//! it (a scene of 20,000 D65 lamps builds one table).
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock, PoisonError};
 
 use serde::{Deserialize, Serialize};
 
@@ -28,7 +32,7 @@ pub const KNOWN_ILLUMINANTS: &str =
 #[serde(try_from = "IlluminantRepr")]
 pub struct CieIlluminant {
     name: String,
-    spd: Box<dyn SpectralPowerDistribution>,
+    spd: Arc<dyn SpectralPowerDistribution>,
 }
 
 /// Scene-file form of [`CieIlluminant`].
@@ -57,25 +61,39 @@ impl CieIlluminant {
     /// # Errors
     /// [`SpectrumError::UnknownIlluminant`] listing the known names.
     pub fn new(name: &str) -> Result<Self, SpectrumError> {
-        let spd: Box<dyn SpectralPowerDistribution> = match name {
-            "A" => Box::new(Blackbody::with_c2(
+        // At most one entry per known name: unknown names are refused before they are cached.
+        static BUILT: OnceLock<Mutex<HashMap<String, Arc<dyn SpectralPowerDistribution>>>> =
+            OnceLock::new();
+        let built = BUILT.get_or_init(Default::default);
+        if let Some(spd) = built.lock().unwrap_or_else(PoisonError::into_inner).get(name) {
+            return Ok(Self { name: name.to_owned(), spd: spd.clone() });
+        }
+        let spd = Self::build(name)?;
+        built.lock().unwrap_or_else(PoisonError::into_inner).insert(name.to_owned(), spd.clone());
+        Ok(Self { name: name.to_owned(), spd })
+    }
+
+    /// Builds illuminant `name`'s spectrum.
+    fn build(name: &str) -> Result<Arc<dyn SpectralPowerDistribution>, SpectrumError> {
+        let spd: Arc<dyn SpectralPowerDistribution> = match name {
+            "A" => Arc::new(Blackbody::with_c2(
                 "CieIlluminant",
                 tables::A_FORMULA_T_K,
                 300.0,
                 830.0,
                 tables::A_FORMULA_C2_NM_K,
             )?),
-            "D65" => Box::new(Tabulated::regular(
+            "D65" => Arc::new(Tabulated::regular(
                 tables::D65_START_NM,
                 tables::D65_STEP_NM,
                 &tables::D65,
             )?),
-            "D50" => Box::new(daylight(5000.0)?),
-            "D55" => Box::new(daylight(5500.0)?),
-            "D75" => Box::new(daylight(7500.0)?),
-            "E" => Box::new(Uniform::equal_energy()),
+            "D50" => Arc::new(daylight(5000.0)?),
+            "D55" => Arc::new(daylight(5500.0)?),
+            "D75" => Arc::new(daylight(7500.0)?),
+            "E" => Arc::new(Uniform::equal_energy()),
             _ => match name.strip_prefix('F').and_then(|k| k.parse::<usize>().ok()) {
-                Some(k @ 1..=12) if name == format!("F{k}") => Box::new(Tabulated::regular(
+                Some(k @ 1..=12) if name == format!("F{k}") => Arc::new(Tabulated::regular(
                     tables::F_START_NM,
                     tables::F_STEP_NM,
                     &tables::F[k - 1],
@@ -88,7 +106,7 @@ impl CieIlluminant {
                 }
             },
         };
-        Ok(Self { name: name.to_owned(), spd })
+        Ok(spd)
     }
 
     /// The illuminant's name.
