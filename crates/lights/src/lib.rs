@@ -27,7 +27,8 @@
 //! it ([`LightSource::sample_towards`], [`LightSource::pdf_towards`],
 //! [`LightSource::emitted_radiance`], [`LightSource::sample_emission`] with the same distribution
 //! as `next_beam`, [`LightSource::pdf_emission`], [`LightSource::surface`] for area lights, and
-//! [`LightSource::flags`] for which densities are deltas); a [`LightSet`] chooses a light by
+//! [`LightSource::flags`] for which densities are deltas, [`LightSource::light_bounds`] for a
+//! light tree's [`LightBounds`]); a [`LightSet`] chooses a light by
 //! power ([`LightSet::sample_light`]) and defers to it. The crate README tabulates what each light returns.
 //!
 //! The key design decisions: [`SpdLight`] (the seed's `spdLightSource`) gives every built-in light

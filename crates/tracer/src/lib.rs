@@ -4,8 +4,9 @@
 //! This crate sits on all the others (sampling, spectrum, lights, geometry, materials) and under
 //! the renderer. A [`LightTracerScene`] holds what every estimator needs: the
 //! [`spectrace_geometry::World`], one [`spectrace_materials::Material`] per shape, the
-//! [`spectrace_lights::LightSet`] with the one light sampler every estimator asks
-//! ([`PowerLightSampler`]), what each shape emits ([`Emitter`]: area lights' own surfaces and
+//! [`spectrace_lights::LightSet`] with the light samplers the estimators ask (by power,
+//! [`PowerLightSampler`], and for next-event estimation among many lights a [`LightTree`], both
+//! behind [`NextEventLights`]), what each shape emits ([`Emitter`]: area lights' own surfaces and
 //! glowing objects, [`ObjectLight`]) and the [`PinholeCamera`] (a pinhole or a thin lens).
 //! [`LightTracer`] follows beams from the lights and connects them to the camera; [`PathTracer`]
 //! follows camera paths with next-event estimation and multiple importance sampling, carrying
@@ -14,7 +15,8 @@
 //! registry ([`INTEGRATORS`], [`build_integrator`]) builds it, and the render loop ([`render`])
 //! drives any of them.
 //!
-//! The layout follows the jobs: `scene` (what is traced), `integrators` (one module per estimator,
+//! The layout follows the jobs: `scene` (what is traced), `light_sampler`, `light_tree` and
+//! `next_event` (which light a connection goes to), `integrators` (one module per estimator,
 //! over `integrators/common`, the transport steps they share, and `integrators/pass`, the camera
 //! estimators' pass loop), `batch` (the path tracer's batched kernel: many paths moved through
 //! the same steps stage by stage, giving the scalar kernel's image bit for bit; [`Kernel`]),
