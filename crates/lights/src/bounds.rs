@@ -179,23 +179,21 @@ impl PreparedBounds {
     /// [`LightBounds::importance`] at `point`.
     #[inline]
     pub fn importance(&self, point: DVec3) -> f64 {
+        self.importance_at(point, DVec3::ZERO)
+    }
+
+    /// [`LightBounds::importance`] at `point` on a surface of unit `normal` (either side;
+    /// `DVec3::ZERO` for a point on no surface), times a bound on the cosine at the receiver:
+    /// the cosine of the least angle between the normal (or its opposite) and a direction
+    /// from `point` into the box, 0 only where every such direction lies in the surface's
+    /// plane or beyond it (pbrt-v4's `LightBounds::Importance`).
+    #[inline]
+    pub fn importance_at(&self, point: DVec3, normal: DVec3) -> f64 {
         let half_diagonal = self.half_diagonal;
         let to = point - self.centre;
         let distance2 = to.length_squared();
         let d2 = distance2.max(half_diagonal * half_diagonal).max(f64::MIN_POSITIVE);
-        if self.cos_theta_o <= -1.0 {
-            // Normals every way: theta' is 0 wherever the point is (the general case below
-            // gives cos theta' = 1 too), so only the distance counts.
-            let value = self.phi / d2;
-            return if value.is_finite() { value } else { f64::MAX };
-        }
         let distance = distance2.sqrt();
-        // The angle between the axis and the direction to the point.
-        let mut cos_w = if distance > 0.0 { self.axis.dot(to) / distance } else { 1.0 };
-        if self.two_sided {
-            cos_w = cos_w.abs();
-        }
-        let sin_w = (1.0 - cos_w * cos_w).max(0.0).sqrt();
         // Every direction from the box towards the point lies within theta_b of `to`.
         let (sin_b, cos_b) = if distance > half_diagonal && distance > 0.0 {
             let sin_b = (half_diagonal / distance).min(1.0);
@@ -203,13 +201,32 @@ impl PreparedBounds {
         } else {
             (1.0, -1.0)
         };
+        let receiver = if normal == DVec3::ZERO || !(distance > 0.0) {
+            1.0
+        } else {
+            let cos_i = (normal.dot(to) / distance).abs().min(1.0);
+            let sin_i = (1.0 - cos_i * cos_i).max(0.0).sqrt();
+            sub_clamped((sin_i, cos_i), (sin_b, cos_b)).1.max(0.0)
+        };
+        if self.cos_theta_o <= -1.0 {
+            // Normals every way: theta' is 0 wherever the point is (the general case below
+            // gives cos theta' = 1 too), so only the distance and the receiver count.
+            let value = self.phi * receiver / d2;
+            return if value.is_finite() { value } else { f64::MAX };
+        }
+        // The angle between the axis and the direction to the point.
+        let mut cos_w = if distance > 0.0 { self.axis.dot(to) / distance } else { 1.0 };
+        if self.two_sided {
+            cos_w = cos_w.abs();
+        }
+        let sin_w = (1.0 - cos_w * cos_w).max(0.0).sqrt();
         // theta' = max(0, theta_w - theta_o - theta_b).
         let (sin_x, cos_x) = sub_clamped((sin_w, cos_w), (self.sin_theta_o, self.cos_theta_o));
         let (_, cos_p) = sub_clamped((sin_x, cos_x), (sin_b, cos_b));
         if cos_p < self.cos_theta_e {
             return 0.0;
         }
-        let value = self.phi * cos_p / d2;
+        let value = self.phi * cos_p * receiver / d2;
         if value.is_finite() { value } else { f64::MAX }
     }
 }
@@ -320,6 +337,27 @@ mod tests {
         let point = LightBounds::point(DVec3::ONE, 2.0);
         assert!((point.importance(DVec3::new(1.0, 1.0, 3.0)) - 0.5).abs() < 1e-12);
         assert!(point.importance(DVec3::ONE).is_finite());
+    }
+
+    #[test]
+    fn the_receiver_normal_weighs_by_the_cosine_and_rejects_only_the_plane() {
+        let point = LightBounds::point(DVec3::Y, 1.0).prepare();
+        let at = DVec3::ZERO;
+        assert!((point.importance_at(at, DVec3::Y) - 1.0).abs() < 1e-12);
+        assert!((point.importance_at(at, -DVec3::Y) - 1.0).abs() < 1e-12, "either side");
+        let tilted = DVec3::new(1.0, 1.0, 0.0).normalize();
+        assert!((point.importance_at(at, tilted) - 0.5f64.sqrt()).abs() < 1e-12);
+        assert_eq!(point.importance_at(at, DVec3::X), 0.0, "a point in the receiver's plane");
+        // A square straddling the receiver's plane still reaches it.
+        let square = LightBounds::surface(
+            &[DVec3::new(-0.5, 0.9, 0.0), DVec3::new(0.5, 1.1, 0.0)],
+            DVec3::X,
+            1.0,
+            true,
+        )
+        .prepare();
+        assert!(square.importance_at(DVec3::new(-3.0, 1.0, 0.0), DVec3::Y) > 0.0);
+        assert_eq!(point.importance_at(at, DVec3::ZERO), point.importance(at));
     }
 
     #[test]

@@ -572,8 +572,18 @@ fn light_bounds_hold_what_the_light_emits() {
             // Receivers anywhere within 3 m.
             let u = uniforms(&mut rng);
             let receiver = v(6.0 * u[0] - 3.0, 6.0 * u[1] - 3.0, 6.0 * u[2] - 3.0);
-            if light.sample_towards(receiver, [u[3], u[0]]).is_some_and(|s| s.intensity > 0.0) {
+            let Some(s) = light.sample_towards(receiver, [u[3], u[0]]) else { continue };
+            if s.intensity > 0.0 {
                 assert!(bounds.importance(receiver) > 0.0, "{name}: {receiver} is lit");
+                // On a surface through the receiver, lit unless the light lies in its plane.
+                let normal = v(u[1] - 0.5, u[2] - 0.5, u[0] - 0.5).normalize();
+                if s.direction.dot(normal).abs() > 1e-9 {
+                    let prepared = bounds.prepare();
+                    assert!(
+                        prepared.importance_at(receiver, normal) > 0.0,
+                        "{name}: {receiver} {normal}"
+                    );
+                }
             }
         }
     }

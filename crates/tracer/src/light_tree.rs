@@ -4,7 +4,8 @@
 //!
 //! Each node holds a [`LightBounds`] of the lights under it. A choice walks down from the
 //! root: at each node it goes to one of the two children with probability proportional to its
-//! [`LightBounds::importance`] at the point, remapping the uniform so that what is left of it
+//! importance at the receiving point and its surface normal
+//! ([`spectrace_lights::PreparedBounds::importance_at`]), remapping the uniform so that what is left of it
 //! chooses further down (and then the point on the light). The probability of a light is the
 //! product of the probabilities along its path from the root, recomputed from the same
 //! importances by [`LightTree::pmf`], so a strategy weighted by multiple importance sampling
@@ -164,9 +165,10 @@ impl LightTree {
         union
     }
 
-    /// Chooses a light for a receiver at `point` from the uniform `u`; `None` when no light
-    /// can send light there (every importance is 0) or there is none.
-    pub fn sample(&self, point: DVec3, u: f64) -> Option<SampledLight> {
+    /// Chooses a light for a receiver at `point` with unit surface `normal` (`DVec3::ZERO`:
+    /// none) from the uniform `u`; `None` when no light can send light there (every importance
+    /// is 0) or there is none.
+    pub fn sample(&self, (point, normal): (DVec3, DVec3), u: f64) -> Option<SampledLight> {
         let mut u = u.clamp(0.0, ONE_MINUS_EPSILON);
         if u < self.p_unbounded {
             let choice = self.unbounded_choice.as_ref()?;
@@ -183,11 +185,11 @@ impl LightTree {
         loop {
             match self.nodes[node].kind {
                 NodeKind::Leaf(id) => {
-                    let reaches = self.nodes[node].bounds.importance(point) > 0.0;
+                    let reaches = self.nodes[node].bounds.importance_at(point, normal) > 0.0;
                     return reaches.then_some(SampledLight { id, pmf, u });
                 }
                 NodeKind::Inner { second } => {
-                    let p_first = self.first_share(node, second as usize, point)?;
+                    let p_first = self.first_share(node, second as usize, (point, normal))?;
                     if u < p_first {
                         u = (u / p_first).min(ONE_MINUS_EPSILON);
                         pmf *= p_first;
@@ -203,8 +205,8 @@ impl LightTree {
     }
 
     /// The probability that [`sample`](Self::sample) chooses light `id` for a receiver at
-    /// `point` (0 for a light it never chooses there).
-    pub fn pmf(&self, point: DVec3, id: LightId) -> f64 {
+    /// `point` with `normal` (0 for a light it never chooses there).
+    pub fn pmf(&self, (point, normal): (DVec3, DVec3), id: LightId) -> f64 {
         if let Some(k) = self.unbounded_entry.get(id.0 as usize).copied().flatten() {
             return self
                 .unbounded_choice
@@ -216,7 +218,9 @@ impl LightTree {
         let mut node = 0;
         for depth in 0..trail.depth {
             let NodeKind::Inner { second } = self.nodes[node].kind else { return 0.0 };
-            let Some(p_first) = self.first_share(node, second as usize, point) else { return 0.0 };
+            let Some(p_first) = self.first_share(node, second as usize, (point, normal)) else {
+                return 0.0;
+            };
             if trail.bits & (1u128 << depth) == 0 {
                 pmf *= p_first;
                 node += 1;
@@ -225,16 +229,21 @@ impl LightTree {
                 node = second as usize;
             }
         }
-        if self.nodes[node].bounds.importance(point) > 0.0 { pmf } else { 0.0 }
+        if self.nodes[node].bounds.importance_at(point, normal) > 0.0 { pmf } else { 0.0 }
     }
 
     /// The probability of going to the first child of inner node `node` (whose second child is
-    /// `second`) for a receiver at `point`; `None` when neither child reaches it.
+    /// `second`) for a receiver at `point` with `normal`; `None` when neither child reaches it.
     #[inline]
-    fn first_share(&self, node: usize, second: usize, point: DVec3) -> Option<f64> {
+    fn first_share(
+        &self,
+        node: usize,
+        second: usize,
+        (point, normal): (DVec3, DVec3),
+    ) -> Option<f64> {
         // Halved so that two importances near the largest double still add.
-        let a = 0.5 * self.nodes[node + 1].bounds.importance(point);
-        let b = 0.5 * self.nodes[second].bounds.importance(point);
+        let a = 0.5 * self.nodes[node + 1].bounds.importance_at(point, normal);
+        let b = 0.5 * self.nodes[second].bounds.importance_at(point, normal);
         let total = a + b;
         (total > 0.0).then(|| a / total)
     }
@@ -381,8 +390,9 @@ mod tests {
             let tree = LightTree::new(&lights, |_, _| true);
             assert_eq!(tree.len(), lights.lights().len());
             for p in receivers() {
-                let pmfs: Vec<f64> =
-                    (0..lights.lights().len()).map(|i| tree.pmf(p, LightId(i as u32))).collect();
+                let pmfs: Vec<f64> = (0..lights.lights().len())
+                    .map(|i| tree.pmf((p, DVec3::ZERO), LightId(i as u32)))
+                    .collect();
                 // At most 1: a walk that reaches a node none of whose lights shine on `p`
                 // chooses nothing (those lights would add nothing).
                 let total: f64 = pmfs.iter().sum();
@@ -392,12 +402,14 @@ mod tests {
                 let n = 20_000;
                 let (mut counts, mut none) = (vec![0u32; pmfs.len()], 0u32);
                 for k in 0..n {
-                    let Some(s) = tree.sample(p, (f64::from(k) + 0.5) / f64::from(n)) else {
+                    let Some(s) =
+                        tree.sample((p, DVec3::ZERO), (f64::from(k) + 0.5) / f64::from(n))
+                    else {
                         none += 1;
                         continue;
                     };
                     assert!((0.0..1.0).contains(&s.u));
-                    assert_eq!(s.pmf, tree.pmf(p, s.id), "{p}: light {:?}", s.id);
+                    assert_eq!(s.pmf, tree.pmf((p, DVec3::ZERO), s.id), "{p}: light {:?}", s.id);
                     assert!(s.pmf > 0.0);
                     counts[s.id.0 as usize] += 1;
                 }
@@ -430,13 +442,13 @@ mod tests {
         assert!(normal.y < -0.99, "the rectangles face down: {normal}");
         let tree = LightTree::new(&lights, |_, _| true);
         let p = DVec3::new(0.5, 2.0, 0.5);
-        assert_eq!(tree.pmf(p, LightId(0)), 0.0);
-        assert_eq!(tree.pmf(p, LightId(1)), 1.0);
+        assert_eq!(tree.pmf((p, DVec3::ZERO), LightId(0)), 0.0);
+        assert_eq!(tree.pmf((p, DVec3::ZERO), LightId(1)), 1.0);
         for k in 0..100 {
-            assert_eq!(tree.sample(p, f64::from(k) / 100.0).unwrap().id, LightId(1));
+            assert_eq!(tree.sample((p, DVec3::ZERO), f64::from(k) / 100.0).unwrap().id, LightId(1));
         }
         // Above both, neither reaches: no choice at all.
-        assert!(tree.sample(DVec3::new(0.5, 4.0, 0.5), 0.3).is_none());
+        assert!(tree.sample((DVec3::new(0.5, 4.0, 0.5), DVec3::ZERO), 0.3).is_none());
     }
 
     #[test]
@@ -447,7 +459,7 @@ mod tests {
         assert_eq!(tree.depth(), 13, "5000 lights in halves: ceil(log2 5000) levels");
         let p = DVec3::new(0.0, 0.0, 0.0);
         for i in [0, 1234, 4999] {
-            assert!((tree.pmf(p, LightId(i)) - 1.0 / 5000.0).abs() < 1e-15);
+            assert!((tree.pmf((p, DVec3::ZERO), LightId(i)) - 1.0 / 5000.0).abs() < 1e-15);
         }
     }
 
@@ -457,10 +469,10 @@ mod tests {
         let sky = LightId(40);
         let tree = LightTree::new(&lights, |id, _| id.0 % 2 == 0 || id == sky);
         let p = DVec3::new(0.0, 0.5, 0.0);
-        assert_eq!(tree.pmf(p, LightId(1)), 0.0);
+        assert_eq!(tree.pmf((p, DVec3::ZERO), LightId(1)), 0.0);
         // One unbounded light: chosen half the time, as pbrt-v4 does.
-        assert!((tree.pmf(p, sky) - 0.5).abs() < 1e-15);
-        let total: f64 = (0..41).map(|i| tree.pmf(p, LightId(i))).sum();
+        assert!((tree.pmf((p, DVec3::ZERO), sky) - 0.5).abs() < 1e-15);
+        let total: f64 = (0..41).map(|i| tree.pmf((p, DVec3::ZERO), LightId(i))).sum();
         assert!((total - 1.0).abs() < 1e-12);
     }
 }

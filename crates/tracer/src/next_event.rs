@@ -136,10 +136,16 @@ impl NextEventLights {
         }
     }
 
-    /// Calls `f` with every light next-event estimation samples at a vertex at `point` whose
-    /// light uniforms are `u`.
+    /// Calls `f` with every light next-event estimation samples at a vertex at `point` with
+    /// unit shading normal `normal` (`DVec3::ZERO`: not on a surface) whose light uniforms
+    /// are `u`.
     #[inline]
-    pub fn for_each(&self, point: DVec3, u: [f64; 2], mut f: impl FnMut(LightChoice)) {
+    pub fn for_each(
+        &self,
+        (point, normal): (DVec3, DVec3),
+        u: [f64; 2],
+        mut f: impl FnMut(LightChoice),
+    ) {
         let chosen = match self {
             Self::Each { delta, area } => {
                 for &id in delta {
@@ -148,21 +154,22 @@ impl NextEventLights {
                 area.sample(u[0])
             }
             Self::Power(sampler) => sampler.sample(u[0]),
-            Self::Tree(tree) => tree.sample(point, u[0]),
+            Self::Tree(tree) => tree.sample((point, normal), u[0]),
         };
         if let Some(c) = chosen {
             f(LightChoice { id: c.id, pmf: c.pmf, u: [c.u, u[1]] });
         }
     }
 
-    /// The probability that next-event estimation at `point` chooses light `id`, a light
-    /// sampled by area (for the weight of the same light found by a BSDF-sampled ray).
+    /// The probability that next-event estimation at `point` with `normal` chooses light
+    /// `id`, a light sampled by area (for the weight of the same light found by a BSDF-sampled
+    /// ray).
     #[inline]
-    pub fn pmf(&self, point: DVec3, id: LightId) -> f64 {
+    pub fn pmf(&self, (point, normal): (DVec3, DVec3), id: LightId) -> f64 {
         match self {
             Self::Each { area, .. } => area.pmf(id),
             Self::Power(sampler) => sampler.pmf(id),
-            Self::Tree(tree) => tree.pmf(point, id),
+            Self::Tree(tree) => tree.pmf((point, normal), id),
         }
     }
 

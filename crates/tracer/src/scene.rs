@@ -361,12 +361,13 @@ impl<'a> LightTracerScene<'a> {
         (radiance > 0.0).then_some((emitter.light(), radiance))
     }
 
-    /// Solid-angle density (at `receiver`) with which next-event estimation (a light chosen by
-    /// [`Self::next_event`], then a point by its `sample_towards`) picks the emitting point
-    /// `hit`; 0 where the shape does not emit or the light is not among those it samples.
-    pub fn emitter_pdf(&self, receiver: DVec3, hit: &Hit) -> f64 {
+    /// Solid-angle density (at `receiver`, a point and its shading normal) with which
+    /// next-event estimation (a light chosen by [`Self::next_event`], then a point by its
+    /// `sample_towards`) picks the emitting point `hit`; 0 where the shape does not emit or the
+    /// light is not among those it samples.
+    pub fn emitter_pdf(&self, (receiver, normal): (DVec3, DVec3), hit: &Hit) -> f64 {
         let Some(emitter) = self.emitter(hit.primitive) else { return 0.0 };
-        let pmf = self.next_event().pmf(receiver, emitter.light());
+        let pmf = self.next_event().pmf((receiver, normal), emitter.light());
         if !(pmf > 0.0) {
             return 0.0;
         }

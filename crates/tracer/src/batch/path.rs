@@ -109,7 +109,7 @@ impl<'a> Lanes<'a> {
             let Some(vertex) = self.vertices[i].as_ref().filter(|v| v.next_event) else { continue };
             let at = Shading { hit, wo: -path.state.ray.direction, material: &*vertex.material };
             let queue = &mut self.queue;
-            tracer.for_each_light(hit.point, vertex.light, |light| {
+            tracer.for_each_light(hit, vertex.light, |light| {
                 if let Some(c) = tracer.connection(&path.state, &at, light) {
                     queue.push((i, c));
                 }

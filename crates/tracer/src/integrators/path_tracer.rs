@@ -175,8 +175,10 @@ pub(crate) struct PathState {
     /// The wavelengths light travels at along the path; they differ from the film's beyond a
     /// fluorescent re-emission.
     transport: [f64; HERO],
-    /// The previous vertex and the density of the direction that left it (for MIS on emission).
+    /// The previous vertex, its shading normal and the density of the direction that left it
+    /// (for MIS on emission).
     prev_point: DVec3,
+    prev_normal: DVec3,
     prev_pdf: f64,
     /// The direction that reached this vertex came from a delta lobe (or the camera).
     specular: bool,
@@ -198,6 +200,7 @@ impl PathState {
             radiance: [0.0; HERO],
             transport: *lambdas,
             prev_point: ray.origin,
+            prev_normal: DVec3::ZERO,
             prev_pdf: 0.0,
             specular: true,
             depth: 0,
@@ -362,7 +365,7 @@ impl<'a> PathTracer<'a> {
             };
             if vertex.next_event {
                 let at = Shading { hit: &hit, wo: -p.ray.direction, material: &*vertex.material };
-                self.for_each_light(hit.point, vertex.light, |light| {
+                self.for_each_light(&hit, vertex.light, |light| {
                     if let Some(c) = self.connection(p, &at, light)
                         && c.shadow.visible(self.scene)
                     {
@@ -394,7 +397,7 @@ impl<'a> PathTracer<'a> {
             let weight = if p.specular {
                 1.0
             } else {
-                power_heuristic(p.prev_pdf, scene.emitter_pdf(p.prev_point, hit))
+                power_heuristic(p.prev_pdf, scene.emitter_pdf((p.prev_point, p.prev_normal), hit))
             };
             p.add_emission(scene, light, (hit.point, -p.ray.direction), le, weight);
         }
@@ -421,11 +424,11 @@ impl<'a> PathTracer<'a> {
         Some(Vertex { material, light: u.light, next_event })
     }
 
-    /// Calls `f` with every light next-event estimation samples at a vertex at `point` whose
+    /// Calls `f` with every light next-event estimation samples at the vertex `hit` whose
     /// light uniforms are `u` (see [`crate::NextEventLights`]).
     #[inline]
-    pub(crate) fn for_each_light(&self, point: DVec3, u: [f64; 2], f: impl FnMut(LightChoice)) {
-        self.scene.next_event().for_each(point, u, f);
+    pub(crate) fn for_each_light(&self, hit: &Hit, u: [f64; 2], f: impl FnMut(LightChoice)) {
+        self.scene.next_event().for_each((hit.point, hit.shading_normal), u, f);
     }
 
     /// Next-event estimation's light sample `light` seen from the vertex `at`, weighted by the
@@ -534,6 +537,7 @@ impl<'a> PathTracer<'a> {
         p.specular = scattered.kind == ScatterKind::Specular;
         p.prev_pdf = scattered.pdf;
         p.prev_point = hit.point;
+        p.prev_normal = hit.shading_normal;
         p.depth += 1;
         if p.depth > self.settings.rr_depth && !p.last_bounce {
             let relative = relative_throughput(&p.beta, &[1.0; HERO]);

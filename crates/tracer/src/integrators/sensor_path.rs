@@ -181,7 +181,7 @@ pub(crate) fn gather(
             crate::LightSamplerKind::Each => 0.5,
             _ => uniform(rng),
         };
-        next_event.for_each(x, [u, 0.5], |choice| {
+        next_event.for_each((x, glam::DVec3::ZERO), [u, 0.5], |choice| {
             let id = choice.id;
             let Some(s) = sample_light(scene, id, x, [0.5, 0.5]).filter(|s| s.delta) else {
                 return;
