@@ -183,10 +183,10 @@ impl PreparedBounds {
     }
 
     /// [`LightBounds::importance`] at `point` on a surface of unit `normal` (either side;
-    /// `DVec3::ZERO` for a point on no surface), times a bound on the cosine at the receiver:
-    /// the cosine of the least angle between the normal (or its opposite) and a direction
-    /// from `point` into the box, 0 only where every such direction lies in the surface's
-    /// plane or beyond it (pbrt-v4's `LightBounds::Importance`).
+    /// `DVec3::ZERO` for a point on no surface), times a bound on the cosine at the receiver
+    /// (pbrt-v4's `LightBounds::Importance` bounds it by `cos(theta_i - theta_b)`; this takes
+    /// the larger `min(1, cos theta_i + sin theta_b)`, which needs no angle): 0 only for a box
+    /// that is a point in the surface's plane, which sends it nothing.
     #[inline]
     pub fn importance_at(&self, point: DVec3, normal: DVec3) -> f64 {
         let half_diagonal = self.half_diagonal;
@@ -194,19 +194,10 @@ impl PreparedBounds {
         let distance2 = to.length_squared();
         let d2 = distance2.max(half_diagonal * half_diagonal).max(f64::MIN_POSITIVE);
         let distance = distance2.sqrt();
-        // Every direction from the box towards the point lies within theta_b of `to`.
-        let (sin_b, cos_b) = if distance > half_diagonal && distance > 0.0 {
-            let sin_b = (half_diagonal / distance).min(1.0);
-            (sin_b, (1.0 - sin_b * sin_b).max(0.0).sqrt())
-        } else {
-            (1.0, -1.0)
-        };
-        let receiver = if normal == DVec3::ZERO || !(distance > 0.0) {
+        let receiver = if normal == DVec3::ZERO || !(distance > half_diagonal) {
             1.0
         } else {
-            let cos_i = (normal.dot(to) / distance).abs().min(1.0);
-            let sin_i = (1.0 - cos_i * cos_i).max(0.0).sqrt();
-            sub_clamped((sin_i, cos_i), (sin_b, cos_b)).1.max(0.0)
+            ((normal.dot(to).abs() + half_diagonal) / distance).min(1.0)
         };
         if self.cos_theta_o <= -1.0 {
             // Normals every way: theta' is 0 wherever the point is (the general case below
@@ -220,6 +211,13 @@ impl PreparedBounds {
             cos_w = cos_w.abs();
         }
         let sin_w = (1.0 - cos_w * cos_w).max(0.0).sqrt();
+        // Every direction from the box towards the point lies within theta_b of `to`.
+        let (sin_b, cos_b) = if distance > half_diagonal && distance > 0.0 {
+            let sin_b = (half_diagonal / distance).min(1.0);
+            (sin_b, (1.0 - sin_b * sin_b).max(0.0).sqrt())
+        } else {
+            (1.0, -1.0)
+        };
         // theta' = max(0, theta_w - theta_o - theta_b).
         let (sin_x, cos_x) = sub_clamped((sin_w, cos_w), (self.sin_theta_o, self.cos_theta_o));
         let (_, cos_p) = sub_clamped((sin_x, cos_x), (sin_b, cos_b));
@@ -346,7 +344,7 @@ mod tests {
         assert!((point.importance_at(at, DVec3::Y) - 1.0).abs() < 1e-12);
         assert!((point.importance_at(at, -DVec3::Y) - 1.0).abs() < 1e-12, "either side");
         let tilted = DVec3::new(1.0, 1.0, 0.0).normalize();
-        assert!((point.importance_at(at, tilted) - 0.5f64.sqrt()).abs() < 1e-12);
+        assert!((point.importance_at(at, tilted) - 0.5f64.sqrt()).abs() < 1e-12, "cos 45");
         assert_eq!(point.importance_at(at, DVec3::X), 0.0, "a point in the receiver's plane");
         // A square straddling the receiver's plane still reaches it.
         let square = LightBounds::surface(
