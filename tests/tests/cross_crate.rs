@@ -1,6 +1,7 @@
 //! Cross-crate tests: contracts between the Spectrace crates that no single crate can check.
 #![allow(clippy::unwrap_used)]
 
+mod camera_estimators;
 mod environment;
 mod estimate;
 mod fluorescence;

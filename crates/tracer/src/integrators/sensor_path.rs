@@ -174,14 +174,7 @@ pub(crate) fn gather(
     }
     let mut irradiance = [0.0; HERO];
     if response.counts_delta_lights() {
-        // Every delta light under `each`; otherwise one light chosen as next-event estimation
-        // chooses it (an area light chosen here adds nothing: the sampled direction finds it).
-        let next_event = scene.next_event();
-        let u = match next_event.kind() {
-            crate::LightSamplerKind::Each => 0.5,
-            _ => uniform(rng),
-        };
-        next_event.for_each((x, glam::DVec3::ZERO), [u, 0.5], |choice| {
+        let mut add = |choice: crate::LightChoice| {
             let id = choice.id;
             let Some(s) = sample_light(scene, id, x, [0.5, 0.5]).filter(|s| s.delta) else {
                 return;
@@ -195,7 +188,17 @@ pub(crate) fn gather(
             for j in 0..HERO {
                 irradiance[j] += e * spd.value(lambdas[j]);
             }
-        });
+        };
+        // Every delta light under `each`; otherwise one light chosen as next-event estimation
+        // chooses it (an area light chosen here adds nothing: the sampled direction finds it).
+        match scene.next_event() {
+            crate::NextEventLights::Each { delta, .. } => {
+                for &id in delta {
+                    add(crate::LightChoice { id, pmf: 1.0, u: [0.5; 2] });
+                }
+            }
+            chooser => chooser.for_each((x, glam::DVec3::ZERO), [uniform(rng), 0.5], &mut add),
+        }
     }
     let (direction, factor) = response.sample(rng);
     if factor > 0.0 {
