@@ -3,8 +3,10 @@
 //! points without knowing it.
 
 use std::convert::Infallible;
+use std::sync::OnceLock;
 
 use rand::{Rng, TryRng};
+use sobol_burley::parts;
 
 /// Dimensions of a path served from the Sobol table (the Joe-Kuo direction numbers of the
 /// `sobol_burley` crate); later draws of a path come from the fallback generator.
@@ -42,21 +44,20 @@ pub struct SobolSampler<R> {
     seed: u64,
     /// Scramble of the current path's sequence (from seed, stream and block).
     scramble: u32,
-    /// Point index within the block.
-    index: u32,
+    /// The current point's index within the block, bit-reversed and shuffled by the scramble
+    /// (`sobol_burley`'s first step, done once per path instead of once per draw).
+    shuffled: u32,
+    /// The scramble's part of every dimension's Owen-scrambling key (`scramble * 0x9c8f2d3b`).
+    key: u32,
     /// Next dimension to serve; [`SOBOL_DIMENSIONS`] or more: fallback only.
     dimension: u32,
-    /// Dimensions `4k .. 4k + 4` of the current point, computed together when dimension `4k`
-    /// is drawn (`sobol_burley::sample_4d`: the same values as four `sample` calls, in SIMD
-    /// lanes).
-    set: [f32; 4],
 }
 
 impl<R: Rng> SobolSampler<R> {
     /// A sampler whose scrambles derive from `seed`, with `fallback` for the low bits and the
     /// dimensions beyond the table. Until [`start_path`](Self::start_path) it is the fallback.
     pub fn new(seed: u64, fallback: R) -> Self {
-        Self { fallback, seed, scramble: 0, index: 0, dimension: SOBOL_DIMENSIONS, set: [0.0; 4] }
+        Self { fallback, seed, scramble: 0, shuffled: 0, key: 0, dimension: SOBOL_DIMENSIONS }
     }
 
     /// Starts a path: point `index` of the sequence scrambled for `stream` (and the sampler's
@@ -65,7 +66,10 @@ impl<R: Rng> SobolSampler<R> {
         let block = index / SOBOL_BLOCK;
         let key = mix(mix(mix(self.seed) ^ stream) ^ block.wrapping_mul(0xD6E8_FEB8_6659_FD93));
         self.scramble = (key ^ (key >> 32)) as u32;
-        self.index = (index % SOBOL_BLOCK) as u32;
+        let index = (index % SOBOL_BLOCK) as u32;
+        self.shuffled =
+            parts::owen_scramble_rev(index.reverse_bits(), parts::hash(self.scramble ^ INDEX_KEY));
+        self.key = self.scramble.wrapping_mul(SEED_FACTOR);
         self.dimension = 0;
     }
 
@@ -78,6 +82,53 @@ impl<R: Rng> SobolSampler<R> {
     pub fn fallback_mut(&mut self) -> &mut R {
         &mut self.fallback
     }
+
+    /// The top [`SOBOL_BITS`] bits of dimension `dimension` of the current point:
+    /// `sobol_burley::sample(index, dimension, scramble)` times `2^23` (an integer, exactly),
+    /// the crate's steps with the unscrambled Sobol integer read from [`ByteTables`].
+    #[inline]
+    fn coordinate(&self, dimension: u32) -> u32 {
+        let sobol = match byte_tables().get(dimension as usize) {
+            Some(t) => {
+                t[0][(self.shuffled >> 24) as usize] ^ t[1][((self.shuffled >> 16) & 0xff) as usize]
+            }
+            None => parts::sobol_rev(self.shuffled, dimension),
+        };
+        let key = (dimension >> 2) ^ self.key ^ LANE_KEYS[(dimension & 3) as usize];
+        // `u32_to_f32_norm(n)` is `(n >> 9) * 2^-23` exactly: its top 23 bits.
+        parts::owen_scramble_rev(sobol, parts::hash(key)).reverse_bits() >> (32 - SOBOL_BITS)
+    }
+}
+
+/// `sobol_burley`'s key for shuffling the point index (see `sobol_burley::sample`).
+const INDEX_KEY: u32 = 0x79c6_8e4a;
+/// `sobol_burley`'s factor on the seed in every dimension's scrambling key.
+const SEED_FACTOR: u32 = 0x9c8f_2d3b;
+/// `sobol_burley`'s per-lane constants of the scrambling key (dimension mod 4).
+const LANE_KEYS: [u32; 4] = [0x912f_69ba, 0x174f_18ab, 0x691e_72ca, 0xb40c_c1b8];
+
+/// Dimensions whose Sobol integers are tabulated by byte (2 KiB each); later ones use
+/// `sobol_burley`'s bit loop.
+const TABLE_DIMENSIONS: u32 = if SOBOL_DIMENSIONS < 256 { SOBOL_DIMENSIONS } else { 256 };
+
+/// Per dimension, the (bit-reversed) Sobol integer of every value of the shuffled index's top
+/// byte (`[0]`) and of its second byte (`[1]`). The Sobol integer of an index is the XOR of the
+/// direction vectors of its set bits (`sobol_burley` reads the top 16 bits), so it is the XOR of
+/// the two bytes' entries: two loads instead of a loop over up to 16 bits.
+type ByteTables = Vec<[[u32; 256]; 2]>;
+
+/// The tables, built once per process from `sobol_burley::parts::sobol_rev` (0.1 ms).
+fn byte_tables() -> &'static ByteTables {
+    static TABLES: OnceLock<ByteTables> = OnceLock::new();
+    TABLES.get_or_init(|| {
+        (0..TABLE_DIMENSIONS)
+            .map(|d| {
+                let byte =
+                    |shift: u32| std::array::from_fn(|b| parts::sobol_rev((b as u32) << shift, d));
+                [byte(24), byte(16)]
+            })
+            .collect()
+    })
 }
 
 /// SplitMix64's finaliser: a bijective mix of 64 bits.
@@ -100,14 +151,8 @@ impl<R: Rng> TryRng for SobolSampler<R> {
         if self.dimension >= SOBOL_DIMENSIONS {
             return Ok(low);
         }
-        let lane = (self.dimension % 4) as usize;
-        if lane == 0 {
-            self.set = sobol_burley::sample_4d(self.index, self.dimension / 4, self.scramble);
-        }
-        let x = self.set[lane];
+        let high = u64::from(self.coordinate(self.dimension));
         self.dimension += 1;
-        // `x` is a multiple of 2^-23 in [0, 1): exactly an integer below 2^23 after scaling.
-        let high = (f64::from(x) * f64::from(1u32 << SOBOL_BITS)) as u64;
         Ok((high << (64 - SOBOL_BITS)) | (low >> SOBOL_BITS))
     }
 
@@ -215,13 +260,18 @@ mod tests {
 
     #[test]
     fn draws_are_the_crates_points_dimension_by_dimension() {
-        // Served four dimensions at a time, each draw is still `sample(index, dimension,
-        // scramble)`: the top 23 bits equal the one-dimension function's value.
+        // Every draw is `sample(index, dimension, scramble)` of the crate: the top 23 bits equal
+        // the one-dimension function's value, in every dimension (the byte tables' and the bit
+        // loop's beyond them), for indices whose shuffled bits cover both table bytes.
         let mut s = sampler(21);
-        for index in [0u64, 1, 7, 4095, SOBOL_BLOCK + 3] {
-            s.start_path(5, index);
+        for (stream, index) in
+            [(5, 0u64), (5, 1), (6, 7), (7, 4095), (8, 65535), (5, SOBOL_BLOCK + 3)]
+                .into_iter()
+                .chain((0..64).map(|k| (k, k * 1031 % SOBOL_BLOCK)))
+        {
+            s.start_path(stream, index);
             let scramble = s.scramble;
-            for d in 0..11 {
+            for d in 0..SOBOL_DIMENSIONS {
                 let x = sobol_burley::sample((index % SOBOL_BLOCK) as u32, d, scramble);
                 let expected = (f64::from(x) * f64::from(1u32 << SOBOL_BITS)) as u64;
                 assert_eq!(s.next_u64() >> 41, expected, "index {index}, dimension {d}");
