@@ -239,8 +239,10 @@ impl Bvh {
         self.walk(&mut slab, t_max, on_leaf);
     }
 
-    /// The traversal loop, generic over the box test: the children a node's test accepts are
-    /// pushed farthest first, so the nearest is popped next.
+    /// The traversal loop, generic over the box test. The nearest child a node's test accepts
+    /// is visited next without going through the stack (tested at once if it is a node, its
+    /// primitives run at once if it is a leaf); the others are pushed farthest first, so the
+    /// nearest of them is popped next.
     #[inline]
     fn walk<S: Slab>(
         &self,
@@ -253,16 +255,11 @@ impl Bvh {
         loop {
             let n = &self.nodes[node];
             let (mask, near) = slab.test(n);
-            if mask != 0 && mask & (mask - 1) == 0 {
-                // One child met (the common case): visit it without touching the stack.
-                let lane = mask.trailing_zeros() as usize;
-                let child = n.child[lane];
-                if child & LEAF == 0 {
-                    node = child as usize;
-                    continue;
-                }
-                stack.push((child, near[lane]));
-            } else if mask != 0 {
+            let next = if mask == 0 {
+                None
+            } else if mask & (mask - 1) == 0 {
+                Some(n.child[mask.trailing_zeros() as usize])
+            } else {
                 let mut hits = [(0, S::T::default()); WIDTH];
                 let mut len = 0;
                 let mut bits = mask;
@@ -272,7 +269,23 @@ impl Bvh {
                     hits[len] = (n.child[lane], near[lane]);
                     len += 1;
                 }
-                stack.push_sorted(&mut hits[..len]);
+                sort_farthest_first(&mut hits[..len]);
+                stack.push_all(&hits[..len - 1]);
+                Some(hits[len - 1].0)
+            };
+            if let Some(child) = next {
+                if child & LEAF == 0 {
+                    node = child as usize;
+                    continue;
+                }
+                match on_leaf(child & !LEAF, t_max) {
+                    Some(t) if t < 0.0 => return,
+                    Some(t) => {
+                        t_max = t;
+                        slab.set_limit(t);
+                    }
+                    None => {}
+                }
             }
             loop {
                 let Some((child, near)) = stack.pop() else { return };
@@ -292,6 +305,19 @@ impl Bvh {
                     None => {}
                 }
             }
+        }
+    }
+}
+
+/// Sorts `entries` (at most [`WIDTH`]) by entry distance, farthest first (insertion sort: most
+/// nodes have two or three children met).
+#[inline(always)]
+fn sort_farthest_first<T: PartialOrd>(entries: &mut [(u32, T)]) {
+    for i in 1..entries.len() {
+        let mut j = i;
+        while j > 0 && entries[j - 1].1 < entries[j].1 {
+            entries.swap(j - 1, j);
+            j -= 1;
         }
     }
 }
@@ -538,18 +564,10 @@ impl<T: Copy + Default + PartialOrd> Stack<T> {
         self.spill.pop().or_else(|| self.inline.pop())
     }
 
-    /// Pushes `entries` (at most [`WIDTH`]) so that the nearest is on top: sorted by entry
-    /// distance, farthest first.
+    /// Pushes `entries` in order (the last on top).
     #[inline(always)]
-    fn push_sorted(&mut self, entries: &mut [(u32, T)]) {
-        for i in 1..entries.len() {
-            let mut j = i;
-            while j > 0 && entries[j - 1].1 < entries[j].1 {
-                entries.swap(j - 1, j);
-                j -= 1;
-            }
-        }
-        for &e in entries.iter() {
+    fn push_all(&mut self, entries: &[(u32, T)]) {
+        for &e in entries {
             self.push(e);
         }
     }
