@@ -259,6 +259,14 @@ impl Bvh {
                 None
             } else if mask & (mask - 1) == 0 {
                 Some(n.child[mask.trailing_zeros() as usize])
+            } else if (mask & (mask - 1)).count_ones() == 1 {
+                // Two children met (a quarter of all nodes): the farther is pushed by a select,
+                // not a sort loop (ties keep the sort's order: the higher lane is visited first).
+                let (i, j) = (mask.trailing_zeros() as usize, (31 - mask.leading_zeros()) as usize);
+                let (a, b) = ((n.child[i], near[i]), (n.child[j], near[j]));
+                let (far, nearest) = if a.1 < b.1 { (b, a) } else { (a, b) };
+                stack.push(far);
+                Some(nearest.0)
             } else {
                 let mut hits = [(0, S::T::default()); WIDTH];
                 let mut len = 0;
