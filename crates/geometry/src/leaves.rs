@@ -67,6 +67,10 @@ pub(crate) struct Leaves {
     leaves: Vec<LeafRecord>,
     packets: Vec<Triangles4>,
     has_triangles: bool,
+    /// Every leaf is one packet of triangles, numbered as the leaf (meshes whose leaves hold
+    /// at most four triangles): a leaf's packet is found without reading its record first, so
+    /// the two loads overlap instead of waiting one for the other.
+    packet_per_leaf: bool,
 }
 
 impl Leaves {
@@ -93,13 +97,16 @@ impl Leaves {
             vertices.push(v);
         }
         let mut packets = Vec::new();
-        let records = leaves
+        let records: Vec<LeafRecord> = leaves
             .iter()
             .map(|leaf| {
                 let range = leaf.first as usize..(leaf.first + leaf.count) as usize;
                 let (kinds, vertices) = (&slots[range.clone()], &vertices[range]);
                 let packet = packets.len() as u32;
-                if kinds.iter().any(|s| s.kind == SlotKind::Triangle) {
+                // Mesh leaves get packets even when all their triangles are degenerate (their
+                // lanes are zeros, which the filter rejects), so that every leaf of a mesh is
+                // one packet.
+                if kinds.iter().any(|s| s.kind != SlotKind::Analytic) {
                     for (k, v) in kinds.chunks(LANES).zip(vertices.chunks(LANES)) {
                         packets.push(packet_of(k.iter().map(|s| s.kind).zip(v.iter().copied())));
                     }
@@ -110,7 +117,10 @@ impl Leaves {
             })
             .collect();
         let has_triangles = slots.iter().any(|s| s.kind == SlotKind::Triangle);
-        Self { slots, leaves: records, packets, has_triangles }
+        let packet_per_leaf = records.iter().enumerate().all(|(i, r): (usize, &LeafRecord)| {
+            r.packets == 1 && r.packet as usize == i && !r.analytic
+        });
+        Self { slots, leaves: records, packets, has_triangles, packet_per_leaf }
     }
 
     /// Number of primitive slots.
@@ -141,6 +151,11 @@ impl Leaves {
         mut limit: f64,
         best: &mut Nearest,
     ) -> Option<f64> {
+        if self.packet_per_leaf
+            && let Some(tr) = triangle_ray
+        {
+            return self.nearest_in_packet(leaf, tr, limit, best);
+        }
         let record = self.leaves[leaf as usize];
         let mut closer = None;
         if let Some(tr) = triangle_ray {
@@ -174,6 +189,34 @@ impl Leaves {
         closer
     }
 
+    /// [`Leaves::nearest`] for a world whose every leaf is the packet of the same number: the
+    /// leaf's record is read only for a triangle that is hit.
+    #[inline]
+    fn nearest_in_packet(
+        &self,
+        leaf: u32,
+        tr: &TriangleRay,
+        mut limit: f64,
+        best: &mut Nearest,
+    ) -> Option<f64> {
+        let packet = &self.packets[leaf as usize];
+        let mut lanes = tr.candidates4(packet, limit);
+        let mut closer = None;
+        while lanes != 0 {
+            let lane = lanes.trailing_zeros() as usize;
+            lanes &= lanes - 1;
+            let vertices = lane_vertices(packet, lane);
+            let Some((t, b)) = tr.intersect(&vertices.map(|v| v.to_array()), limit) else {
+                continue;
+            };
+            let slot = self.leaves[leaf as usize].first + lane as u32;
+            *best = Nearest::Triangle { slot, vertices, t, b };
+            limit = t;
+            closer = Some(t);
+        }
+        closer
+    }
+
     /// Whether any primitive of `leaf` lies on the ray with `0 < t < limit`.
     #[inline]
     pub(crate) fn any(
@@ -184,6 +227,21 @@ impl Leaves {
         triangle_ray: Option<&TriangleRay>,
         limit: f64,
     ) -> bool {
+        if self.packet_per_leaf
+            && let Some(tr) = triangle_ray
+        {
+            let packet = &self.packets[leaf as usize];
+            let mut lanes = tr.candidates4(packet, limit);
+            while lanes != 0 {
+                let lane = lanes.trailing_zeros() as usize;
+                lanes &= lanes - 1;
+                let vertices = lane_vertices(packet, lane).map(|v| v.to_array());
+                if tr.intersect(&vertices, limit).is_some() {
+                    return true;
+                }
+            }
+            return false;
+        }
         let record = self.leaves[leaf as usize];
         if let Some(tr) = triangle_ray {
             for packet in self.packets_of(record) {
@@ -254,4 +312,40 @@ fn packet_of(slots: impl Iterator<Item = (SlotKind, [[f64; 3]; 3])>) -> Triangle
 fn lane_vertices(packet: &Triangles4, lane: usize) -> [DVec3; 3] {
     let c = |vertex: usize, axis: usize| packet[vertex][axis].as_array_ref()[lane];
     [0, 1, 2].map(|v| DVec3::new(c(v, 0), c(v, 1), c(v, 2)))
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use crate::bench_scenes::bumpy_sphere_triangles;
+    use crate::{Mesh, Ray, Shape, Sphere, World};
+    use glam::DVec3;
+
+    /// A degenerate triangle far from the others sits in a leaf of its own: that leaf still
+    /// gets a packet (of zeros, which the filter rejects), so a mesh world keeps the
+    /// packet-per-leaf layout; it loses it once an analytic shape shares the tree.
+    #[test]
+    fn a_mesh_world_has_one_packet_per_leaf_and_a_mixed_one_does_not() {
+        let (mut positions, mut triangles) = bumpy_sphere_triangles(8);
+        let n = positions.len() as u32;
+        positions.extend([DVec3::new(100.0, 0.0, 0.0), DVec3::new(101.0, 0.0, 0.0)]);
+        positions.push(DVec3::new(102.0, 0.0, 0.0));
+        triangles.push([n, n + 1, n + 2]);
+        let mesh: Shape = Mesh::from_triangles(positions, triangles).unwrap().into();
+        let world = World::new(vec![mesh.clone()]).unwrap();
+        let lone = |l: &super::LeafRecord| {
+            let slots = &world.leaves.slots[l.first as usize..(l.first + l.count) as usize];
+            slots.iter().all(|s| s.kind == super::SlotKind::Never)
+        };
+        assert!(world.leaves.leaves.iter().any(lone), "a leaf holds only the degenerate one");
+        assert!(world.leaves.packet_per_leaf);
+        let ray = Ray::new(DVec3::new(0.0, 0.0, 5.0), DVec3::NEG_Z);
+        assert_eq!(
+            world.intersect(&ray, f64::INFINITY),
+            world.intersect_brute_force(&ray, f64::INFINITY)
+        );
+        let sphere: Shape = Sphere::new(DVec3::new(5.0, 0.0, 0.0), 1.0).unwrap().into();
+        let mixed = World::new(vec![mesh, sphere]).unwrap();
+        assert!(!mixed.leaves.packet_per_leaf);
+    }
 }

@@ -52,7 +52,7 @@ fn conservative_aabb(b: Bounds, center: DVec3) -> Aabb {
 pub struct World {
     shapes: Vec<Shape>,
     /// The primitives of the BVH's leaves.
-    leaves: Leaves,
+    pub(crate) leaves: Leaves,
     /// Test every leaf instead of traversing (see [`DIRECT_PRIMITIVES`]).
     direct: bool,
     bvh2: Bvh2,
