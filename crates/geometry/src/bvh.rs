@@ -451,7 +451,8 @@ impl Slab for SlabF32 {
             t1 = min_keeping(far, t1);
         }
         let t1 = t1 * f32x8::splat(WIDEN) + f32x8::splat(f32::MIN_POSITIVE);
-        let t1 = t1.cmp_lt(self.t_max).blend(t1, self.t_max);
+        // One `minps`: neither side is ever NaN (`t1` starts at +inf and takes no NaN exit).
+        let t1 = min_keeping(t1, self.t_max);
         (t0.cmp_le(t1).move_mask() as u32, t0.to_array())
     }
 
