@@ -355,6 +355,15 @@ fn f32_down(x: f64) -> f32 {
     if f64::from(f) > x { f.next_down() } else { f }
 }
 
+/// `x > 0` (not NaN) rounded to f32 upwards, without a branch: the nearest f32, or the next
+/// one up if that is below `x` (one more in the bits of a non-negative float; infinity stays
+/// infinity, being above every f64).
+#[inline(always)]
+fn positive_f32_up(x: f64) -> f32 {
+    let f = x as f32;
+    f32::from_bits(f.to_bits() + u32::from(f64::from(f) < x))
+}
+
 /// `x` rounded to f32 upwards (so the result is `>= x`; NaN stays NaN).
 fn f32_up(x: f64) -> f32 {
     let f = x as f32;
@@ -458,7 +467,7 @@ impl Slab for SlabF32 {
 
     #[inline]
     fn set_limit(&mut self, t_max: f64) {
-        self.t_max = f32x8::splat(f32_up(t_max) * WIDEN + f32::MIN_POSITIVE);
+        self.t_max = f32x8::splat(positive_f32_up(t_max) * WIDEN + f32::MIN_POSITIVE);
     }
 
     #[inline(always)]
@@ -593,6 +602,9 @@ mod tests {
             let (lo, hi) = (f32_down(x), f32_up(x));
             assert!(f64::from(lo) <= x && x <= f64::from(hi), "{x}: {lo} {hi}");
             assert!(hi == lo || hi == lo.next_up(), "{x}: {lo} {hi}");
+        }
+        for x in [0.1, 1e6 + 0.3, 1e-40, 1e-50, 3.0, 1e39, f64::MAX, f64::INFINITY, 0.5] {
+            assert_eq!(positive_f32_up(x).to_bits(), f32_up(x).to_bits(), "{x}");
         }
     }
 
