@@ -7,6 +7,11 @@
 //! The filter is the scalar test's first half with the same arithmetic in every lane, so it
 //! never drops a triangle the scalar test accepts, and every reported hit comes from the scalar
 //! test: results are those of a primitive-by-primitive search.
+//!
+//! Two layout choices keep a ray's chain of dependent loads short (measured with the `ray_rate`
+//! example, see the crate README): a packet carries its lanes' shape and triangle index, so the
+//! winning triangle's hit needs no slot lookup; and in a world of meshes only every leaf is the
+//! packet of the same number, so a leaf's packet is loaded without reading its record first.
 
 use glam::DVec3;
 use wide::f64x4;
@@ -55,7 +60,7 @@ pub(crate) enum Nearest {
     None,
     /// A triangle slot, its vertices, and the distance and barycentrics its test found (the
     /// full hit is built once, at the end).
-    Triangle { slot: u32, vertices: [DVec3; 3], t: f64, b: [f64; 3] },
+    Triangle { shape: u32, index: u32, vertices: [DVec3; 3], t: f64, b: [f64; 3] },
     /// An analytic shape's full hit.
     Hit(Hit),
 }
@@ -65,7 +70,7 @@ pub(crate) enum Nearest {
 pub(crate) struct Leaves {
     slots: Vec<Slot>,
     leaves: Vec<LeafRecord>,
-    packets: Vec<Triangles4>,
+    packets: Vec<Packet>,
     has_triangles: bool,
     /// Every leaf is one packet of triangles, numbered as the leaf (meshes whose leaves hold
     /// at most four triangles): a leaf's packet is found without reading its record first, so
@@ -108,7 +113,7 @@ impl Leaves {
                 // one packet.
                 if kinds.iter().any(|s| s.kind != SlotKind::Analytic) {
                     for (k, v) in kinds.chunks(LANES).zip(vertices.chunks(LANES)) {
-                        packets.push(packet_of(k.iter().map(|s| s.kind).zip(v.iter().copied())));
+                        packets.push(packet_of(k.iter().copied().zip(v.iter().copied())));
                     }
                 }
                 let packets = packets.len() as u32 - packet;
@@ -159,17 +164,8 @@ impl Leaves {
         let record = self.leaves[leaf as usize];
         let mut closer = None;
         if let Some(tr) = triangle_ray {
-            for (k, packet) in self.packets_of(record).iter().enumerate() {
-                let mut lanes = tr.candidates4(packet, limit);
-                while lanes != 0 {
-                    let lane = lanes.trailing_zeros() as usize;
-                    lanes &= lanes - 1;
-                    let vertices = lane_vertices(packet, lane);
-                    let Some((t, b)) = tr.intersect(&vertices.map(|v| v.to_array()), limit) else {
-                        continue;
-                    };
-                    let slot = record.first + (k * LANES + lane) as u32;
-                    *best = Nearest::Triangle { slot, vertices, t, b };
+            for packet in self.packets_of(record) {
+                if let Some(t) = packet.nearest(tr, limit, best) {
                     limit = t;
                     closer = Some(t);
                 }
@@ -196,25 +192,10 @@ impl Leaves {
         &self,
         leaf: u32,
         tr: &TriangleRay,
-        mut limit: f64,
+        limit: f64,
         best: &mut Nearest,
     ) -> Option<f64> {
-        let packet = &self.packets[leaf as usize];
-        let mut lanes = tr.candidates4(packet, limit);
-        let mut closer = None;
-        while lanes != 0 {
-            let lane = lanes.trailing_zeros() as usize;
-            lanes &= lanes - 1;
-            let vertices = lane_vertices(packet, lane);
-            let Some((t, b)) = tr.intersect(&vertices.map(|v| v.to_array()), limit) else {
-                continue;
-            };
-            let slot = self.leaves[leaf as usize].first + lane as u32;
-            *best = Nearest::Triangle { slot, vertices, t, b };
-            limit = t;
-            closer = Some(t);
-        }
-        closer
+        self.packets[leaf as usize].nearest(tr, limit, best)
     }
 
     /// Whether any primitive of `leaf` lies on the ray with `0 < t < limit`.
@@ -230,31 +211,13 @@ impl Leaves {
         if self.packet_per_leaf
             && let Some(tr) = triangle_ray
         {
-            let packet = &self.packets[leaf as usize];
-            let mut lanes = tr.candidates4(packet, limit);
-            while lanes != 0 {
-                let lane = lanes.trailing_zeros() as usize;
-                lanes &= lanes - 1;
-                let vertices = lane_vertices(packet, lane).map(|v| v.to_array());
-                if tr.intersect(&vertices, limit).is_some() {
-                    return true;
-                }
-            }
-            return false;
+            return self.packets[leaf as usize].any(tr, limit);
         }
         let record = self.leaves[leaf as usize];
-        if let Some(tr) = triangle_ray {
-            for packet in self.packets_of(record) {
-                let mut lanes = tr.candidates4(packet, limit);
-                while lanes != 0 {
-                    let lane = lanes.trailing_zeros() as usize;
-                    lanes &= lanes - 1;
-                    let vertices = lane_vertices(packet, lane).map(|v| v.to_array());
-                    if tr.intersect(&vertices, limit).is_some() {
-                        return true;
-                    }
-                }
-            }
+        if let Some(tr) = triangle_ray
+            && self.packets_of(record).iter().any(|p| p.any(tr, limit))
+        {
+            return true;
         }
         record.analytic
             && self
@@ -267,11 +230,10 @@ impl Leaves {
         match nearest {
             Nearest::None => None,
             Nearest::Hit(hit) => Some(hit),
-            Nearest::Triangle { slot, vertices, t, b } => {
-                let s = self.slots[slot as usize];
-                let mesh = shapes[s.shape as usize].triangle_mesh()?;
-                let mut hit = mesh.hit_at(s.index, vertices, t, b)?;
-                hit.primitive = s.shape;
+            Nearest::Triangle { shape, index, vertices, t, b } => {
+                let mesh = shapes[shape as usize].triangle_mesh()?;
+                let mut hit = mesh.hit_at(index, vertices, t, b)?;
+                hit.primitive = shape;
                 Some(hit)
             }
         }
@@ -279,7 +241,7 @@ impl Leaves {
 
     /// The packets of a leaf's slots (none for a leaf without triangles).
     #[inline(always)]
-    fn packets_of(&self, record: LeafRecord) -> &[Triangles4] {
+    fn packets_of(&self, record: LeafRecord) -> &[Packet] {
         let first = record.packet as usize;
         &self.packets[first..first + record.packets as usize]
     }
@@ -291,20 +253,70 @@ impl Leaves {
     }
 }
 
-/// A packet of up to four slots: triangles' vertices in their lanes, zeros (which
-/// [`TriangleRay::candidates4`] rejects) for other slots and unused lanes.
-fn packet_of(slots: impl Iterator<Item = (SlotKind, [[f64; 3]; 3])>) -> Triangles4 {
+/// Up to four slots of a leaf: their triangles' vertices as SIMD lanes, for
+/// [`TriangleRay::candidates4`], and each lane's shape and triangle index, so that a hit needs
+/// no other lookup (a lane that is not a triangle holds zeros, which the filter rejects).
+#[derive(Debug, Clone, Copy)]
+struct Packet {
+    vertices: Triangles4,
+    shape: [u32; LANES],
+    index: [u32; LANES],
+}
+
+impl Packet {
+    /// Tests the packet's triangles closer than `limit` (the filter, then the scalar test on the
+    /// lanes that pass, in lane order), recording the nearest in `best`; the new limit if one
+    /// was closer.
+    #[inline(always)]
+    fn nearest(&self, tr: &TriangleRay, mut limit: f64, best: &mut Nearest) -> Option<f64> {
+        let mut lanes = tr.candidates4(&self.vertices, limit);
+        let mut closer = None;
+        while lanes != 0 {
+            let lane = lanes.trailing_zeros() as usize;
+            lanes &= lanes - 1;
+            let vertices = lane_vertices(&self.vertices, lane);
+            let Some((t, b)) = tr.intersect(&vertices.map(|v| v.to_array()), limit) else {
+                continue;
+            };
+            let (shape, index) = (self.shape[lane], self.index[lane]);
+            *best = Nearest::Triangle { shape, index, vertices, t, b };
+            limit = t;
+            closer = Some(t);
+        }
+        closer
+    }
+
+    /// Whether any of the packet's triangles lies on the ray with `0 < t < limit`.
+    #[inline(always)]
+    fn any(&self, tr: &TriangleRay, limit: f64) -> bool {
+        let mut lanes = tr.candidates4(&self.vertices, limit);
+        while lanes != 0 {
+            let lane = lanes.trailing_zeros() as usize;
+            lanes &= lanes - 1;
+            let vertices = lane_vertices(&self.vertices, lane).map(|v| v.to_array());
+            if tr.intersect(&vertices, limit).is_some() {
+                return true;
+            }
+        }
+        false
+    }
+}
+
+/// The packet of up to four slots and their vertices (zeros for a slot that is no triangle).
+fn packet_of(slots: impl Iterator<Item = (Slot, [[f64; 3]; 3])>) -> Packet {
     let mut lanes = [[[0.0; LANES]; 3]; 3];
-    for (lane, (kind, v)) in slots.enumerate() {
-        if kind == SlotKind::Triangle {
+    let (mut shape, mut index) = ([0; LANES], [0; LANES]);
+    for (lane, (slot, v)) in slots.enumerate() {
+        if slot.kind == SlotKind::Triangle {
             for (vertex, p) in v.iter().enumerate() {
                 for axis in 0..3 {
                     lanes[vertex][axis][lane] = p[axis];
                 }
             }
+            (shape[lane], index[lane]) = (slot.shape, slot.index);
         }
     }
-    lanes.map(|v| v.map(f64x4::from))
+    Packet { vertices: lanes.map(|v| v.map(f64x4::from)), shape, index }
 }
 
 /// The vertices in lane `lane` of a packet.
