@@ -269,7 +269,7 @@ impl Packet {
     /// was closer.
     #[inline(always)]
     fn nearest(&self, tr: &TriangleRay, mut limit: f64, best: &mut Nearest) -> Option<f64> {
-        let mut lanes = tr.candidates4(&self.vertices, limit);
+        let mut lanes = tr.candidates4(&self.vertices);
         let mut closer = None;
         while lanes != 0 {
             let lane = lanes.trailing_zeros() as usize;
@@ -289,7 +289,7 @@ impl Packet {
     /// Whether any of the packet's triangles lies on the ray with `0 < t < limit`.
     #[inline(always)]
     fn any(&self, tr: &TriangleRay, limit: f64) -> bool {
-        let mut lanes = tr.candidates4(&self.vertices, limit);
+        let mut lanes = tr.candidates4(&self.vertices);
         while lanes != 0 {
             let lane = lanes.trailing_zeros() as usize;
             lanes &= lanes - 1;
