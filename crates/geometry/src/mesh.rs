@@ -640,8 +640,11 @@ impl TriangleRay {
         let e1 = x2 * y0 - y2 * x0;
         let e2 = x0 * y1 - y0 * x1;
         let zero = f64x4::ZERO;
-        let negative = e0.cmp_lt(zero) | e1.cmp_lt(zero) | e2.cmp_lt(zero);
-        let positive = e0.cmp_gt(zero) | e1.cmp_gt(zero) | e2.cmp_gt(zero);
+        // Some edge negative and some positive: the least below 0 and the greatest above. A
+        // SIMD min or max returns one of its operands (NaN at worst, which compares false), so
+        // a lane rejected here has a negative and a positive edge for the scalar test too.
+        let negative = e0.fast_min(e1).fast_min(e2).cmp_lt(zero);
+        let positive = e0.fast_max(e1).fast_max(e2).cmp_gt(zero);
         let det = e0 + e1 + e2;
         let rejected = (negative & positive) | det.cmp_eq(zero) | !det.is_finite();
         !(rejected.move_mask() as u32) & 0b1111
