@@ -15,9 +15,19 @@ use crate::leaves::{Leaves, Nearest};
 use crate::{Bounds, GeometryError, Hit, Ray, Shape};
 
 /// The build settings of the BVH: `obvhs`'s medium-quality PLOC build with leaves of at most
-/// `MAX_PRIMS_PER_LEAF` primitives.
+/// `MAX_PRIMS_PER_LEAF` primitives, and the reinsertion passes of its slow build (four times the
+/// nodes reconsidered, from one level higher). On the geometry benchmark's 102,400 triangles
+/// that tree answers 4-5% more closest-hit and shadow rays per second, for a build of 108 ms
+/// instead of 65 ms (`ray_rate`, five alternating runs). The slow build's spatial pre-splits
+/// are left out: they clip primitives' boxes inside `obvhs`, outside the outward rounding that
+/// keeps every box here conservative (`conservative_aabb`).
 fn build_params() -> BvhBuildParams {
-    BvhBuildParams { max_prims_per_leaf: MAX_PRIMS_PER_LEAF, ..BvhBuildParams::medium_build() }
+    BvhBuildParams {
+        max_prims_per_leaf: MAX_PRIMS_PER_LEAF,
+        reinsertion_batch_ratio: 0.2,
+        search_depth_threshold: 2,
+        ..BvhBuildParams::medium_build()
+    }
 }
 
 /// Worlds of at most this many primitives, none of them a torus, are not traversed: every
