@@ -267,7 +267,10 @@ impl RectangleLight {
 #[typetag::serde]
 impl LightSource for RectangleLight {
     fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
-        let (lambda, scale) = self.emission.wavelength(uniform(rng));
+        self.next_beam_at(uniform(rng), rng)
+    }
+    fn next_beam_at(&self, u_lambda: f64, rng: &mut dyn Rng) -> Beam {
+        let (lambda, scale) = self.emission.wavelength(u_lambda);
         let origin = self.corner + self.edge_u * uniform(rng) + self.edge_v * uniform(rng);
         let (u1, u2, u3) = (uniform(rng), uniform(rng), uniform(rng));
         let direction = lambertian_direction(&self.frame, self.two_sided, u1, u2, u3);
@@ -426,7 +429,10 @@ impl DiskLight {
 #[typetag::serde]
 impl LightSource for DiskLight {
     fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
-        let (lambda, scale) = self.emission.wavelength(uniform(rng));
+        self.next_beam_at(uniform(rng), rng)
+    }
+    fn next_beam_at(&self, u_lambda: f64, rng: &mut dyn Rng) -> Beam {
+        let (lambda, scale) = self.emission.wavelength(u_lambda);
         let origin = self.point(uniform(rng), uniform(rng));
         let (u1, u2, u3) = (uniform(rng), uniform(rng), uniform(rng));
         let direction = lambertian_direction(&self.frame, self.two_sided, u1, u2, u3);

@@ -174,7 +174,10 @@ impl Laser {
 #[typetag::serde]
 impl LightSource for Laser {
     fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
-        let (lambda, scale) = self.emission.wavelength(uniform(rng));
+        self.next_beam_at(uniform(rng), rng)
+    }
+    fn next_beam_at(&self, u_lambda: f64, rng: &mut dyn Rng) -> Beam {
+        let (lambda, scale) = self.emission.wavelength(u_lambda);
         let origin = if self.beam_radius > 0.0 {
             self.origin_from([uniform(rng), uniform(rng)])
         } else {

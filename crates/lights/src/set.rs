@@ -172,6 +172,14 @@ impl LightSource for LightSet {
         self.counter.increment();
         beam
     }
+    /// The light chosen from `rng` as in `next_beam`, its beam's wavelength from `u_lambda`.
+    fn next_beam_at(&self, u_lambda: f64, rng: &mut dyn Rng) -> Beam {
+        let i = self.choice.sample(uniform(rng));
+        let mut beam = self.lights[i].next_beam_at(u_lambda, rng);
+        beam.parent = LightId(i as u32);
+        self.counter.increment();
+        beam
+    }
     fn number_of_beams(&self) -> u64 {
         self.counter.total()
     }

@@ -194,7 +194,10 @@ impl Sky {
 #[typetag::serde]
 impl LightSource for Sky {
     fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
-        let (lambda, scale) = self.emission.wavelength(uniform(rng));
+        self.next_beam_at(uniform(rng), rng)
+    }
+    fn next_beam_at(&self, u_lambda: f64, rng: &mut dyn Rng) -> Beam {
+        let (lambda, scale) = self.emission.wavelength(u_lambda);
         let origin = self.point(uniform(rng), uniform(rng));
         self.emission.count();
         Beam::new(origin, self.direction, lambda, scale)

@@ -34,6 +34,21 @@ pub trait LightSource: Send + Sync + Debug {
     /// `level` 0. Counts it.
     fn next_beam(&self, rng: &mut dyn Rng) -> Beam;
 
+    /// Emits the next beam as [`next_beam`](Self::next_beam) does, its wavelength drawn from
+    /// the uniform `u_lambda` in `[0, 1)` by the same map as
+    /// [`sample_wavelength`](Self::sample_wavelength) (and used for nothing else), its other
+    /// draws from `rng`. A light tracer passes one `u_lambda` and draws the companions of the
+    /// beam's wavelength bundle at `u_lambda + j / k` (mod 1), so that the bundle's `k`
+    /// wavelengths are stratified together, as a camera path's hero wavelengths are. The
+    /// default ignores `u_lambda` and calls `next_beam`: still unbiased (each wavelength keeps
+    /// its density and the beam's path does not depend on `u_lambda`), only less stratified.
+    /// Every light of this crate draws its wavelength first, so its `next_beam(rng)` is
+    /// `next_beam_at(u, rng)` with `u` its first draw from `rng` (tested).
+    fn next_beam_at(&self, u_lambda: f64, rng: &mut dyn Rng) -> Beam {
+        let _ = u_lambda;
+        self.next_beam(rng)
+    }
+
     /// How many beams this light has emitted so far.
     fn number_of_beams(&self) -> u64;
 

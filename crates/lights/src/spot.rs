@@ -232,7 +232,10 @@ impl UniformSpotLight {
 #[typetag::serde]
 impl LightSource for UniformSpotLight {
     fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
-        let (lambda, scale) = self.emission.wavelength(uniform(rng));
+        self.next_beam_at(uniform(rng), rng)
+    }
+    fn next_beam_at(&self, u_lambda: f64, rng: &mut dyn Rng) -> Beam {
+        let (lambda, scale) = self.emission.wavelength(u_lambda);
         let direction = self.direction_from([uniform(rng), uniform(rng)]);
         self.emission.count();
         Beam::new(self.position, direction, lambda, scale)
@@ -447,7 +450,10 @@ impl FadingSpotLight {
 #[typetag::serde]
 impl LightSource for FadingSpotLight {
     fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
-        let (lambda, scale) = self.emission.wavelength(uniform(rng));
+        self.next_beam_at(uniform(rng), rng)
+    }
+    fn next_beam_at(&self, u_lambda: f64, rng: &mut dyn Rng) -> Beam {
+        let (lambda, scale) = self.emission.wavelength(u_lambda);
         let direction = self.direction_from([uniform(rng), uniform(rng)]);
         self.emission.count();
         Beam::new(self.position, direction, lambda, scale)
@@ -600,7 +606,10 @@ impl PointLight {
 #[typetag::serde]
 impl LightSource for PointLight {
     fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
-        let (lambda, scale) = self.emission.wavelength(uniform(rng));
+        self.next_beam_at(uniform(rng), rng)
+    }
+    fn next_beam_at(&self, u_lambda: f64, rng: &mut dyn Rng) -> Beam {
+        let (lambda, scale) = self.emission.wavelength(u_lambda);
         // z = cos(theta) uniform on [-1, 1]: uniform on the sphere.
         let direction = sphere_direction([uniform(rng), uniform(rng)]);
         self.emission.count();

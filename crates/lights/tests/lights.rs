@@ -158,6 +158,34 @@ fn every_beam_is_well_formed() {
     }
 }
 
+/// Every built-in light draws its wavelength first: `next_beam(rng)` is `next_beam_at(u, rng)`
+/// with `u` its first draw, bit for bit; and with importance or observer sampling the beam's
+/// wavelength is the one `sample_wavelength(u)` gives (the map a light tracer's companions use).
+#[test]
+fn next_beam_is_next_beam_at_its_first_draw_and_shares_the_companions_map() {
+    use rand::RngExt;
+    for (name, mut light) in zoo() {
+        for sampling in [WavelengthSampling::Importance, WavelengthSampling::Observer] {
+            light.set_wavelength_sampling(sampling).unwrap();
+            let mut a = Pcg64::seed_from_u64(7);
+            for _ in 0..200 {
+                let mut b = a.clone();
+                let u = spectrace_lights::uniform(&mut b);
+                let (x, y) = (light.next_beam(&mut a), light.next_beam_at(u, &mut b));
+                assert_eq!(x, y, "{name} {sampling:?}");
+                assert_eq!(a.random::<u64>(), b.random::<u64>(), "{name}: same draws after");
+                if light.spd().range().1 > light.spd().range().0 {
+                    assert_eq!(y.lambda, light.sample_wavelength(u).0, "{name} {sampling:?}");
+                }
+            }
+        }
+    }
+    // A light that implements only `next_beam` ignores `u_lambda` and stays a beam source.
+    let seed_only = SeedOnlyLight { power: 1.0 };
+    let mut rng = Pcg64::seed_from_u64(3);
+    assert_eq!(seed_only.next_beam_at(0.25, &mut rng), seed_only.next_beam(&mut rng));
+}
+
 #[test]
 fn beam_powers_sum_to_the_light_power() {
     for (name, light) in zoo() {

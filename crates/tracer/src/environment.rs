@@ -486,11 +486,11 @@ impl<'de> Deserialize<'de> for Environment {
     }
 }
 
-#[typetag::serde]
-impl LightSource for Environment {
-    fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
-        let u = [uniform(rng), uniform(rng), uniform(rng), uniform(rng)];
-        let lambda = self.spd.sample_lambda(uniform(rng));
+impl Environment {
+    /// The beam of the four uniforms `u` (its origin and direction) and the wavelength drawn
+    /// from `u_lambda`.
+    fn beam(&self, u: [f64; 4], u_lambda: f64) -> Beam {
+        let lambda = self.spd.sample_lambda(u_lambda);
         self.counter.increment();
         match self.emission_ray(u) {
             Some((origin, direction, pdf, cos)) if cos > 0.0 => {
@@ -503,6 +503,19 @@ impl LightSource for Environment {
             Some((origin, direction, ..)) => Beam::new(origin, direction, lambda, 0.0),
             None => Beam::new(self.center + DVec3::Z * self.radius, -DVec3::Z, lambda, 0.0),
         }
+    }
+}
+
+#[typetag::serde]
+impl LightSource for Environment {
+    fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
+        let u = [uniform(rng), uniform(rng), uniform(rng), uniform(rng)];
+        self.beam(u, uniform(rng))
+    }
+
+    fn next_beam_at(&self, u_lambda: f64, rng: &mut dyn Rng) -> Beam {
+        let u = [uniform(rng), uniform(rng), uniform(rng), uniform(rng)];
+        self.beam(u, u_lambda)
     }
 
     fn number_of_beams(&self) -> u64 {

@@ -245,14 +245,27 @@ impl<'de> Deserialize<'de> for ObjectLight {
     }
 }
 
+impl ObjectLight {
+    /// The beam of the five uniforms `u` (its origin and direction) and the wavelength drawn
+    /// from `u_lambda`.
+    fn beam(&self, u: [f64; 5], u_lambda: f64) -> Beam {
+        let s = self.sample(u);
+        let (lambda, scale) = self.emission.wavelength(u_lambda);
+        self.emission.count();
+        Beam::new(s.position, s.direction, lambda, scale)
+    }
+}
+
 #[typetag::serde]
 impl LightSource for ObjectLight {
     fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
         let u = [uniform(rng), uniform(rng), uniform(rng), uniform(rng), uniform(rng)];
-        let s = self.sample(u);
-        let (lambda, scale) = self.emission.wavelength(uniform(rng));
-        self.emission.count();
-        Beam::new(s.position, s.direction, lambda, scale)
+        self.beam(u, uniform(rng))
+    }
+
+    fn next_beam_at(&self, u_lambda: f64, rng: &mut dyn Rng) -> Beam {
+        let u = [uniform(rng), uniform(rng), uniform(rng), uniform(rng), uniform(rng)];
+        self.beam(u, u_lambda)
     }
 
     spectrace_lights::delegate_to_spd_light!(emission);

@@ -421,8 +421,9 @@ impl Luminaire {
         self.orientation.direction(c, cos_gamma)
     }
 
-    pub(crate) fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
-        let (lambda, scale) = self.emission.wavelength(uniform(rng));
+    /// The next beam, its wavelength from `u_lambda` (see [`LightSource::next_beam_at`]).
+    pub(crate) fn next_beam_at(&self, u_lambda: f64, rng: &mut dyn Rng) -> Beam {
+        let (lambda, scale) = self.emission.wavelength(u_lambda);
         let direction = self.sample_direction([uniform(rng), uniform(rng)]);
         self.emission.count();
         Beam::new(self.position, direction, lambda, scale)
@@ -475,7 +476,10 @@ macro_rules! luminaire_accessors {
 macro_rules! luminaire_light_source {
     () => {
         fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
-            self.luminaire.next_beam(rng)
+            self.luminaire.next_beam_at(uniform(rng), rng)
+        }
+        fn next_beam_at(&self, u_lambda: f64, rng: &mut dyn Rng) -> Beam {
+            self.luminaire.next_beam_at(u_lambda, rng)
         }
         fn number_of_beams(&self) -> u64 {
             self.luminaire.emission.number_of_beams()

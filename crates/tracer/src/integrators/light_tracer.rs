@@ -189,6 +189,13 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
     stats
 }
 
+/// `u + shift` (both in `[0, 1)`) wrapped into `[0, 1)`.
+fn shifted(u: f64, shift: f64) -> f64 {
+    let v = u + shift;
+    let v = if v >= 1.0 { v - 1.0 } else { v };
+    v.clamp(0.0, spectrace_sampling::ONE_MINUS_EPSILON)
+}
+
 /// What one beam's trace needs, fixed for the chunk.
 struct BeamTracer<'s, 'a> {
     scene: &'s LightTracerScene<'a>,
@@ -209,9 +216,15 @@ struct Bundle {
 }
 
 impl BeamTracer<'_, '_> {
-    /// The bundle of `beam`: its own wavelength and weight, plus `bundle - 1` wavelengths drawn
-    /// (stratified) as the beam's light draws its companions, with the weight of that density.
-    fn bundle(&self, beam: &Beam, rng: &mut dyn rand::Rng) -> Bundle {
+    /// The bundle of `beam`, whose wavelength its light drew from `u_lambda`
+    /// ([`LightSource::next_beam_at`]): that wavelength and weight, plus `bundle - 1` companions
+    /// drawn by the light ([`LightSource::sample_wavelength`]) from `u_lambda + j / bundle` (mod
+    /// 1), with the weight of that density. The bundle's wavelengths are thus stratified
+    /// together, one in each `1 / bundle` of the light's wavelength density (Mitsuba's shifted
+    /// wavelengths; a camera path's hero wavelengths do the same). Each is still distributed by
+    /// that density alone, and `u_lambda` decides nothing else of the beam, so every
+    /// wavelength's estimate stays unbiased.
+    fn bundle(&self, beam: &Beam, u_lambda: f64) -> Bundle {
         let k = self.bundle;
         let mut b = Bundle {
             lambdas: [beam.lambda; MAX_BUNDLE],
@@ -223,8 +236,7 @@ impl BeamTracer<'_, '_> {
         if k > 1 {
             let own = self.scene.lights.light(beam.parent);
             for j in 1..k {
-                let u = ((j - 1) as f64 + uniform(rng)) / (k - 1) as f64;
-                let u = u.min(spectrace_sampling::ONE_MINUS_EPSILON);
+                let u = shifted(u_lambda, j as f64 / k as f64);
                 let (lambda, scale) = own.map_or((beam.lambda, 0.0), |l| l.sample_wavelength(u));
                 b.lambdas[j] = lambda;
                 b.weights[j] = scale / k as f64;
@@ -270,8 +282,9 @@ impl BeamTracer<'_, '_> {
     ) {
         let scene = self.scene;
         let light: &dyn LightSource = scene.lights;
-        let beam = light.next_beam(rng);
-        let mut b = self.bundle(&beam, rng);
+        let u_lambda = uniform(rng);
+        let beam = light.next_beam_at(u_lambda, rng);
+        let mut b = self.bundle(&beam, u_lambda);
         let u_lens = self.layout.lens(rng);
         if !scene.is_sensors_only()
             && let Some((seen, value)) =
