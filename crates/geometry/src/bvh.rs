@@ -286,13 +286,8 @@ impl Bvh {
                     node = child as usize;
                     continue;
                 }
-                match on_leaf(child & !LEAF, t_max) {
-                    Some(t) if t < 0.0 => return,
-                    Some(t) => {
-                        t_max = t;
-                        slab.set_limit(t);
-                    }
-                    None => {}
+                if lowered(on_leaf(child & !LEAF, t_max), &mut t_max, slab) {
+                    return;
                 }
             }
             loop {
@@ -304,16 +299,26 @@ impl Bvh {
                     node = child as usize;
                     break;
                 }
-                match on_leaf(child & !LEAF, t_max) {
-                    Some(t) if t < 0.0 => return,
-                    Some(t) => {
-                        t_max = t;
-                        slab.set_limit(t);
-                    }
-                    None => {}
+                if lowered(on_leaf(child & !LEAF, t_max), &mut t_max, slab) {
+                    return;
                 }
             }
         }
+    }
+}
+
+/// Applies what a leaf's test returned (see [`Bvh::traverse`]): a closer hit lowers `t_max` and
+/// the box test's limit; `true` when the walk must stop.
+#[inline(always)]
+fn lowered<S: Slab>(found: Option<f64>, t_max: &mut f64, slab: &mut S) -> bool {
+    match found {
+        Some(t) if t < 0.0 => true,
+        Some(t) => {
+            *t_max = t;
+            slab.set_limit(t);
+            false
+        }
+        None => false,
     }
 }
 
