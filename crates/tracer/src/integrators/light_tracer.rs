@@ -282,8 +282,14 @@ impl BeamTracer<'_, '_> {
     ) {
         let scene = self.scene;
         let light: &dyn LightSource = scene.lights;
-        let u_lambda = uniform(rng);
-        let beam = light.next_beam_at(u_lambda, rng);
+        // A bundle of one (dispersion, fluorescence, lights whose colour varies) needs no
+        // uniform of its own: the beam draws its wavelength as it always has.
+        let (beam, u_lambda) = if self.bundle > 1 {
+            let u = uniform(rng);
+            (light.next_beam_at(u, rng), u)
+        } else {
+            (light.next_beam(rng), 0.0)
+        };
         let mut b = self.bundle(&beam, u_lambda);
         let u_lens = self.layout.lens(rng);
         if !scene.is_sensors_only()
