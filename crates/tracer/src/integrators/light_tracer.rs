@@ -217,7 +217,8 @@ struct Bundle {
 
 impl BeamTracer<'_, '_> {
     /// The bundle of `beam`, whose wavelength its light drew from `u_lambda`
-    /// ([`LightSource::next_beam_at`]): that wavelength and weight, plus `bundle - 1` companions
+    /// ([`LightSource::next_beam_at`]; unused for a bundle of one, whose beam comes from
+    /// `next_beam`): that wavelength and weight, plus `bundle - 1` companions
     /// drawn by the light ([`LightSource::sample_wavelength`]) from `u_lambda + j / bundle` (mod
     /// 1), with the weight of that density. The bundle's wavelengths are thus stratified
     /// together, one in each `1 / bundle` of the light's wavelength density (Mitsuba's shifted
