@@ -75,12 +75,8 @@ impl CameraWavelengths {
     /// The [`HERO`] stratified wavelengths of one path from one uniform, with the weight
     /// `1 / (HERO p(lambda_j))` of each in the path's estimate.
     pub fn sample_hero(self, u: f64) -> ([f64; HERO], [f64; HERO]) {
-        let u = spectrace_sampling::clamp_uniform(u);
-        // `(u + j / HERO) mod 1`, exactly (`x - 1` is exact for `x` in `[1, 2)`).
-        let uj: [f64; HERO] = std::array::from_fn(|j| {
-            let shifted = u + j as f64 / HERO as f64;
-            if shifted >= 1.0 { shifted - 1.0 } else { shifted }
-        });
+        let uj: [f64; HERO] =
+            std::array::from_fn(|j| spectrace_sampling::shifted_uniform(u, j, HERO));
         let (lambdas, p) = match self {
             Self::Visible => {
                 // The density from the `tanh` the sample came from: `1 / cosh^2 = 1 - tanh^2`

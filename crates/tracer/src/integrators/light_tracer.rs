@@ -189,13 +189,6 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
     stats
 }
 
-/// `u + shift` (both in `[0, 1)`) wrapped into `[0, 1)`.
-fn shifted(u: f64, shift: f64) -> f64 {
-    let v = u + shift;
-    let v = if v >= 1.0 { v - 1.0 } else { v };
-    v.clamp(0.0, spectrace_sampling::ONE_MINUS_EPSILON)
-}
-
 /// What one beam's trace needs, fixed for the chunk.
 struct BeamTracer<'s, 'a> {
     scene: &'s LightTracerScene<'a>,
@@ -237,7 +230,7 @@ impl BeamTracer<'_, '_> {
         if k > 1 {
             let own = self.scene.lights.light(beam.parent);
             for j in 1..k {
-                let u = shifted(u_lambda, j as f64 / k as f64);
+                let u = spectrace_sampling::shifted_uniform(u_lambda, j, k);
                 let (lambda, scale) = own.map_or((beam.lambda, 0.0), |l| l.sample_wavelength(u));
                 b.lambdas[j] = lambda;
                 b.weights[j] = scale / k as f64;
