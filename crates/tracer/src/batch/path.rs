@@ -8,20 +8,40 @@ use crate::integrators::pass::{PassEstimator, pass_items_until, pixel_of};
 use crate::integrators::path_tracer::{CameraPath, Connection, PathTracer, Shading, Vertex};
 use crate::{ChunkSampler, ChunkWork, Splat, TraceStats};
 
-/// The paths in flight, as a structure of arrays: one entry per lane in each.
+/// The paths in flight, as a structure of arrays: one entry per lane in each. A lane keeps its
+/// slot from its first ray to its splat and a new path is written into a free slot in place, so
+/// no path is moved while it is traced.
 struct Lanes<'a> {
     /// The paths (pixel, wavelengths, throughput, radiance, next ray).
     paths: Vec<CameraPath>,
     /// Each path's own sampler.
     rngs: Vec<ChunkSampler>,
+    /// Which slots hold a path in flight (bit `i`: slot `i`).
+    live: u32,
     /// What each lane's ray hit this round.
-    hits: Vec<Option<Hit>>,
+    hits: [Option<Hit>; LANES],
     /// The vertex each lane reached this round (`None`: the path ends).
-    vertices: Vec<Option<Vertex<'a>>>,
+    vertices: [Option<Vertex<'a>>; LANES],
     /// The lanes in shading order: by the primitive hit (`u32::MAX`: nothing).
     order: Vec<(u32, usize)>,
     /// Next-event estimation's queued samples: the lane and the connection.
     queue: Vec<(usize, Connection)>,
+}
+
+/// Every slot's bit (the live mask is a `u32`).
+const ALL_SLOTS: u32 = u32::MAX >> (32 - LANES);
+const _: () = assert!(LANES >= 1 && LANES <= 32);
+
+/// The slots set in `mask`, lowest first.
+fn slots(mask: u32) -> impl Iterator<Item = usize> {
+    let mut rest = mask;
+    std::iter::from_fn(move || {
+        (rest != 0).then(|| {
+            let i = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            i
+        })
+    })
 }
 
 /// Renders the camera samples of pass `work.chunk` (`work.items` pixels, or a prefix of them
@@ -37,14 +57,15 @@ pub(crate) fn render_pass<'a>(
     let mut lanes = Lanes::<'a> {
         paths: Vec::with_capacity(LANES),
         rngs: Vec::with_capacity(LANES),
-        hits: Vec::with_capacity(LANES),
-        vertices: Vec::with_capacity(LANES),
+        live: 0,
+        hits: std::array::from_fn(|_| None),
+        vertices: std::array::from_fn(|_| None),
         order: Vec::with_capacity(LANES),
         queue: Vec::with_capacity(2 * LANES),
     };
     loop {
         lanes.generate(tracer, work, &mut items, &mut stats);
-        if lanes.paths.is_empty() {
+        if lanes.live == 0 {
             return stats;
         }
         lanes.intersect(tracer);
@@ -55,7 +76,7 @@ pub(crate) fn render_pass<'a>(
 }
 
 impl<'a> Lanes<'a> {
-    /// Stage 1: free lanes take the next items.
+    /// Stage 1: free slots take the next items, their paths written in place.
     fn generate(
         &mut self,
         tracer: &PathTracer<'a>,
@@ -65,12 +86,20 @@ impl<'a> Lanes<'a> {
     ) {
         let kind = tracer.scene().sampler();
         let width = u64::from(tracer.scene().camera.width());
-        while self.paths.len() < LANES {
+        for i in slots(!self.live & ALL_SLOTS) {
             let Some(item) = items.next() else { break };
             let (px, py) = pixel_of(item, width);
-            let mut rng = ChunkSampler::for_path(kind, work.seed, work.chunk, item);
-            self.paths.push(tracer.start(px, py, &mut rng));
-            self.rngs.push(rng);
+            let rng = ChunkSampler::for_path(kind, work.seed, work.chunk, item);
+            if i < self.paths.len() {
+                self.rngs[i] = rng;
+                tracer.restart(&mut self.paths[i], px, py, &mut self.rngs[i]);
+            } else {
+                // Slots are taken lowest first, so a new slot is the next one.
+                self.rngs.push(rng);
+                let path = tracer.start(px, py, &mut self.rngs[i]);
+                self.paths.push(path);
+            }
+            self.live |= 1 << i;
             stats.beams += 1;
         }
     }
@@ -78,24 +107,21 @@ impl<'a> Lanes<'a> {
     /// Stage 2: every lane's closest hit.
     fn intersect(&mut self, tracer: &PathTracer<'a>) {
         let world = tracer.scene().world;
-        self.hits.clear();
-        self.hits.extend(self.paths.iter().map(|p| world.intersect(&p.state.ray, f64::INFINITY)));
+        for i in slots(self.live) {
+            self.hits[i] = world.intersect(&self.paths[i].state.ray, f64::INFINITY);
+        }
     }
 
     /// Stage 3: the lanes in material order; each one's arrival and its light samples, queued.
     fn shade(&mut self, tracer: &PathTracer<'a>, stats: &mut TraceStats) {
         self.order.clear();
         self.order.extend(
-            self.hits
-                .iter()
-                .enumerate()
-                .map(|(i, h)| (h.as_ref().map_or(u32::MAX, |h| h.primitive), i)),
+            slots(self.live).map(|i| (self.hits[i].as_ref().map_or(u32::MAX, |h| h.primitive), i)),
         );
         self.order.sort_unstable();
-        self.vertices.clear();
-        self.vertices.resize(self.paths.len(), None);
         self.queue.clear();
         for &(_, i) in &self.order {
+            self.vertices[i] = None;
             let Some(hit) = &self.hits[i] else { continue };
             let path = &mut self.paths[i];
             let vertex = tracer.arrive(
@@ -129,7 +155,7 @@ impl<'a> Lanes<'a> {
         }
     }
 
-    /// Stages 6 and 7: each lane's next direction, or its sample on the film and its lane
+    /// Stages 6 and 7: each lane's next direction, or its sample on the film and its slot
     /// freed.
     fn go_on_or_splat(
         &mut self,
@@ -137,7 +163,7 @@ impl<'a> Lanes<'a> {
         film: &mut dyn Splat,
         stats: &mut TraceStats,
     ) {
-        for i in (0..self.paths.len()).rev() {
+        for i in slots(self.live) {
             let alive = match (&self.hits[i], self.vertices[i].take()) {
                 (Some(hit), Some(vertex)) => {
                     tracer.go_on(&mut self.paths[i].state, hit, vertex, &mut self.rngs[i], stats)
@@ -146,8 +172,7 @@ impl<'a> Lanes<'a> {
             };
             if !alive {
                 tracer.finish(&self.paths[i], film);
-                self.paths.swap_remove(i);
-                self.rngs.swap_remove(i);
+                self.live &= !(1 << i);
             }
         }
     }

@@ -193,6 +193,23 @@ pub(crate) struct PathState {
 }
 
 impl PathState {
+    /// The state of a path starting along `ray` at `lambdas`, written over `self` in place.
+    #[inline]
+    fn reset(&mut self, ray: Ray, lambdas: &[f64; HERO]) {
+        self.ray = ray;
+        self.beta = [1.0; HERO];
+        self.radiance = [0.0; HERO];
+        self.transport = *lambdas;
+        self.prev_point = ray.origin;
+        self.prev_normal = DVec3::ZERO;
+        self.prev_pdf = 0.0;
+        self.specular = true;
+        self.depth = 0;
+        self.last_bounce = false;
+        self.collapsed = false;
+        self.spd_cache = None;
+    }
+
     fn new(ray: Ray, lambdas: &[f64; HERO]) -> Self {
         Self {
             ray,
@@ -306,6 +323,18 @@ impl<'a> PathTracer<'a> {
         let ray = Ray { origin: camera_ray.origin, direction: camera_ray.direction };
         let (lambdas, lambda_weights) = self.settings.wavelengths.sample_hero(u.wavelength);
         CameraPath { px, py, lambdas, lambda_weights, state: PathState::new(ray, &lambdas) }
+    }
+
+    /// [`PathTracer::start`] written into `path` in place (the batched kernel's slots: a path
+    /// built elsewhere and copied in costs a copy of its whole state).
+    #[inline]
+    pub(crate) fn restart(&self, path: &mut CameraPath, px: u32, py: u32, rng: &mut ChunkSampler) {
+        let u = CameraSamples::draw(&self.layout, rng);
+        let camera_ray = self.scene.camera.generate_ray(px, py, u.film, u.lens);
+        let ray = Ray { origin: camera_ray.origin, direction: camera_ray.direction };
+        let (lambdas, lambda_weights) = self.settings.wavelengths.sample_hero(u.wavelength);
+        (path.px, path.py, path.lambdas, path.lambda_weights) = (px, py, lambdas, lambda_weights);
+        path.state.reset(ray, &lambdas);
     }
 
     /// Adds a finished camera sample to the film.
