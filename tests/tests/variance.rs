@@ -344,24 +344,37 @@ fn sobol_renders_are_bit_identical_across_threads_and_merge_shards_exactly() {
 }
 
 #[test]
-fn the_default_sampler_is_sobol_for_camera_estimators_unless_a_target_stops_the_render() {
+fn the_default_sampler_is_sobol_where_it_pays_and_the_estimate_stays_the_error() {
     // `settings.sampler` unset is "auto": the sidecar names the sampler used. Sobol for the
-    // path tracer and BDPT at a fixed effort; independent for the light tracer, and for a
+    // path tracer and BDPT at a fixed effort, and for the light tracer where its beams stop after
+    // a diffuse hit (one diffuse plane), with a target error too (its chunks are independently
+    // scrambled sequences: `estimate.rs` tests that its estimate is the error); independent for
+    // the light tracer where beams go on bouncing (a second plane facing the first), and for a
     // camera estimator rendering to a target error (its estimate must be the error itself).
     let dir = std::env::temp_dir().join(format!("spectrace-auto-sampler-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let s = scene(POINT_OVER_PLANE);
+    let plane = scene(POINT_OVER_PLANE);
+    let two_planes = scene(&POINT_OVER_PLANE.replace(
+        r#"}],
+  "lights""#,
+        r#"},
+              {"shape": {"type": "Rectangle", "corner": [-3, 0, -3], "edge_u": [6, 0, 0], "edge_v": [0, 3, 0]},
+               "material": {"type": "Diffuse", "reflectance": 0.5}}],
+  "lights""#,
+    ));
     let cases = [
-        (IntegratorChoice::Path, None, "sobol"),
-        (IntegratorChoice::Bdpt, None, "sobol"),
-        (IntegratorChoice::Light, None, "independent"),
-        (IntegratorChoice::Path, Some(0.5), "independent"),
+        (&plane, IntegratorChoice::Path, None, "sobol"),
+        (&plane, IntegratorChoice::Bdpt, None, "sobol"),
+        (&plane, IntegratorChoice::Light, None, "sobol"),
+        (&two_planes, IntegratorChoice::Light, None, "independent"),
+        (&plane, IntegratorChoice::Light, Some(0.5), "sobol"),
+        (&plane, IntegratorChoice::Path, Some(0.5), "independent"),
     ];
-    for (k, (integrator, target_error, expected)) in cases.into_iter().enumerate() {
+    for (k, (s, integrator, target_error, expected)) in cases.into_iter().enumerate() {
         let camera = integrator != IntegratorChoice::Light;
         let options = RenderOptions {
             spp: (camera && target_error.is_none()).then_some(2),
-            beams: (!camera).then_some(20_000),
+            beams: (!camera && target_error.is_none()).then_some(20_000),
             target_error,
             time: target_error.map(|_| 30.0),
             integrator: Some(integrator),
@@ -370,8 +383,8 @@ fn the_default_sampler_is_sobol_for_camera_estimators_unless_a_target_stops_the_
             verbose: false,
             ..RenderOptions::default()
         };
-        let report = render_scene(&s, &options).unwrap();
-        assert_eq!(report.sampler, expected, "{integrator:?}, target {target_error:?}");
+        let report = render_scene(s, &options).unwrap();
+        assert_eq!(report.sampler, expected, "case {k}: {integrator:?}, target {target_error:?}");
         let sidecar = std::fs::read_dir(dir.join(k.to_string()))
             .unwrap()
             .map(|e| e.unwrap().path())

@@ -103,7 +103,8 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<RenderRepo
     }
     let error_decides = plan.target_error.is_some();
     if options.verbose {
-        tell!("sampler: {}", sampler_text(scene.settings.sampler, choice, error_decides));
+        let text = sampler_text(scene.settings.sampler, choice, error_decides, &effects);
+        tell!("sampler: {text}");
         if choice == IntegratorChoice::Bdpt {
             let text = bdpt_wavelengths_text(scene.settings.bdpt_wavelengths, &effects.features);
             tell!("wavelengths: {text}");
@@ -290,8 +291,9 @@ impl Finished<'_> {
         r.integrator_reason = setup.reason.to_owned();
         r.lights = LightReport::all(scene.lights.lights());
         let error_decides = setup.plan.target_error.is_some();
-        r.sampler =
-            sampler_of(scene.settings.sampler, setup.choice, error_decides).name().to_owned();
+        r.sampler = sampler_of(scene.settings.sampler, setup.choice, error_decides, &setup.effects)
+            .name()
+            .to_owned();
         r.kernel = kernel_of(setup.choice, setup.kernel).name().to_owned();
         r.light_sampler = light_sampler_of(scene).name().to_owned();
         r.bdpt_wavelengths = (setup.choice == IntegratorChoice::Bdpt).then(|| {

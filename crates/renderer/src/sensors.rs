@@ -16,10 +16,11 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 use spectrace_lights::LightSource;
 use spectrace_tracer::{
-    Effects, Film, Integrator, LightTracer, PathTracer, RenderOutput, RenderPlan, SensorPathTracer,
-    SensorSet, SensorSums, render as render_plan,
+    Effects, Film, Integrator, IntegratorChoice, LightTracer, LightTracerScene, PathTracer,
+    RenderOutput, RenderPlan, SensorPathTracer, SensorSet, SensorSums, render as render_plan,
 };
 
+use crate::integrators::sampler_of;
 use crate::sensor_output::{SensorGrid, write_sensor_files};
 use crate::{DEFAULT_SENSOR_SPP, RenderError, Scene, SensorIntegrator, tracer_scene};
 
@@ -102,6 +103,15 @@ pub fn check_sensor_names(scene: &Scene, image_name: &str) -> Result<(), RenderE
     Ok(())
 }
 
+/// The scene of a light-tracer sensor pass: connected to no camera, drawing from the sampler the
+/// light tracer's image would (`sampler_of`, no target error: Sobol points where beams stop
+/// after a diffuse hit), so that a sensor pass and a light-tracer image of as many beams fill
+/// a sensor alike.
+fn sensor_tracer_scene<'s>(scene: &'s Scene, effects: &Effects) -> LightTracerScene<'s> {
+    let sampler = sampler_of(scene.settings.sampler, IntegratorChoice::Light, false, effects);
+    tracer_scene(scene).sensors_only().with_sampler(sampler)
+}
+
 /// Runs a sensor pass: the light tracer, connected to no camera, filling `scene`'s sensors with
 /// `plan`'s beams. Returns the film (its sensor cells) and the seconds it took.
 ///
@@ -113,7 +123,7 @@ pub fn sensor_pass(
     effects: Effects,
 ) -> Result<(Film, u64, f64), RenderError> {
     let started = Instant::now();
-    let traced = tracer_scene(scene).sensors_only();
+    let traced = sensor_tracer_scene(scene, &effects);
     let tracer = LightTracer::new(&traced, scene.tracer_settings(), effects);
     let plan = RenderPlan { error_estimate: false, target_error: None, ..*plan };
     let output =
@@ -213,7 +223,7 @@ pub(crate) fn fixed_sensor_pass(
     let (plan, mut output, items_per_sample, filled_by) =
         if sensor_integrator(scene) == SensorIntegrator::Light {
             let plan = sensor_plan(scene, threads);
-            let traced = tracer_scene(scene).sensors_only();
+            let traced = sensor_tracer_scene(scene, &effects);
             let tracer = LightTracer::new(&traced, scene.tracer_settings(), effects);
             let output = render_plan(&tracer, &RenderPlan { shard, ..plan }, &|_| {})
                 .map_err(|e| RenderError::Options(e.to_string()))?;

@@ -207,7 +207,9 @@ fn write_merged(
     report.beams_per_second =
         if total_seconds > 0.0 { merged.beams as f64 / total_seconds } else { 0.0 };
     let error_decides = first.plan.target_error.is_some();
-    report.sampler = sampler_of(first.sampler, first.integrator, error_decides).name().to_owned();
+    report.sampler = sampler_of(first.sampler, first.integrator, error_decides, &first.effects)
+        .name()
+        .to_owned();
     let (sensors, observers) = receivers.finish(out_dir, merged, first.light_power, parts)?;
     for r in &sensors {
         report.outputs.extend(r.files.iter().cloned());

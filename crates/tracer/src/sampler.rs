@@ -98,7 +98,8 @@ impl SamplerKind {
     /// measurable, and never raise it beyond the sweep's noise. The light tracer's chunks
     /// spread a sequence over the whole image (no pixel sees more than a few of its points):
     /// its time to 10% there was mixed (0.49x to 3x across the shipped scenes), so it stays
-    /// independent.
+    /// independent here; the renderer passes `true` for it where its beams stop after a
+    /// diffuse hit, where Sobol points pay (`spectrace_renderer`'s `sampler_of`).
     pub fn resolve(self, camera_passes: bool) -> SamplerKind {
         match self {
             Self::Auto if camera_passes => Self::Sobol,

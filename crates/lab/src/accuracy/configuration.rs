@@ -173,18 +173,18 @@ impl Configuration {
     }
 
     /// The sampler the configuration sets (`settings.sampler`; `None`: as written, which
-    /// `auto` resolves per estimator): Sobol for the `*sobol` configurations, independent
-    /// sampling for `path`, `bdpt` and their peers `bdpt_beam` and `path_uniform_wavelengths`.
+    /// `auto` resolves per estimator): Sobol for the `*sobol` configurations, `auto` as written,
+    /// and independent sampling for every other one (`baseline` and the light tracer's knobs,
+    /// whose peer it is, `path`, `bdpt` and their peers `bdpt_beam` and
+    /// `path_uniform_wavelengths`), so that each knob is measured against its peer alone
+    /// whatever `auto` would draw for the scene.
     pub fn sampler(self) -> Option<SamplerKind> {
         match self {
             Configuration::Sobol | Configuration::PathSobol | Configuration::BdptSobol => {
                 Some(SamplerKind::Sobol)
             }
-            Configuration::Path
-            | Configuration::Bdpt
-            | Configuration::BdptBeam
-            | Configuration::PathUniformWavelengths => Some(SamplerKind::Independent),
-            _ => None,
+            Configuration::Auto => None,
+            _ => Some(SamplerKind::Independent),
         }
     }
 

@@ -62,9 +62,11 @@ fn the_knobs_are_set_on_the_typed_scene() {
     assert_eq!(Configuration::from_name("path_sobol"), Some(Configuration::PathSobol));
     assert_eq!(Configuration::BdptSobol.integrator(), IntegratorChoice::Bdpt);
     assert_eq!(Configuration::from_name("bdpt_sobol"), Some(Configuration::BdptSobol));
-    // `path` and `bdpt`, their peers, sample independently whatever the scene says; the
-    // other knobs leave the scene's sampler (`auto` by default) as written.
+    // `baseline`, `path` and `bdpt`, the Sobol knobs' peers, sample independently whatever the
+    // scene says (`auto` draws Sobol points for a light tracer whose beams stop after a diffuse
+    // hit); `auto` leaves the scene's sampler as written.
     for (c, written, expected) in [
+        (Configuration::Baseline, SamplerKind::Auto, SamplerKind::Independent),
         (Configuration::Path, SamplerKind::Sobol, SamplerKind::Independent),
         (Configuration::Bdpt, SamplerKind::Sobol, SamplerKind::Independent),
         (Configuration::Auto, SamplerKind::Auto, SamplerKind::Auto),
