@@ -115,7 +115,8 @@ impl Configuration {
         match self {
             Configuration::Baseline => {
                 "the light tracer on the scene as written: wavelengths by importance, SPDs as \
-                 given, effects analysis auto (the `light` of the integrator tables)"
+                 given, effects analysis auto, independent sampling, as every light-tracer knob \
+                 but `sobol` (the `light` of the integrator tables)"
             }
             Configuration::EqualWavelengths => {
                 "every light draws wavelengths uniformly over its SPD's range, weighted by the SPD \

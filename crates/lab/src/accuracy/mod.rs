@@ -8,7 +8,7 @@
 //!
 //! | configuration | what changes |
 //! |---|---|
-//! | `baseline` | nothing: the light tracer on the scene as written, effects analysis `auto` |
+//! | `baseline` | nothing: the light tracer on the scene as written, effects analysis `auto`, independent sampling |
 //! | `equal_wavelengths` | every light draws its wavelengths uniformly with weights (`"wavelength_sampling": "equal_wavelengths"`) instead of by importance |
 //! | `piecewise_constant_spd` | every `Tabulated` SPD of the lights (and every tabulated `CieIlluminant`) becomes the seed's "choppy" `Binned` SPD: bins centred on the table's nodes, the same values |
 //! | `effects_off` | the effects analysis off (one wavelength per path, beams continue after diffuse hits) |
