@@ -37,8 +37,7 @@ impl GridLocator {
         if n == 0 || !(x >= xs[0]) {
             return 0;
         }
-        // `as usize` saturates (and maps NaN to 0), so any guess is an index after the `min`.
-        let mut i = (((x - self.origin) * self.inv_step) as usize).min(n - 1);
+        let mut i = cell_index((x - self.origin) * self.inv_step, n - 1);
         for _ in 0..Self::STEPS {
             if xs[i] > x {
                 i -= 1; // xs[0] <= x, so i > 0 here
@@ -53,6 +52,23 @@ impl GridLocator {
         } else {
             xs.partition_point(|&v| v <= x) - 1
         }
+    }
+}
+
+/// `floor(x)` as an index in `0..=last`: `x` below 0 and NaN give 0, `x` at or above `last`
+/// gives `last`. Equal to `(x as usize).min(last)`, in about a third of its instructions: a
+/// saturating `as usize` must handle values from `2^63` on, a conversion through `u32` only a
+/// clamp (taken for every `last` below `2^32`, the plain conversion beyond).
+#[inline]
+pub fn cell_index(x: f64, last: usize) -> usize {
+    if last > u32::MAX as usize {
+        (x as usize).min(last)
+    } else if x < last as f64 {
+        x as u32 as usize
+    } else if x >= 0.0 {
+        last
+    } else {
+        0
     }
 }
 
@@ -74,6 +90,17 @@ mod tests {
         }
         let one = [3.0];
         assert_eq!(GridLocator::new(&one).last_at_or_below(&one, 5.0), 0);
+    }
+
+    #[test]
+    fn cell_index_is_the_saturating_conversion_clamped() {
+        let xs = [-1e300, -2.0, -0.5, -0.0, 0.0, 0.3, 1.0, 6.999, 7.0, 7.5, 1e10, 4.3e9, 1e300];
+        let specials = [f64::NAN, f64::INFINITY, f64::NEG_INFINITY];
+        for last in [0usize, 1, 7, u32::MAX as usize - 1, u32::MAX as usize, 1 << 40] {
+            for &x in xs.iter().chain(&specials) {
+                assert_eq!(cell_index(x, last), (x as usize).min(last), "{x} {last}");
+            }
+        }
     }
 
     proptest! {

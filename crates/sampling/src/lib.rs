@@ -64,7 +64,7 @@ pub use alias::AliasTable;
 pub use discrete::Discrete;
 pub use error::SamplingError;
 pub use frame::Frame;
-pub use grid::GridLocator;
+pub use grid::{GridLocator, cell_index};
 pub use piecewise_bilinear::PiecewiseBilinear;
 pub use piecewise_constant::PiecewiseConstant;
 pub use piecewise_linear::{PiecewiseLinear, linear_segment_inverse};

@@ -287,7 +287,7 @@ impl Cdf {
             return (self.search(target), target);
         }
         let m = self.guide.len() - 1;
-        let k = ((u * m as f64) as usize).min(m - 1);
+        let k = crate::cell_index(u * m as f64, m - 1);
         let (lo, hi) = (self.guide[k] as usize, self.guide[k + 1] as usize);
         // The answer lies in lo..=hi when edges[lo] <= target < edges[hi + 1]; otherwise (rounding
         // at a cutpoint, or target at the very top) fall back to the full search.

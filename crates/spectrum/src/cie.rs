@@ -73,7 +73,7 @@ pub fn cmf(lambda: f64) -> Xyz {
         return Xyz::default();
     }
     let p = lambda - CMF_START_NM;
-    let i = (p as usize).min(CMF_LEN - 2);
+    let i = spectrace_sampling::cell_index(p, CMF_LEN - 2);
     let t = p - i as f64;
     let (a, b) = (CIE_1931_2DEG[i], CIE_1931_2DEG[i + 1]);
     Xyz::new(a[0] * (1.0 - t) + b[0] * t, a[1] * (1.0 - t) + b[1] * t, a[2] * (1.0 - t) + b[2] * t)

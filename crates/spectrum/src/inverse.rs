@@ -271,7 +271,7 @@ impl InverseCdf {
     pub(crate) fn sample(&self, ln_f: &dyn Fn(f64) -> f64, u: f64) -> f64 {
         let u = spectrace_sampling::clamp_uniform(u);
         let m = self.guide.len() - 1;
-        let k = ((u * m as f64) as usize).min(m - 1);
+        let k = spectrace_sampling::cell_index(u * m as f64, m - 1);
         let (lo, hi) = (self.guide[k] as usize, self.guide[k + 1] as usize);
         let i = if lo == hi { lo } else { lo + self.us[lo + 1..=hi].partition_point(|&v| v <= u) };
         let (p, x1) = (&self.panels[i], self.panels[i + 1].x0);

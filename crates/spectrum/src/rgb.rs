@@ -51,7 +51,7 @@ pub fn d65_visible(lambda: f64) -> f64 {
         })
     };
     let p = (lambda - VISIBLE_MIN_NM) / D65_STEP_NM;
-    let i = (p as usize).min(93);
+    let i = spectrace_sampling::cell_index(p, 93);
     let t = p - i as f64;
     entry(i) * (1.0 - t) + entry(i + 1) * t
 }

@@ -118,7 +118,7 @@ impl RgbTable {
         let n = Self::RESOLUTION;
         let cell = |v: f64| {
             let p = v * (n - 1) as f64;
-            let k = (p as usize).min(n - 2);
+            let k = spectrace_sampling::cell_index(p, n - 2);
             (k, p - k as f64)
         };
         let (x0, fx) = cell(rgb[(i + 1) % 3] / z);

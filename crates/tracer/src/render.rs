@@ -460,7 +460,8 @@ pub fn render_observed(
         .time_budget
         .and_then(|s| Duration::try_from_secs_f64(s.max(0.0)).ok())
         .and_then(|d| started.checked_add(d));
-    // The live estimate after every chunk, at a cost of a few pixels per item.
+    // The live estimate after every chunk, redone at most an eighth of a pixel per item and
+    // ever more rarely (see `LiveEstimate`).
     let live = Mutex::new(LiveEstimate::new(
         plan.error_measure,
         u64::from(w) * u64::from(h),

@@ -84,16 +84,16 @@ fn estimate_matches_the_spread_of_independent_renders() {
 }
 
 #[test]
-fn the_live_estimate_is_redone_every_few_chunks_or_when_a_target_may_be_reached() {
+fn the_live_estimate_is_redone_as_the_chunks_grow_or_when_a_target_may_be_reached() {
     let mut rng = rand_pcg::Pcg64::seed_from_u64(3);
     let mut m = Moments::new(4, 1).unwrap();
     let mut chunk = |m: &mut Moments| {
         let v: f64 = rng.random_range(0.5..1.5);
         m.add_chunk(m.chunks(), (0..4).map(|p| (p, [v, v * (1.0 + p as f64), v])), 4);
     };
-    // 4 pixels in chunks of 4 items: redone every 4 chunks.
+    // A 2-pixel film in chunks of 4 items: redone every 8 x 2 / 4 = 4 chunks at first.
     for measure in [ErrorMeasure::RelMse, ErrorMeasure::Energy] {
-        let mut live = LiveEstimate::new(measure, 4, 4);
+        let mut live = LiveEstimate::new(measure, 2, 4);
         let mut fresh = Vec::new();
         let mut m = Moments::new(4, 1).unwrap();
         for _ in 0..10 {
@@ -108,8 +108,20 @@ fn the_live_estimate_is_redone_every_few_chunks_or_when_a_target_may_be_reached(
         let (e, _) = live.update(&m, None);
         assert!(e.batches <= m.chunks());
     }
+    // Later, once a quarter of the chunks is more than 4, after a quarter more: the chunks of
+    // the fresh estimates of 100 grow by max(4, last / 4).
+    let mut live = LiveEstimate::new(ErrorMeasure::RelMse, 2, 4);
+    let mut m = Moments::new(4, 1).unwrap();
+    let mut fresh_at = Vec::new();
+    for _ in 0..100 {
+        chunk(&mut m);
+        if live.update(&m, None).1 {
+            fresh_at.push(m.chunks());
+        }
+    }
+    assert_eq!(fresh_at, [1, 5, 9, 13, 17, 21, 26, 32, 40, 50, 62, 77, 96]);
     // With a target the energy estimate has reached, every chunk is checked at once.
-    let mut live = LiveEstimate::new(ErrorMeasure::Energy, 4, 4);
+    let mut live = LiveEstimate::new(ErrorMeasure::Energy, 2, 4);
     for _ in 0..3 {
         chunk(&mut m);
     }
