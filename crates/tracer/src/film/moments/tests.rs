@@ -111,12 +111,12 @@ fn the_live_estimate_is_redone_as_the_chunks_grow_or_when_a_target_may_be_reache
     // Later, once a quarter of the chunks is more than 4, after a quarter more: the chunks of
     // the fresh estimates of 100 grow by max(4, last / 4).
     let mut live = LiveEstimate::new(ErrorMeasure::RelMse, 2, 4);
-    let mut m = Moments::new(4, 1).unwrap();
+    let mut grown = Moments::new(4, 1).unwrap();
     let mut fresh_at = Vec::new();
     for _ in 0..100 {
-        chunk(&mut m);
-        if live.update(&m, None).1 {
-            fresh_at.push(m.chunks());
+        chunk(&mut grown);
+        if live.update(&grown, None).1 {
+            fresh_at.push(grown.chunks());
         }
     }
     assert_eq!(fresh_at, [1, 5, 9, 13, 17, 21, 26, 32, 40, 50, 62, 77, 96]);
