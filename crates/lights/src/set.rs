@@ -161,19 +161,12 @@ impl LightSet {
     pub fn probability(&self, id: LightId) -> f64 {
         self.choice.pmf(id.0 as usize)
     }
-
-    /// The light of the next beam, by power: one uniform from `rng`, none for a set of one
-    /// light (its only light, with probability 1), so that a lone light's beams draw what the
-    /// light itself would and low-discrepancy points are not spent on a choice already made.
-    fn choose(&self, rng: &mut dyn Rng) -> usize {
-        if self.lights.len() == 1 { 0 } else { self.choice.sample(uniform(rng)) }
-    }
 }
 
 #[typetag::serde]
 impl LightSource for LightSet {
     fn next_beam(&self, rng: &mut dyn Rng) -> Beam {
-        let i = self.choose(rng);
+        let i = self.choice.sample(uniform(rng));
         let mut beam = self.lights[i].next_beam(rng);
         beam.parent = LightId(i as u32);
         self.counter.increment();
@@ -181,7 +174,7 @@ impl LightSource for LightSet {
     }
     /// The light chosen from `rng` as in `next_beam`, its beam's wavelength from `u_lambda`.
     fn next_beam_at(&self, u_lambda: f64, rng: &mut dyn Rng) -> Beam {
-        let i = self.choose(rng);
+        let i = self.choice.sample(uniform(rng));
         let mut beam = self.lights[i].next_beam_at(u_lambda, rng);
         beam.parent = LightId(i as u32);
         self.counter.increment();

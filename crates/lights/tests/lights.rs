@@ -901,38 +901,6 @@ fn nested_light_sets_are_flattened() {
 }
 
 #[test]
-fn a_set_of_one_light_draws_no_uniform_for_its_choice() {
-    let spot = || {
-        UniformSpotLight::new(
-            v(0.0, 2.0, 0.0),
-            v(0.2, -1.0, 0.1),
-            30.0,
-            5.0,
-            d65(),
-            WavelengthSampling::Importance,
-        )
-        .unwrap()
-    };
-    let set = LightSet::new(vec![Box::new(spot())]).unwrap();
-    let alone = spot();
-    let (mut a, mut b) = (Pcg64::seed_from_u64(9), Pcg64::seed_from_u64(9));
-    for _ in 0..100 {
-        let (from_set, own) = (set.next_beam_at(0.3, &mut a), alone.next_beam_at(0.3, &mut b));
-        assert_eq!((from_set.origin, from_set.direction), (own.origin, own.direction));
-        assert_eq!(
-            (from_set.lambda, from_set.scale, from_set.parent.0),
-            (own.lambda, own.scale, 0)
-        );
-        let (from_set, own) = (set.next_beam(&mut a), alone.next_beam(&mut b));
-        assert_eq!((from_set.direction, from_set.lambda), (own.direction, own.lambda));
-    }
-    // Two lights: the choice takes a uniform, so the streams part.
-    let two = LightSet::new(vec![Box::new(spot()), Box::new(spot())]).unwrap();
-    let (mut a, mut b) = (Pcg64::seed_from_u64(9), Pcg64::seed_from_u64(9));
-    assert_ne!(two.next_beam_at(0.3, &mut a).direction, alone.next_beam_at(0.3, &mut b).direction);
-}
-
-#[test]
 fn the_experiment_hooks_retune_lights_in_place_and_keep_the_set_consistent() {
     let table: Arc<dyn SpectralPowerDistribution> = Arc::new(
         spectrum::Tabulated::new(&[400.0, 500.0, 600.0, 700.0], &[0.2, 1.0, 0.6, 0.3]).unwrap(),
