@@ -193,23 +193,6 @@ pub(crate) struct PathState {
 }
 
 impl PathState {
-    /// The state of a path starting along `ray` at `lambdas`, written over `self` in place.
-    #[inline]
-    fn reset(&mut self, ray: Ray, lambdas: &[f64; HERO]) {
-        self.ray = ray;
-        self.beta = [1.0; HERO];
-        self.radiance = [0.0; HERO];
-        self.transport = *lambdas;
-        self.prev_point = ray.origin;
-        self.prev_normal = DVec3::ZERO;
-        self.prev_pdf = 0.0;
-        self.specular = true;
-        self.depth = 0;
-        self.last_bounce = false;
-        self.collapsed = false;
-        self.spd_cache = None;
-    }
-
     fn new(ray: Ray, lambdas: &[f64; HERO]) -> Self {
         Self {
             ray,
@@ -318,10 +301,7 @@ impl<'a> PathTracer<'a> {
     /// path's own sampler `rng`.
     #[inline]
     pub(crate) fn start(&self, px: u32, py: u32, rng: &mut ChunkSampler) -> CameraPath {
-        let u = CameraSamples::draw(&self.layout, rng);
-        let camera_ray = self.scene.camera.generate_ray(px, py, u.film, u.lens);
-        let ray = Ray { origin: camera_ray.origin, direction: camera_ray.direction };
-        let (lambdas, lambda_weights) = self.settings.wavelengths.sample_hero(u.wavelength);
+        let (ray, lambdas, lambda_weights) = self.first_ray(px, py, rng);
         CameraPath { px, py, lambdas, lambda_weights, state: PathState::new(ray, &lambdas) }
     }
 
@@ -329,12 +309,25 @@ impl<'a> PathTracer<'a> {
     /// built elsewhere and copied in costs a copy of its whole state).
     #[inline]
     pub(crate) fn restart(&self, path: &mut CameraPath, px: u32, py: u32, rng: &mut ChunkSampler) {
+        let (ray, lambdas, lambda_weights) = self.first_ray(px, py, rng);
+        (path.px, path.py, path.lambdas, path.lambda_weights) = (px, py, lambdas, lambda_weights);
+        path.state = PathState::new(ray, &lambdas);
+    }
+
+    /// A camera sample's first draws: its ray through pixel `(px, py)`, its hero wavelengths
+    /// and their weights.
+    #[inline]
+    fn first_ray(
+        &self,
+        px: u32,
+        py: u32,
+        rng: &mut ChunkSampler,
+    ) -> (Ray, [f64; HERO], [f64; HERO]) {
         let u = CameraSamples::draw(&self.layout, rng);
         let camera_ray = self.scene.camera.generate_ray(px, py, u.film, u.lens);
         let ray = Ray { origin: camera_ray.origin, direction: camera_ray.direction };
         let (lambdas, lambda_weights) = self.settings.wavelengths.sample_hero(u.wavelength);
-        (path.px, path.py, path.lambdas, path.lambda_weights) = (px, py, lambdas, lambda_weights);
-        path.state.reset(ray, &lambdas);
+        (ray, lambdas, lambda_weights)
     }
 
     /// Adds a finished camera sample to the film.
