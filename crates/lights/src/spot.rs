@@ -54,7 +54,7 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 use spectrace_sampling::{
     Frame, PiecewiseLinear, clamp_uniform, one_minus_cos, sample_uniform_cone,
-    sample_uniform_sphere, spherical_direction,
+    sample_uniform_sphere, spherical_direction_turn,
 };
 use spectrace_spectrum::SpectralPowerDistribution;
 
@@ -441,9 +441,8 @@ impl FadingSpotLight {
     /// azimuth uniform.
     fn direction_from(&self, u: [f64; 2]) -> DVec3 {
         let theta = self.theta.sample(clamp_uniform(u[0]));
-        let phi = TAU * clamp_uniform(u[1]);
         let (s, c) = theta.sin_cos();
-        self.frame.to_world(spherical_direction(s, c, phi)).normalize()
+        self.frame.to_world(spherical_direction_turn(s, c, clamp_uniform(u[1]))).normalize()
     }
 }
 

@@ -57,6 +57,7 @@ mod piecewise_linear;
 mod sobol;
 pub mod stats;
 mod table;
+mod trig;
 mod uniform;
 pub mod warp;
 
@@ -70,6 +71,7 @@ pub use piecewise_constant::PiecewiseConstant;
 pub use piecewise_linear::{PiecewiseLinear, linear_segment_inverse};
 pub use sobol::{SOBOL_BLOCK, SOBOL_DIMENSIONS, SobolSampler};
 pub use table::ONE_MINUS_EPSILON;
+pub use trig::sin_cos_turn;
 pub use uniform::{clamp_uniform, shifted_uniform, uniform};
 pub use warp::{
     invert_cosine_hemisphere, invert_cosine_hemisphere_concentric, invert_uniform_cone,
@@ -78,4 +80,5 @@ pub use warp::{
     pdf_uniform_hemisphere, pdf_uniform_sphere, sample_cosine_hemisphere,
     sample_cosine_hemisphere_concentric, sample_uniform_cone, sample_uniform_disk_concentric,
     sample_uniform_hemisphere, sample_uniform_sphere, sin_from_cos, spherical_direction,
+    spherical_direction_turn,
 };

@@ -12,7 +12,7 @@ use std::f64::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI, TAU};
 
 use glam::DVec3;
 
-use crate::clamp_uniform;
+use crate::{clamp_uniform, sin_cos_turn};
 
 /// `sin theta` from `cos theta`, as `sqrt((1 - c)(1 + c))` (no cancellation near `c = +-1`, where
 /// `1 - c^2` would lose the digits), clamped at 0 for `|c| > 1` by rounding.
@@ -33,6 +33,14 @@ pub fn one_minus_cos(angle: f64) -> f64 {
 #[inline]
 pub fn spherical_direction(sin_theta: f64, cos_theta: f64, phi: f64) -> DVec3 {
     DVec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+}
+
+/// [`spherical_direction`] with the azimuth as a fraction of a turn, `phi = 2 pi turn` for
+/// `turn` in `[0, 1)`, through [`sin_cos_turn`] (exact reduction, no C library call).
+#[inline]
+pub fn spherical_direction_turn(sin_theta: f64, cos_theta: f64, turn: f64) -> DVec3 {
+    let (s, c) = sin_cos_turn(turn);
+    DVec3::new(sin_theta * c, sin_theta * s, cos_theta)
 }
 
 /// The azimuth of a local direction (or disk point) as a fraction of a turn, in `[0, 1)`.
@@ -106,7 +114,7 @@ pub fn sample_cosine_hemisphere(u: [f64; 2]) -> DVec3 {
     let u0 = clamp_uniform(u[0]);
     let r = u0.sqrt();
     let cos_theta = (1.0 - u0).sqrt();
-    let (s, c) = (TAU * clamp_uniform(u[1])).sin_cos();
+    let (s, c) = sin_cos_turn(clamp_uniform(u[1]));
     DVec3::new(r * c, r * s, cos_theta)
 }
 
@@ -151,7 +159,7 @@ pub fn invert_cosine_hemisphere_concentric(w: DVec3) -> [f64; 2] {
 #[inline]
 pub fn sample_uniform_hemisphere(u: [f64; 2]) -> DVec3 {
     let z = clamp_uniform(u[0]);
-    spherical_direction(sin_from_cos(z), z, TAU * clamp_uniform(u[1]))
+    spherical_direction_turn(sin_from_cos(z), z, clamp_uniform(u[1]))
 }
 
 /// Density per steradian of [`sample_uniform_hemisphere`]: `1 / (2 pi)`.
@@ -170,7 +178,7 @@ pub fn invert_uniform_hemisphere(w: DVec3) -> [f64; 2] {
 #[inline]
 pub fn sample_uniform_sphere(u: [f64; 2]) -> DVec3 {
     let z = 1.0 - 2.0 * clamp_uniform(u[0]);
-    spherical_direction(sin_from_cos(z), z, TAU * clamp_uniform(u[1]))
+    spherical_direction_turn(sin_from_cos(z), z, clamp_uniform(u[1]))
 }
 
 /// Density per steradian of [`sample_uniform_sphere`]: `1 / (4 pi)`.
@@ -199,7 +207,7 @@ pub fn invert_uniform_sphere(w: DVec3) -> [f64; 2] {
 pub fn sample_uniform_cone(u: [f64; 2], one_minus_cos_max: f64) -> DVec3 {
     let t = clamp_uniform(u[0]) * one_minus_cos_max;
     let sin_theta = (t * (2.0 - t)).max(0.0).sqrt();
-    spherical_direction(sin_theta, 1.0 - t, TAU * clamp_uniform(u[1]))
+    spherical_direction_turn(sin_theta, 1.0 - t, clamp_uniform(u[1]))
 }
 
 /// Density per steradian of [`sample_uniform_cone`] inside the cone: `1 / (2 pi (1 - cos
