@@ -39,29 +39,42 @@ pub fn sin_cos_turn(turn: f64) -> (f64, f64) {
 }
 
 /// `(sin, cos)` of `a` with `|a| <= pi / 4`: Taylor polynomials through `a^17` and `a^16`, whose
-/// first omitted terms are below `1e-19` and `3e-18` there.
+/// first omitted terms are below `1e-19` and `3e-18` there, as `a + a z S(z)` and `1 + z C(z)`
+/// with `z = a^2` (the leading term added last, exactly).
 #[inline(always)]
 fn sin_cos_eighth(a: f64) -> (f64, f64) {
     let z = a * a;
-    let s = 1.0 / 355_687_428_096_000.0;
-    let s = s * z - 1.0 / 1_307_674_368_000.0;
-    let s = s * z + 1.0 / 6_227_020_800.0;
-    let s = s * z - 1.0 / 39_916_800.0;
-    let s = s * z + 1.0 / 362_880.0;
-    let s = s * z - 1.0 / 5_040.0;
-    let s = s * z + 1.0 / 120.0;
-    let s = s * z - 1.0 / 6.0;
-    let sin = a + a * (s * z);
-    let c = 1.0 / 20_922_789_888_000.0;
-    let c = c * z - 1.0 / 87_178_291_200.0;
-    let c = c * z + 1.0 / 479_001_600.0;
-    let c = c * z - 1.0 / 3_628_800.0;
-    let c = c * z + 1.0 / 40_320.0;
-    let c = c * z - 1.0 / 720.0;
-    let c = c * z + 1.0 / 24.0;
-    let c = c * z - 0.5;
-    let cos = 1.0 + z * c;
-    (sin, cos)
+    (a + a * (z * horner(z, &SIN_TAIL)), 1.0 + z * horner(z, &COS_TAIL))
+}
+
+/// The sine's Taylor coefficients after the first, `(-1)^k / (2k + 1)!` for `k = 1..=8`.
+const SIN_TAIL: [f64; 8] = [
+    -1.0 / 6.0,
+    1.0 / 120.0,
+    -1.0 / 5_040.0,
+    1.0 / 362_880.0,
+    -1.0 / 39_916_800.0,
+    1.0 / 6_227_020_800.0,
+    -1.0 / 1_307_674_368_000.0,
+    1.0 / 355_687_428_096_000.0,
+];
+
+/// The cosine's Taylor coefficients after the first, `(-1)^k / (2k)!` for `k = 1..=8`.
+const COS_TAIL: [f64; 8] = [
+    -0.5,
+    1.0 / 24.0,
+    -1.0 / 720.0,
+    1.0 / 40_320.0,
+    -1.0 / 3_628_800.0,
+    1.0 / 479_001_600.0,
+    -1.0 / 87_178_291_200.0,
+    1.0 / 20_922_789_888_000.0,
+];
+
+/// `c[0] + z c[1] + z^2 c[2] + ...` by Horner's rule.
+#[inline(always)]
+fn horner(z: f64, c: &[f64]) -> f64 {
+    c.iter().rev().fold(0.0, |acc, &k| acc * z + k)
 }
 
 #[cfg(test)]
