@@ -50,30 +50,15 @@ fn bad_lights_are_rejected_with_the_field_named() {
         );
     }
     // NaN and infinities cannot be written in JSON; the constructors reject them by name.
-    let e = PointLight::new(
-        DVec3::new(f64::NAN, 0.0, 0.0),
-        1.0,
-        Arc::new(CieIlluminant::new("D65").unwrap()),
-        WavelengthSampling::Importance,
-    )
-    .unwrap_err();
-    assert!(e.to_string().starts_with("PointLight.position"), "{e}");
-    let e = PointLight::new(
-        DVec3::ZERO,
-        f64::INFINITY,
-        Arc::new(CieIlluminant::new("D65").unwrap()),
-        WavelengthSampling::Importance,
-    )
-    .unwrap_err();
-    assert!(e.to_string().starts_with("PointLight.power"), "{e}");
-    let e = PointLight::new(
-        DVec3::ZERO,
-        f64::NAN,
-        Arc::new(CieIlluminant::new("D65").unwrap()),
-        WavelengthSampling::Importance,
-    )
-    .unwrap_err();
-    assert!(e.to_string().starts_with("PointLight.power"), "{e}");
+    for (position, power, field) in [
+        (DVec3::new(f64::NAN, 0.0, 0.0), 1.0, "PointLight.position"),
+        (DVec3::ZERO, f64::INFINITY, "PointLight.power"),
+        (DVec3::ZERO, f64::NAN, "PointLight.power"),
+    ] {
+        let d65 = Arc::new(CieIlluminant::new("D65").unwrap());
+        let e = PointLight::new(position, power, d65, WavelengthSampling::Importance).unwrap_err();
+        assert!(e.to_string().starts_with(field), "{e}");
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

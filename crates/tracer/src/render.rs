@@ -460,8 +460,8 @@ pub fn render_observed(
         .time_budget
         .and_then(|s| Duration::try_from_secs_f64(s.max(0.0)).ok())
         .and_then(|d| started.checked_add(d));
-    // The live estimate after every chunk, redone at most an eighth of a pixel per item and
-    // ever more rarely (see `LiveEstimate`).
+    // The live estimate after every chunk; its full O(pixels) form is redone ever more rarely,
+    // at a cost of at most an eighth of a pixel per item (see `LiveEstimate`).
     let live = Mutex::new(LiveEstimate::new(
         plan.error_measure,
         u64::from(w) * u64::from(h),
