@@ -1,4 +1,4 @@
-//! The path tracer's two kernels: the batched one (the default) against the scalar reference.
+//! The path tracer's two kernels: the batched one against the scalar reference (the default).
 //!
 //! Both call the same per-vertex steps and every camera path draws from its own sampler, so a
 //! path's radiance is the same in either kernel whatever its lane and neighbours, and the exact

@@ -22,8 +22,9 @@ struct Lanes<'a> {
     hits: [Option<Hit>; LANES],
     /// The vertex each lane reached this round (`None`: the path ends).
     vertices: [Option<Vertex<'a>>; LANES],
-    /// The lanes in shading order: by the primitive hit (`u32::MAX`: nothing).
-    order: Vec<(u32, usize)>,
+    /// The lanes in shading order, as sort keys: the primitive hit (`u32::MAX`: nothing) in the
+    /// high half, the slot in the low half (one integer sorts faster than a pair).
+    order: Vec<u64>,
     /// Next-event estimation's queued samples: the lane and the connection.
     queue: Vec<(usize, Connection)>,
 }
@@ -115,12 +116,14 @@ impl<'a> Lanes<'a> {
     /// Stage 3: the lanes in material order; each one's arrival and its light samples, queued.
     fn shade(&mut self, tracer: &PathTracer<'a>, stats: &mut TraceStats) {
         self.order.clear();
-        self.order.extend(
-            slots(self.live).map(|i| (self.hits[i].as_ref().map_or(u32::MAX, |h| h.primitive), i)),
-        );
+        self.order.extend(slots(self.live).map(|i| {
+            let primitive = self.hits[i].as_ref().map_or(u32::MAX, |h| h.primitive);
+            (u64::from(primitive) << 32) | i as u64
+        }));
         self.order.sort_unstable();
         self.queue.clear();
-        for &(_, i) in &self.order {
+        for &key in &self.order {
+            let i = (key & u64::from(u32::MAX)) as usize;
             self.vertices[i] = None;
             let Some(hit) = &self.hits[i] else { continue };
             let path = &mut self.paths[i];
@@ -143,11 +146,14 @@ impl<'a> Lanes<'a> {
         }
     }
 
-    /// Stages 4 and 5: the queued shadow rays, then the unoccluded samples' light.
+    /// Stages 4 and 5: the queued shadow rays, each unoccluded sample's light added to its
+    /// path as soon as its ray is tested (no second pass over the queue).
     fn shadow_and_connect(&mut self, tracer: &PathTracer<'a>, stats: &mut TraceStats) {
         let scene = tracer.scene();
-        self.queue.retain(|(_, c)| c.shadow.visible(scene));
         for (i, c) in &self.queue {
+            if !c.shadow.visible(scene) {
+                continue;
+            }
             let (Some(hit), Some(vertex)) = (&self.hits[*i], &self.vertices[*i]) else { continue };
             let path = &mut self.paths[*i];
             let at = Shading { hit, wo: -path.state.ray.direction, material: &*vertex.material };
