@@ -187,9 +187,57 @@ pub(crate) struct PathState {
     last_bounce: bool,
     /// A dispersive surface has left the hero alone.
     collapsed: bool,
-    /// The last light spectrum evaluated at `transport` (a path mostly meets one light, at
-    /// wavelengths that change only at a fluorescent re-emission).
-    spd_cache: Option<(LightId, [f64; HERO], [f64; HERO])>,
+    /// The light spectra already evaluated at `transport` (wavelengths that change only at a
+    /// fluorescent re-emission).
+    spd_cache: SpdCache,
+}
+
+/// Lights whose spectrum [`SpdCache`] keeps per path.
+const SPD_CACHE: usize = 8;
+
+/// The last [`SPD_CACHE`] light spectra a path evaluated, at one set of wavelengths: a path in a
+/// room of luminaires samples several lights, one per bounce, and a Planckian or tabulated
+/// spectrum costs an exponential or a table search per wavelength, so each light's values are
+/// computed once per path instead of once per connection.
+#[derive(Clone, Copy)]
+struct SpdCache {
+    /// The wavelengths the values are at.
+    at: [f64; HERO],
+    /// The lights (`u32::MAX`: an empty entry).
+    ids: [u32; SPD_CACHE],
+    /// Each light's spectrum at `at`.
+    values: [[f64; HERO]; SPD_CACHE],
+    /// The entry the next new light replaces.
+    next: usize,
+}
+
+impl SpdCache {
+    /// An empty cache for wavelengths `at`.
+    fn new(at: [f64; HERO]) -> Self {
+        Self { at, ids: [u32::MAX; SPD_CACHE], values: [[0.0; HERO]; SPD_CACHE], next: 0 }
+    }
+
+    /// Light `light`'s values at `at`, if kept.
+    #[inline]
+    fn get(&self, light: LightId, at: &[f64; HERO]) -> Option<[f64; HERO]> {
+        if self.at != *at {
+            return None;
+        }
+        let k = self.ids.iter().position(|&id| id == light.0)?;
+        Some(self.values[k])
+    }
+
+    /// Keeps `values`, light `light`'s spectrum at `at` (forgetting every light if the
+    /// wavelengths changed, else the oldest entry).
+    #[inline]
+    fn put(&mut self, light: LightId, at: &[f64; HERO], values: [f64; HERO]) {
+        if self.at != *at {
+            *self = Self::new(*at);
+        }
+        self.ids[self.next] = light.0;
+        self.values[self.next] = values;
+        self.next = (self.next + 1) % SPD_CACHE;
+    }
 }
 
 impl PathState {
@@ -206,12 +254,12 @@ impl PathState {
             depth: 0,
             last_bounce: false,
             collapsed: false,
-            spd_cache: None,
+            spd_cache: SpdCache::new(*lambdas),
         }
     }
 
     /// Light `light`'s spectrum at the path's transport wavelengths for light leaving
-    /// `position` along `direction` (cached while the light and the wavelengths stay the same,
+    /// `position` along `direction` (kept in [`SpdCache`] while the wavelengths stay the same,
     /// for a light whose colour does not vary); `None` for a light without one.
     #[inline]
     fn light_values(
@@ -225,15 +273,12 @@ impl PathState {
             scene.light_spd(light)?;
             return Some(scene.light_spectra(light, position, direction, &self.transport));
         }
-        if let Some((id, at, values)) = self.spd_cache
-            && id == light
-            && at == self.transport
-        {
+        if let Some(values) = self.spd_cache.get(light, &self.transport) {
             return Some(values);
         }
         let spd = scene.light_spd(light)?;
         let values = self.transport.map(|l| spd.value(l));
-        self.spd_cache = Some((light, self.transport, values));
+        self.spd_cache.put(light, &self.transport, values);
         Some(values)
     }
 
