@@ -425,7 +425,9 @@ pub fn render(
 /// always claimed) and the chunks in progress stop between items within a few microseconds of
 /// work; the output counts exactly the items done. With a target error, threads stop claiming
 /// chunks once an estimate from at least [`crate::MIN_BATCHES`] chunks reaches it; the chunks in
-/// progress finish (a little more accuracy, never less).
+/// progress finish, and each is judged again with it folded in: if that estimate is above the
+/// target (one more batch can raise it), the threads go on, so a render stops only on an
+/// estimate over all the chunks it keeps.
 ///
 /// # Errors
 /// [`FilmError::InvalidSize`] for a camera whose resolution is not a valid film;
@@ -467,10 +469,27 @@ pub fn render_observed(
         u64::from(w) * u64::from(h),
         plan.chunk_beams,
     ));
-    let live_estimate = || -> Option<(ErrorEstimate, bool)> {
+    // After each chunk: the live estimate, and whether the target is reached, judged under the
+    // moments' lock so that no chunk folded in can escape the judgement. A fresh estimate at or
+    // below the target stops the threads from claiming chunks; a chunk that ends after that
+    // (it was in progress) is folded in and the target judged again, fresh, with it: adding a
+    // batch can raise the estimate, and then the threads go on. So a render stops only on an
+    // estimate over every chunk it keeps.
+    let live_estimate = || -> Option<ErrorEstimate> {
         let m = moments.as_ref()?.lock().unwrap_or_else(PoisonError::into_inner);
         let target = plan.shard_target_error();
-        Some(live.lock().unwrap_or_else(PoisonError::into_inner).update(&m, target))
+        let mut live = live.lock().unwrap_or_else(PoisonError::into_inner);
+        let recheck = target.is_some() && target_reached.load(Ordering::Relaxed);
+        let (e, fresh) = if recheck { (live.fresh(&m), true) } else { live.update(&m, target) };
+        if let Some(target) = target
+            && fresh
+        {
+            let reached = e.is_trusted() && e.relative_error.is_some_and(|r| r <= target);
+            if reached || recheck {
+                target_reached.store(reached, Ordering::Relaxed);
+            }
+        }
+        Some(e)
     };
     let results: Mutex<Vec<ThreadResult>> = Mutex::new(Vec::new());
     // Each thread's writer, its memory had (or refused) before any work starts.
@@ -521,14 +540,7 @@ pub fn render_observed(
                     stats.merge(&s);
                     mine.push(c);
                     let items = done.fetch_add(s.beams, Ordering::Relaxed) + s.beams;
-                    let live = live_estimate();
-                    let estimate = live.map(|(e, _)| e);
-                    if let (Some((e, true)), Some(target)) = (live, plan.shard_target_error())
-                        && e.is_trusted()
-                        && e.relative_error.is_some_and(|r| r <= target)
-                    {
-                        target_reached.store(true, Ordering::Relaxed);
-                    }
+                    let estimate = live_estimate();
                     progress(&Progress {
                         items,
                         seconds: started.elapsed().as_secs_f64(),

@@ -556,6 +556,13 @@ impl LiveEstimate {
         Self { measure, every, last: None }
     }
 
+    /// The estimate after the chunks folded into `moments` so far, computed now.
+    pub(crate) fn fresh(&mut self, moments: &Moments) -> ErrorEstimate {
+        let e = moments.estimate(self.measure);
+        self.last = Some(e);
+        e
+    }
+
     /// The estimate after the chunks folded into `moments` so far, with `target` the error a
     /// render stops at (if any); `fresh` says whether it was computed now (a target may stop
     /// the render only on a fresh one).
@@ -570,11 +577,7 @@ impl LiveEstimate {
         let may_stop = target.is_some_and(|t| self.predicted(moments).is_some_and(|p| p <= t));
         match self.last {
             Some(e) if !due && !may_stop => (e, false),
-            _ => {
-                let e = moments.estimate(self.measure);
-                self.last = Some(e);
-                (e, true)
-            }
+            _ => (self.fresh(moments), true),
         }
     }
 }

@@ -130,6 +130,13 @@ fn the_live_estimate_is_redone_as_the_chunks_grow_or_when_a_target_may_be_reache
     assert!(live.update(&m, Some(0.99)).1, "the quick estimate says 0.99 is reached");
     chunk(&mut m);
     assert!(!live.update(&m, Some(1e-9)).1, "not due, and the target is far");
+    // The re-judgement of a chunk that ended after the target was reached: computed now, over
+    // every chunk, and kept as the latest.
+    let stale = live.update(&m, Some(1e-9)).0;
+    let now = live.fresh(&m);
+    assert_eq!(now.batches, m.chunks());
+    assert!(stale.batches < now.batches, "{} then {}", stale.batches, now.batches);
+    assert_eq!(live.update(&m, Some(1e-9)), (now, false));
 }
 
 #[test]
