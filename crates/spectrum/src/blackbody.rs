@@ -30,12 +30,9 @@ fn d_ln_planck(lambda_nm: f64, kelvin: f64, c2: f64) -> f64 {
 /// The root of `x = 5 (1 - e^-x)`: Planck's law in wavelength peaks at `c2 / (WIEN_X T)`.
 const WIEN_X: f64 = 4.965_114_231_744_276;
 
-/// Below this `x = c2 / (lambda T)`, `expm1(x) < 10^261`, so `lambda^5 expm1(x)` (with
-/// `lambda <` [`DIRECT_MAX_NM`]) stays finite and `value` evaluates Planck's law directly.
+/// Below this `x = c2 / (lambda T)`, `expm1(x) < 10^261` is finite and `value` may evaluate
+/// Planck's law directly.
 const DIRECT_X_MAX: f64 = 600.0;
-
-/// The longest wavelength (nm) `value` evaluates directly (`lambda^5 < 10^25`).
-const DIRECT_MAX_NM: f64 = 1e5;
 
 /// `ln` of Planck's spectral radiance up to a constant: `-5 ln(lambda) - ln(expm1(c2 / (lambda T)))`.
 fn ln_planck(lambda_nm: f64, kelvin: f64, c2: f64) -> f64 {
@@ -174,16 +171,20 @@ impl SpectralPowerDistribution for Blackbody {
             return 0.0;
         }
         // Planck's law directly, one exponential (a quarter of the log form's transcendental
-        // calls, and a few ulps instead of an error that grows with |ln f|), wherever nothing
-        // can overflow: x < DIRECT_X_MAX keeps lambda^5 expm1(x) below 10^300 for
-        // lambda < 10^5 nm.
+        // calls, and a few ulps instead of an error that grows with |ln f|), wherever its
+        // product neither overflows nor underflows; the log form elsewhere (extreme
+        // temperatures and ranges).
         let x = self.c2 / (lambda * self.kelvin);
-        if x < DIRECT_X_MAX && self.direct_scale > 0.0 && lambda < DIRECT_MAX_NM {
+        if x < DIRECT_X_MAX && self.direct_scale > 0.0 {
             // Above x = 1, `exp(x) - 1` loses at most a bit (e^x > 2.7 leaves no cancellation)
             // and `exp` costs a third of `expm1`.
             let em1 = if x > 1.0 { x.exp() - 1.0 } else { x.exp_m1() };
             let l2 = lambda * lambda;
-            return self.direct_scale / (l2 * l2 * lambda * em1);
+            let denominator = l2 * l2 * lambda * em1;
+            let value = self.direct_scale / denominator;
+            if denominator.is_normal() && value.is_finite() {
+                return value;
+            }
         }
         self.sampler.density(ln_planck(lambda, self.kelvin, self.c2))
     }
@@ -232,5 +233,28 @@ mod tests {
         }
         // Both branches ran: all but the coldest bodies are direct.
         assert!(direct > 6 * 95 && direct < 9 * 95, "{direct}");
+    }
+
+    #[test]
+    fn extreme_ranges_whose_direct_product_would_overflow_use_the_log_form() {
+        // At 1e70 nm lambda^5 overflows while a 1e9 K body keeps x small: the direct product
+        // would give 0 where the density is about 7e-71; the guard sends it to the log form.
+        // The others: a range whose normalising factor is not a normal number (log form
+        // throughout), and a cold body over a huge range (both branches).
+        for (kelvin, min_nm, max_nm) in [(1e9, 1e70, 2e70), (1e300, 1e-70, 2e-70), (1.0, 1e-3, 1e6)]
+        {
+            let b = Blackbody::with_range(kelvin, min_nm, max_nm).unwrap();
+            for k in 0..=100 {
+                let lambda = min_nm + (max_nm - min_nm) * f64::from(k) / 100.0;
+                let v = b.value(lambda);
+                let logs = b.sampler.density(ln_planck(lambda, kelvin, b.c2));
+                assert!(v.is_finite() && v >= 0.0, "{kelvin} K, {lambda} nm: {v}");
+                assert!(
+                    (v - logs).abs() <= 1e-12 * logs,
+                    "{kelvin} K, {lambda} nm: {v} vs the log form's {logs}"
+                );
+            }
+        }
+        assert!(Blackbody::with_range(1e9, 1e70, 2e70).unwrap().value(1.5e70) > 0.0);
     }
 }
