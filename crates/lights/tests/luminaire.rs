@@ -147,6 +147,25 @@ fn symmetric_tables_unfold_by_the_mirrors_the_formats_define() {
 }
 
 #[test]
+fn a_rotationally_symmetric_table_gives_one_intensity_all_round_the_nadir() {
+    let vertical = [0.0, 30.0, 60.0, 90.0, 180.0];
+    let round = CandelaDistribution::new(&[0.0], &vertical, &[vec![500.0, 410.0, 230.0, 7.0, 0.0]])
+        .unwrap();
+    assert!(!round.depends_on_c());
+    for gamma in [0.0_f64, 12.5, 30.0, 44.0, 89.0, 120.0] {
+        let cos_gamma = gamma.to_radians().cos();
+        let at_c0 = round.candela(0.0, cos_gamma);
+        assert!(at_c0 > 0.0 || gamma > 90.0, "gamma {gamma}");
+        // Exactly, not to rounding: the intensity is the one column's, whatever C is.
+        for c in [0.3_f64, 1.0, PI, 4.0, 6.2, TAU, -1.0, 20.0] {
+            assert_eq!(round.candela(c, cos_gamma), at_c0, "gamma {gamma}, C {c}");
+        }
+    }
+    let (vertical, horizontal, candela) = asymmetric();
+    assert!(CandelaDistribution::new(&horizontal, &vertical, &candela).unwrap().depends_on_c());
+}
+
+#[test]
 fn c_plane_90_lies_counter_clockwise_from_c0_seen_from_above() {
     // Light only around C 90 (asymmetric, no symmetry): with nadir -y and c0 +x, C 90 is
     // c0 x nadir = -z; turning the luminaire's c0 to +z moves it to +x.

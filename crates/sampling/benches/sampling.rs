@@ -10,7 +10,7 @@ use divan::{Bencher, black_box, counter::ItemsCount};
 use rand::{RngExt, SeedableRng, distr::Distribution};
 use rand_distr::weighted::{WeightedAliasIndex, WeightedIndex};
 use rand_pcg::Pcg64Mcg;
-use spectrace_sampling::{AliasTable, Discrete, PiecewiseConstant, PiecewiseLinear};
+use spectrace_sampling::{AliasTable, Discrete, GuideTable, PiecewiseConstant, PiecewiseLinear};
 
 fn main() {
     divan::main();
@@ -75,4 +75,42 @@ fn rand_distr_weighted_alias_index(bencher: Bencher<'_, '_>, n: usize) {
 fn build_piecewise_linear(bencher: Bencher<'_, '_>, n: usize) {
     let (xs, ys) = (grid(n), weights(n));
     bencher.bench_local(|| PiecewiseLinear::new(black_box(&xs), black_box(&ys)).unwrap());
+}
+
+/// Vertical-angle counts of candela tables: every 5 degrees, and every degree, 0 to 180.
+const ANGLES: [usize; 2] = [37, 181];
+
+/// `-cos(gamma)` at evenly spaced angles: a candela table's vertical grid, whose steps shrink
+/// towards the poles (what [`GuideTable`] is for).
+fn cosine_grid(n: usize) -> Vec<f64> {
+    (0..n).map(|k| -(std::f64::consts::PI * k as f64 / (n - 1) as f64).cos()).collect()
+}
+
+/// Points spread over `[-1, 1]` in a fixed random order (the branch predictor cannot learn it).
+fn probes() -> Vec<f64> {
+    let mut rng = Pcg64Mcg::seed_from_u64(9);
+    (0..BATCH).map(|_| rng.random::<f64>() * 2.0 - 1.0).collect()
+}
+
+/// The cell of each probe on a cosine grid through [`GuideTable`] (ns per lookup).
+#[divan::bench(args = ANGLES)]
+fn cosine_grid_guide_table(bencher: Bencher<'_, '_>, n: usize) {
+    let (ys, probes) = (cosine_grid(n), probes());
+    let guide = GuideTable::new(&ys);
+    bencher.counter(ItemsCount::new(BATCH)).bench_local(|| {
+        for &y in &probes {
+            black_box(guide.last_at_or_below(black_box(&ys), y));
+        }
+    });
+}
+
+/// The same lookups by binary search (`partition_point`), the peer of the guide.
+#[divan::bench(args = ANGLES)]
+fn cosine_grid_binary_search(bencher: Bencher<'_, '_>, n: usize) {
+    let (ys, probes) = (cosine_grid(n), probes());
+    bencher.counter(ItemsCount::new(BATCH)).bench_local(|| {
+        for &y in &probes {
+            black_box(black_box(&ys).partition_point(|&v| v <= y).max(1) - 1);
+        }
+    });
 }

@@ -39,6 +39,11 @@
 //! [`rand::Rng`], one dimension per draw of a path, for renderers that want low-discrepancy
 //! sampling without changing the code that draws the uniforms.
 //!
+//! Tables find the cell holding a point with [`GridLocator`] (a guess by even spacing, for the
+//! evenly spaced tables spectra usually are) or [`GuideTable`] (a guess per cell of an even
+//! subdivision, for grids like the cosines of candela tables' angles); both always answer as a
+//! binary search would.
+//!
 //! The [`files`] module holds the bounded reading of input files that every crate reading one
 //! shares (it is here because this is the lowest crate).
 //!
@@ -65,7 +70,7 @@ pub use alias::AliasTable;
 pub use discrete::Discrete;
 pub use error::SamplingError;
 pub use frame::Frame;
-pub use grid::{GridLocator, cell_index};
+pub use grid::{GridLocator, GuideTable, cell_index};
 pub use piecewise_bilinear::PiecewiseBilinear;
 pub use piecewise_constant::PiecewiseConstant;
 pub use piecewise_linear::{PiecewiseLinear, linear_segment_inverse};

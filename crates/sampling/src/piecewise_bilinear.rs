@@ -17,7 +17,7 @@
 
 use crate::piecewise_linear::invert_linear_segment;
 use crate::table::{validate_grid, validate_nonnegative};
-use crate::{PiecewiseLinear, SamplingError, clamp_uniform};
+use crate::{GuideTable, PiecewiseLinear, SamplingError, clamp_uniform};
 
 /// A density on `[xs[0], xs[n-1]] x [ys[0], ys[m-1]]`, bilinear in each grid cell, with exact
 /// inverse-CDF sampling ([`sample`](Self::sample)) and its density ([`pdf`](Self::pdf)).
@@ -45,6 +45,8 @@ pub struct PiecewiseBilinear {
     marginal: PiecewiseLinear,
     /// Integral of the whole table.
     integral: f64,
+    /// Guides to the cell along `x` and along `y` (candela grids are uneven in `y`).
+    guides: [GuideTable; 2],
 }
 
 impl PiecewiseBilinear {
@@ -102,6 +104,7 @@ impl PiecewiseBilinear {
             prefix,
             marginal,
             integral,
+            guides: [GuideTable::new(xs), GuideTable::new(ys)],
         })
     }
 
@@ -147,7 +150,7 @@ impl PiecewiseBilinear {
     /// clamped to the grid).
     fn column(&self, x: f64) -> (usize, f64) {
         let n = self.xs.len();
-        let i = (self.xs.partition_point(|&v| v <= x).max(1) - 1).min(n - 2);
+        let i = self.guides[0].last_at_or_below(&self.xs, x).min(n - 2);
         let t = ((x - self.xs[i]) / (self.xs[i + 1] - self.xs[i])).clamp(0.0, 1.0);
         (i, t)
     }
@@ -159,7 +162,7 @@ impl PiecewiseBilinear {
             return 0.0;
         }
         let (i, t) = self.column(x);
-        let j = (self.ys.partition_point(|&v| v <= y).max(1) - 1).min(m - 2);
+        let j = self.guides[1].last_at_or_below(&self.ys, y).min(m - 2);
         let s = ((y - self.ys[j]) / (self.ys[j + 1] - self.ys[j])).clamp(0.0, 1.0);
         let v = |ii: usize, jj: usize| self.values[ii * m + jj];
         (1.0 - t) * ((1.0 - s) * v(i, j) + s * v(i, j + 1))

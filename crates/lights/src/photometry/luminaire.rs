@@ -118,6 +118,8 @@ enum Symmetry {
 pub struct CandelaDistribution {
     table: PiecewiseBilinear,
     peak: f64,
+    /// One C-plane: the intensity does not depend on `C`.
+    rotational: bool,
 }
 
 impl CandelaDistribution {
@@ -204,13 +206,28 @@ impl CandelaDistribution {
             }
             other => format!("the candela table cannot be sampled: {other}"),
         })?;
-        Ok(Self { table, peak })
+        Ok(Self { table, peak, rotational: symmetry == Symmetry::Rotational })
     }
 
     /// The luminous intensity (cd) at horizontal angle `c` (radians, any value: taken modulo
     /// 2 pi) and `cos_gamma` (the cosine of the angle from nadir).
     pub fn candela(&self, c: f64, cos_gamma: f64) -> f64 {
-        self.table.value(c.rem_euclid(TAU), -cos_gamma)
+        // One C-plane: its column, exactly (interpolating between its two copies at 0 and
+        // 2 pi could round). `rem_euclid` is a library call (fmod); angles in range skip it.
+        let c = if self.rotational {
+            0.0
+        } else if (0.0..TAU).contains(&c) {
+            c
+        } else {
+            c.rem_euclid(TAU)
+        };
+        self.table.value(c, -cos_gamma)
+    }
+
+    /// `true` if the intensity depends on the horizontal angle `C` (the table has more than one
+    /// C-plane).
+    pub fn depends_on_c(&self) -> bool {
+        !self.rotational
     }
 
     /// The luminous flux (lm): the integral of the intensity over the sphere.
@@ -274,10 +291,17 @@ impl Orientation {
         (self.nadir * cos_gamma + (self.c0 * co + self.c90 * s) * sin_gamma).normalize()
     }
 
-    /// `(C, cos gamma)` of a unit world direction.
-    fn angles(&self, d: DVec3) -> (f64, f64) {
-        let c = d.dot(self.c90).atan2(d.dot(self.c0)).rem_euclid(TAU);
-        (c, d.dot(self.nadir).clamp(-1.0, 1.0))
+    /// `(C, cos gamma)` of a unit world direction; `C` is 0 unless `with_c` (a rotationally
+    /// symmetric distribution does not depend on it, and its `atan2` is a tenth of the cost of
+    /// a light connection in a room of luminaires).
+    fn angles(&self, d: DVec3, with_c: bool) -> (f64, f64) {
+        let cos_gamma = d.dot(self.nadir).clamp(-1.0, 1.0);
+        if !with_c {
+            return (0.0, cos_gamma);
+        }
+        // `atan2` lies in [-pi, pi], where `rem_euclid(TAU)` is exactly this one addition.
+        let c = d.dot(self.c90).atan2(d.dot(self.c0));
+        (if c < 0.0 { c + TAU } else { c }, cos_gamma)
     }
 }
 
@@ -411,8 +435,14 @@ impl Luminaire {
 
     /// Solid-angle density of the beams' directions along the unit world direction `d`.
     pub(crate) fn pdf_direction(&self, d: DVec3) -> f64 {
-        let (c, cos_gamma) = self.orientation.angles(d);
+        let (c, cos_gamma) = self.angles(d);
         self.distribution.pdf(c, cos_gamma)
+    }
+
+    /// `(C, cos gamma)` of the unit world direction `d` (`C` is 0 if the distribution does not
+    /// depend on it).
+    pub(crate) fn angles(&self, d: DVec3) -> (f64, f64) {
+        self.orientation.angles(d, self.distribution.depends_on_c())
     }
 
     /// A direction drawn in proportion to intensity.
@@ -464,7 +494,7 @@ macro_rules! luminaire_accessors {
 
         /// Luminous intensity (cd) along the unit world direction `d`.
         pub fn candela_towards(&self, d: DVec3) -> f64 {
-            let (c, cos_gamma) = self.luminaire.orientation.angles(d);
+            let (c, cos_gamma) = self.luminaire.angles(d);
             self.luminaire.distribution.candela(c, cos_gamma)
         }
     };
