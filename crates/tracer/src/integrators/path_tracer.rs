@@ -217,6 +217,13 @@ impl SpdCache {
         Self { at, ids: [u32::MAX; SPD_CACHE], values: [[0.0; HERO]; SPD_CACHE], next: 0 }
     }
 
+    /// Empties the cache for wavelengths `at`: only the ids are reset (a value is read only
+    /// where its id matched), so a path reusing a cache writes 40 bytes, not 300.
+    #[inline]
+    fn clear(&mut self, at: [f64; HERO]) {
+        (self.at, self.ids, self.next) = (at, [u32::MAX; SPD_CACHE], 0);
+    }
+
     /// Light `light`'s values at `at`, if kept.
     #[inline]
     fn get(&self, light: LightId, at: &[f64; HERO]) -> Option<[f64; HERO]> {
@@ -232,7 +239,7 @@ impl SpdCache {
     #[inline]
     fn put(&mut self, light: LightId, at: &[f64; HERO], values: [f64; HERO]) {
         if self.at != *at {
-            *self = Self::new(*at);
+            self.clear(*at);
         }
         self.ids[self.next] = light.0;
         self.values[self.next] = values;
@@ -256,6 +263,31 @@ impl PathState {
             collapsed: false,
             spd_cache: SpdCache::new(*lambdas),
         }
+    }
+
+    /// The state of [`PathState::new`] written in place (its light cache emptied, not
+    /// rebuilt): no path state is built elsewhere and copied in.
+    #[inline]
+    fn reset(&mut self, ray: Ray, lambdas: &[f64; HERO]) {
+        // Every field named: a new one does not compile until it is reset here too.
+        let Self {
+            ray: path_ray,
+            beta,
+            radiance,
+            transport,
+            prev_point,
+            prev_normal,
+            prev_pdf,
+            specular,
+            depth,
+            last_bounce,
+            collapsed,
+            spd_cache,
+        } = self;
+        (*path_ray, *beta, *radiance, *transport) = (ray, [1.0; HERO], [0.0; HERO], *lambdas);
+        (*prev_point, *prev_normal, *prev_pdf) = (ray.origin, DVec3::ZERO, 0.0);
+        (*specular, *depth, *last_bounce, *collapsed) = (true, 0, false, false);
+        spd_cache.clear(*lambdas);
     }
 
     /// Light `light`'s spectrum at the path's transport wavelengths for light leaving
@@ -350,13 +382,14 @@ impl<'a> PathTracer<'a> {
         CameraPath { px, py, lambdas, lambda_weights, state: PathState::new(ray, &lambdas) }
     }
 
-    /// [`PathTracer::start`] written into `path` in place (the batched kernel's slots: a path
-    /// built elsewhere and copied in costs a copy of its whole state).
+    /// [`PathTracer::start`] written into `path` in place (the batched kernel's slots and the
+    /// scalar kernel's one path: a path built elsewhere and copied in costs a copy of its whole
+    /// state).
     #[inline]
     pub(crate) fn restart(&self, path: &mut CameraPath, px: u32, py: u32, rng: &mut ChunkSampler) {
         let (ray, lambdas, lambda_weights) = self.first_ray(px, py, rng);
         (path.px, path.py, path.lambdas, path.lambda_weights) = (px, py, lambdas, lambda_weights);
-        path.state = PathState::new(ray, &lambdas);
+        path.state.reset(ray, &lambdas);
     }
 
     /// A camera sample's first draws: its ray through pixel `(px, py)`, its hero wavelengths
@@ -386,18 +419,26 @@ impl<'a> PathTracer<'a> {
         film.splat_spectral(path.px, path.py, &path.lambdas, &values);
     }
 
-    /// The radiance estimate of one camera ray at the path's wavelengths, added to the film.
+    /// The radiance estimate of one camera ray at the path's wavelengths, added to the film;
+    /// the path is traced in `slot` (the chunk's one path, restarted in place).
     fn sample_pixel(
         &self,
         px: u32,
         py: u32,
+        slot: &mut Option<CameraPath>,
         rng: &mut ChunkSampler,
         film: &mut dyn Splat,
         stats: &mut TraceStats,
     ) {
-        let mut path = self.start(px, py, rng);
+        let path = match slot {
+            Some(path) => {
+                self.restart(path, px, py, rng);
+                path
+            }
+            None => slot.insert(self.start(px, py, rng)),
+        };
         self.trace(&mut path.state, &mut path.lambda_weights, rng, stats);
-        self.finish(&path, film);
+        self.finish(path, film);
     }
 
     /// Radiance arriving along `ray` at each of the path's wavelengths (spectral, W m^-2 sr^-1
@@ -676,13 +717,16 @@ type DeltaSplat = (u32, u32, spectrace_spectrum::Xyz, f64);
 
 impl PassEstimator for PathTracer<'_> {
     const NAME: &'static str = PathTracer::NAME;
-    type Scratch = ();
+    /// The chunk's camera path, restarted in place for each sample.
+    type Scratch = Option<CameraPath>;
 
     fn scene(&self) -> &LightTracerScene<'_> {
         self.scene
     }
 
-    fn scratch(&self) {}
+    fn scratch(&self) -> Option<CameraPath> {
+        None
+    }
 
     fn pass_splats(&self) -> bool {
         !self.scene.delta_lights().is_empty()
@@ -708,12 +752,12 @@ impl PassEstimator for PathTracer<'_> {
     fn sample(
         &self,
         item: u64,
-        _: &mut (),
+        slot: &mut Option<CameraPath>,
         rng: &mut ChunkSampler,
         film: &mut dyn Splat,
         stats: &mut TraceStats,
     ) {
         let (px, py) = pixel_of(item, u64::from(self.scene.camera.width()));
-        self.sample_pixel(px, py, rng, film, stats);
+        self.sample_pixel(px, py, slot, rng, film, stats);
     }
 }
