@@ -117,9 +117,10 @@ def section(report):
         "developed and copied to numpy included), `llvm_ad_spectral` after untimed warm-up renders "
         "that compile its kernels, `scalar_spectral` with nothing to compile. Samples/s: camera "
         "samples (spp x pixels) per second for path tracers, light paths per second for light "
-        "tracers; every path carries 4 wavelengths in both renderers. Spectrace's path tracer renders "
-        "nothing of the glass sphere (its next-event estimation cannot reach a `Sky`), so it is not "
-        "timed there. Method: below, \"Samples per second\"."
+        "tracers; every path carries 4 wavelengths in both renderers. On the glass sphere neither "
+        "path tracer can render the caustic (next-event estimation of the sky cannot pass the "
+        "glass), so their samples there are cheaper than the light tracers' paths, which do. "
+        "Method: below, \"Samples per second\"."
     )
     if not t.get("race_date"):
         notes += (
