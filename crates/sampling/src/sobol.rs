@@ -41,7 +41,8 @@ const SOBOL_BITS: u32 = 23;
 #[derive(Debug, Clone)]
 pub struct SobolSampler<R> {
     fallback: R,
-    seed: u64,
+    /// The seed, mixed (the part of every path's scramble that depends on it alone).
+    seed_key: u64,
     /// Scramble of the current path's sequence (from seed, stream and block).
     scramble: u32,
     /// The current point's index within the block, bit-reversed and shuffled by the scramble
@@ -53,18 +54,41 @@ pub struct SobolSampler<R> {
     dimension: u32,
 }
 
-impl<R: Rng> SobolSampler<R> {
+impl<R> SobolSampler<R> {
     /// A sampler whose scrambles derive from `seed`, with `fallback` for the low bits and the
     /// dimensions beyond the table. Until [`start_path`](Self::start_path) it is the fallback.
     pub fn new(seed: u64, fallback: R) -> Self {
-        Self { fallback, seed, scramble: 0, shuffled: 0, key: 0, dimension: SOBOL_DIMENSIONS }
+        Self {
+            fallback,
+            seed_key: mix(seed),
+            scramble: 0,
+            shuffled: 0,
+            key: 0,
+            dimension: SOBOL_DIMENSIONS,
+        }
     }
 
+    /// `SobolSampler::new(seed, fallback)` of this sampler's seed, without mixing the seed
+    /// again: for code that makes a sampler per path (no path started yet).
+    #[inline]
+    pub fn with_fallback<S>(&self, fallback: S) -> SobolSampler<S> {
+        SobolSampler::<S> {
+            fallback,
+            seed_key: self.seed_key,
+            scramble: 0,
+            shuffled: 0,
+            key: 0,
+            dimension: SOBOL_DIMENSIONS,
+        }
+    }
+}
+
+impl<R: Rng> SobolSampler<R> {
     /// Starts a path: point `index` of the sequence scrambled for `stream` (and the sampler's
     /// seed); the next draw is its dimension 0.
     pub fn start_path(&mut self, stream: u64, index: u64) {
         let block = index / SOBOL_BLOCK;
-        let key = mix(mix(mix(self.seed) ^ stream) ^ block.wrapping_mul(0xD6E8_FEB8_6659_FD93));
+        let key = mix(mix(self.seed_key ^ stream) ^ block.wrapping_mul(0xD6E8_FEB8_6659_FD93));
         self.scramble = (key ^ (key >> 32)) as u32;
         let index = (index % SOBOL_BLOCK) as u32;
         self.shuffled =
@@ -179,6 +203,20 @@ mod tests {
                 (0..dims).map(|_| uniform(s)).collect()
             })
             .collect()
+    }
+
+    #[test]
+    fn a_sampler_made_with_another_fallback_is_the_one_new_makes() {
+        let template = SobolSampler::new(11, ());
+        for (stream, index) in [(0, 0), (3, 7), (1 << 40, SOBOL_BLOCK + 5)] {
+            let mut a = template.with_fallback(Pcg64::seed_from_u64(4));
+            let mut b = SobolSampler::new(11, Pcg64::seed_from_u64(4));
+            a.start_path(stream, index);
+            b.start_path(stream, index);
+            let (xa, xb): (Vec<u64>, Vec<u64>) =
+                (0..8).map(|_| (a.next_u64(), b.next_u64())).unzip();
+            assert_eq!(xa, xb, "stream {stream}, index {index}");
+        }
     }
 
     #[test]

@@ -43,10 +43,16 @@ pub(crate) fn chunk_rng(seed: u64, chunk: u64) -> Pcg64 {
     Pcg64::seed_from_u64(z ^ (z >> 31))
 }
 
-/// The independent stream of item `item` of chunk `chunk` of a render with seed `seed` (a camera
-/// path's own stream): unrelated to every chunk stream and to every other item's.
-pub(crate) fn path_rng(seed: u64, chunk: u64, item: u64) -> Pcg64 {
-    let z = split_mix(split_mix(seed ^ 0x5851_F42D_4C95_7F2D) ^ chunk);
+/// The part of every camera path's stream of chunk `chunk` that depends on the seed and the
+/// chunk alone.
+fn pass_key(seed: u64, chunk: u64) -> u64 {
+    split_mix(split_mix(seed ^ 0x5851_F42D_4C95_7F2D) ^ chunk)
+}
+
+/// The independent stream of item `item` of a chunk whose [`pass_key`] is `z` (a camera path's
+/// own stream): unrelated to every chunk stream and to every other item's.
+#[inline]
+fn keyed_path_rng(z: u64, item: u64) -> Pcg64 {
     let hi = split_mix(z ^ item.wrapping_mul(0xD6E8_FEB8_6659_FD93));
     let lo = split_mix(hi ^ item);
     // The state from both halves; the stream (increment) from the item too, so that two paths
@@ -130,19 +136,12 @@ impl ChunkSampler {
     }
 
     /// The sampler of one camera path (`kind` resolved for camera passes), item `item` of pass
-    /// (chunk) `chunk` of a render with seed `seed`, already started: its own independent stream (`path_rng(seed, chunk, item)`), or
-    /// point `chunk` of the item's Sobol sequence over it. It depends on nothing else, so a path
+    /// (chunk) `chunk` of a render with seed `seed`, already started: its own independent
+    /// stream (`keyed_path_rng` of the seed and chunk's `pass_key` and the item), or point
+    /// `chunk` of the item's Sobol sequence over it. It depends on nothing else, so a path
     /// gives the same result whichever paths are traced before it or beside it.
     pub fn for_path(kind: SamplerKind, seed: u64, chunk: u64, item: u64) -> Self {
-        let rng = path_rng(seed, chunk, item);
-        match kind.resolve(true) {
-            SamplerKind::Auto | SamplerKind::Independent => Self::Independent(rng),
-            SamplerKind::Sobol => {
-                let mut sobol = SobolSampler::new(seed, rng);
-                sobol.start_path(item, chunk);
-                Self::Sobol(sobol)
-            }
-        }
+        PassSamplers::new(kind, seed, chunk).get(item)
     }
 
     /// Starts a path: point `index` of the sequence of `stream` (nothing for independent
@@ -151,6 +150,44 @@ impl ChunkSampler {
     pub fn start_path(&mut self, stream: u64, index: u64) {
         if let Self::Sobol(s) = self {
             s.start_path(stream, index);
+        }
+    }
+}
+
+/// The samplers of the camera paths of one chunk: [`ChunkSampler::for_path`] of each of its
+/// items, with what depends on the seed and the chunk alone (three of a path's seven mixing
+/// steps) computed once.
+#[derive(Debug, Clone)]
+pub(crate) struct PassSamplers {
+    chunk: u64,
+    /// [`pass_key`] of the seed and the chunk.
+    key: u64,
+    /// Sobol points (the seed mixed in, no fallback yet), or independent sampling.
+    sobol: Option<SobolSampler<()>>,
+}
+
+impl PassSamplers {
+    /// The samplers of chunk `chunk` of a render with seed `seed` (`kind` resolved for camera
+    /// passes).
+    pub(crate) fn new(kind: SamplerKind, seed: u64, chunk: u64) -> Self {
+        let sobol = match kind.resolve(true) {
+            SamplerKind::Auto | SamplerKind::Independent => None,
+            SamplerKind::Sobol => Some(SobolSampler::new(seed, ())),
+        };
+        Self { chunk, key: pass_key(seed, chunk), sobol }
+    }
+
+    /// The sampler of item `item`, already started ([`ChunkSampler::for_path`]).
+    #[inline]
+    pub(crate) fn get(&self, item: u64) -> ChunkSampler {
+        let rng = keyed_path_rng(self.key, item);
+        match &self.sobol {
+            None => ChunkSampler::Independent(rng),
+            Some(template) => {
+                let mut sobol = template.with_fallback(rng);
+                sobol.start_path(item, self.chunk);
+                ChunkSampler::Sobol(sobol)
+            }
         }
     }
 }
@@ -212,7 +249,7 @@ mod tests {
         }
         // Unrelated to the chunk's own stream.
         let mut chunk = chunk_rng(3, 8);
-        assert_ne!(path_rng(3, 8, 0).next_u64(), chunk.next_u64());
+        assert_ne!(keyed_path_rng(pass_key(3, 8), 0).next_u64(), chunk.next_u64());
     }
 
     #[test]

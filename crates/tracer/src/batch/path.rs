@@ -6,6 +6,7 @@ use spectrace_geometry::Hit;
 use super::LANES;
 use crate::integrators::pass::{PassEstimator, pass_items_until, pixel_of};
 use crate::integrators::path_tracer::{CameraPath, Connection, PathTracer, Shading, Vertex};
+use crate::sampler::PassSamplers;
 use crate::{ChunkSampler, ChunkWork, Splat, TraceStats};
 
 /// The paths in flight, as a structure of arrays: one entry per lane in each. A lane keeps its
@@ -64,8 +65,9 @@ pub(crate) fn render_pass<'a>(
         order: Vec::with_capacity(LANES),
         queue: Vec::with_capacity(2 * LANES),
     };
+    let samplers = PassSamplers::new(tracer.scene().sampler(), work.seed, work.chunk);
     loop {
-        lanes.generate(tracer, work, &mut items, &mut stats);
+        lanes.generate(tracer, &samplers, &mut items, &mut stats);
         if lanes.live == 0 {
             return stats;
         }
@@ -81,16 +83,15 @@ impl<'a> Lanes<'a> {
     fn generate(
         &mut self,
         tracer: &PathTracer<'a>,
-        work: ChunkWork,
+        samplers: &PassSamplers,
         items: &mut impl Iterator<Item = u64>,
         stats: &mut TraceStats,
     ) {
-        let kind = tracer.scene().sampler();
         let width = u64::from(tracer.scene().camera.width());
         for i in slots(!self.live & ALL_SLOTS) {
             let Some(item) = items.next() else { break };
             let (px, py) = pixel_of(item, width);
-            let rng = ChunkSampler::for_path(kind, work.seed, work.chunk, item);
+            let rng = samplers.get(item);
             if i < self.paths.len() {
                 self.rngs[i] = rng;
                 tracer.restart(&mut self.paths[i], px, py, &mut self.rngs[i]);

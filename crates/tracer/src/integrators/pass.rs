@@ -23,6 +23,7 @@ use std::time::Instant;
 
 use spectrace_spectrum::Xyz;
 
+use crate::sampler::PassSamplers;
 use crate::{
     ChunkSampler, ChunkWork, Integrator, LightTracerScene, RenderOutput, Splat, TraceStats,
 };
@@ -240,9 +241,9 @@ pub(crate) fn scalar_items<E: PassEstimator + ?Sized>(
     film: &mut dyn Splat,
 ) -> TraceStats {
     let mut scratch = estimator.scratch();
-    let kind = estimator.scene().sampler();
+    let samplers = PassSamplers::new(estimator.scene().sampler(), work.seed, work.chunk);
     run_pass(work, estimator.items(), |item, stats| {
-        let mut rng = ChunkSampler::for_path(kind, work.seed, work.chunk, item);
+        let mut rng = samplers.get(item);
         estimator.sample(item, &mut scratch, &mut rng, film, stats);
     })
 }
