@@ -25,13 +25,14 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 use spectrace_geometry::Ray;
-use spectrace_lights::{Beam, LightSource, uniform};
+use spectrace_lights::{Beam, LightId, LightSource, uniform};
 use spectrace_materials::Transport;
 use spectrace_spectrum::{lumens_per_watt, melanopic_edi_per_watt};
 
 use super::common::{
-    Direction, SampleLayout, ScatterSamples, VertexSamples, choose_lobe, connect_light_to_camera,
-    connect_surface_to_camera, relative_throughput, roulette, shading_correction,
+    CameraConnection, Direction, SampleLayout, ScatterSamples, VertexSamples, choose_lobe,
+    connect_light_to_camera, connect_surface_to_camera, relative_throughput, roulette,
+    shading_correction,
 };
 use crate::{
     ChunkSampler, ChunkWork, Effects, EffectsMode, Integrator, LightTracerScene, SensorSet, Splat,
@@ -171,6 +172,7 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
         layout: SampleLayout::light_paths(scene),
         bundle: effects.wavelengths_per_path.clamp(1, MAX_BUNDLE),
     };
+    let mut memo = OriginMemo::new(scene);
     let mut next_check = DEADLINE_CHECK_WORK;
     for i in 0..work.items {
         if let Some(deadline) = work.deadline {
@@ -184,9 +186,67 @@ pub fn trace_chunk_until<S: Splat + ?Sized>(
         }
         rng.start_path(work.chunk, i);
         stats.beams += 1;
-        tracer.trace_beam(&mut rng, film, &mut stats);
+        tracer.trace_beam(&mut rng, &mut memo, film, &mut stats);
     }
     stats
+}
+
+/// The camera connections of the beam origins of a chunk's lights with a delta position
+/// (points, spots, measured luminaires: every beam of one starts at one point). Through a
+/// pinhole the connection is a function of the light and the point alone
+/// (`connect_light_to_camera` reads no uniform, and a light's emission density at a point is
+/// its own, whatever beam asks), so such a light's origin is connected once per chunk, with the
+/// same result bit for bit. Other lights' origins move from beam to beam, and a thin lens draws
+/// its lens point per beam: those are connected every time.
+struct OriginMemo {
+    /// Per light: `None` if its connections are not kept, else its last one (`None` before
+    /// the first).
+    slots: Vec<Option<Option<KeptOrigin>>>,
+}
+
+/// A point's coordinates (bits) and its connection and value (`None`: not seen).
+type KeptOrigin = ([u64; 3], Option<(CameraConnection, f64)>);
+
+impl OriginMemo {
+    /// The memo of a chunk of `scene`'s beams: slots for its delta-position lights, none for a
+    /// thin-lens camera.
+    fn new(scene: &LightTracerScene<'_>) -> Self {
+        let mut slots = vec![None; scene.lights.lights().len()];
+        if scene.camera.is_pinhole() {
+            for &id in scene.delta_lights() {
+                if !scene.parallel_sampled(id)
+                    && let Some(slot) = slots.get_mut(id.0 as usize)
+                {
+                    *slot = Some(None);
+                }
+            }
+        }
+        Self { slots }
+    }
+
+    /// [`connect_light_to_camera`] of light `id`'s point `point`, kept for the light's next
+    /// beam if it has a slot.
+    #[inline]
+    fn connect(
+        &mut self,
+        scene: &LightTracerScene<'_>,
+        id: LightId,
+        point: glam::DVec3,
+        u_lens: [f64; 2],
+    ) -> Option<(CameraConnection, f64)> {
+        let Some(Some(slot)) = self.slots.get_mut(id.0 as usize) else {
+            return connect_light_to_camera(scene, id, point, u_lens);
+        };
+        let key = point.to_array().map(f64::to_bits);
+        match slot {
+            Some((kept, seen)) if *kept == key => *seen,
+            _ => {
+                let seen = connect_light_to_camera(scene, id, point, u_lens);
+                *slot = Some((key, seen));
+                seen
+            }
+        }
+    }
 }
 
 /// What one beam's trace needs, fixed for the chunk.
@@ -271,6 +331,7 @@ impl BeamTracer<'_, '_> {
     fn trace_beam<S: Splat + ?Sized>(
         &self,
         rng: &mut ChunkSampler,
+        memo: &mut OriginMemo,
         film: &mut S,
         stats: &mut TraceStats,
     ) {
@@ -287,8 +348,7 @@ impl BeamTracer<'_, '_> {
         let mut b = self.bundle(&beam, u_lambda);
         let u_lens = self.layout.lens(rng);
         if !scene.is_sensors_only()
-            && let Some((seen, value)) =
-                connect_light_to_camera(scene, beam.parent, beam.origin, u_lens)
+            && let Some((seen, value)) = memo.connect(scene, beam.parent, beam.origin, u_lens)
         {
             let values = self.origin_values(&beam, &b, seen.to_camera, value);
             if film.splat_spectral(seen.x, seen.y, &b.lambdas[..b.len], &values[..b.len]) {
@@ -411,5 +471,67 @@ impl BeamTracer<'_, '_> {
                 lambdas.iter().zip(weights).map(|(&l, &w)| w * melanopic_edi_per_watt(l)).sum();
             film.splat_sensor(cell, [radiant, luminous, luminous * luminous, melanopic]);
         });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+
+    use glam::DVec3;
+    use spectrace_geometry::{Rectangle, Shape, World};
+    use spectrace_lights::LightSet;
+    use spectrace_materials::Material;
+    use std::sync::Arc;
+
+    use super::*;
+    use crate::{CameraRepr, FovAxis, PinholeCamera};
+
+    fn camera(aperture_radius: f64) -> PinholeCamera {
+        PinholeCamera::new(CameraRepr {
+            position: DVec3::new(0.0, 1.0, 3.0),
+            look_at: DVec3::new(0.0, 0.5, 0.0),
+            up: DVec3::Y,
+            fov: 60.0,
+            fov_axis: FovAxis::Horizontal,
+            width: 16,
+            height: 16,
+            aperture_radius,
+            focus_distance: (aperture_radius > 0.0).then_some(3.0),
+        })
+        .unwrap()
+    }
+
+    fn point(x: f64) -> Box<dyn LightSource> {
+        let json = format!(
+            r#"{{"type": "PointLight", "position": [{x}, 1, 0], "power": 10,
+               "spd": {{"type": "Blackbody", "kelvin": 3000}}}}"#
+        );
+        serde_json::from_str(&json).unwrap()
+    }
+
+    #[test]
+    fn a_kept_origin_connection_is_the_one_made_anew() {
+        let floor = Rectangle::new(DVec3::new(-2.0, 0.0, -2.0), 4.0 * DVec3::Z, 4.0 * DVec3::X);
+        let world = World::new(vec![Shape::Rectangle(floor.unwrap())]).unwrap();
+        let diffuse: Box<dyn Material> =
+            serde_json::from_str(r#"{"type": "Diffuse", "reflectance": 0.5}"#).unwrap();
+        let materials = vec![Arc::from(diffuse)];
+        let lights = LightSet::new(vec![point(-0.5), point(0.5)]).unwrap();
+        for (aperture, kept) in [(0.0, true), (0.05, false)] {
+            let camera = camera(aperture);
+            let scene = LightTracerScene::new(&world, &materials, &lights, &camera);
+            let mut memo = OriginMemo::new(&scene);
+            assert_eq!(memo.slots.iter().all(Option::is_some), kept, "aperture {aperture}");
+            // The lights in turn, a point moved (a light's slot must not answer for it), the
+            // lens point varying (it matters only through a thin lens).
+            let calls = [(0, -0.5, 0.1), (1, 0.5, 0.2), (0, -0.5, 0.3), (0, -0.25, 0.4)];
+            for (k, x, u) in calls.into_iter().chain(calls) {
+                let (id, p) = (LightId(k), DVec3::new(x, 1.0, 0.0));
+                let fresh = connect_light_to_camera(&scene, id, p, [u, 0.7]);
+                assert!(fresh.is_some(), "the test's points are seen");
+                assert_eq!(memo.connect(&scene, id, p, [u, 0.7]), fresh, "{k} at {x}, {u}");
+            }
+        }
     }
 }
