@@ -52,6 +52,19 @@ pub struct SobolSampler<R> {
     key: u32,
     /// Next dimension to serve; [`SOBOL_DIMENSIONS`] or more: fallback only.
     dimension: u32,
+    /// The Sobol integers' byte tables, fetched once (not through the lazy static per draw).
+    tables: Tables,
+}
+
+/// The process's [`ByteTables`], as a slice (one entry per dimension); its `Debug` names
+/// their count rather than printing 2 MiB of integers.
+#[derive(Clone, Copy)]
+struct Tables(&'static [[[u32; 256]; 2]]);
+
+impl std::fmt::Debug for Tables {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Tables({} dimensions)", self.0.len())
+    }
 }
 
 impl<R> SobolSampler<R> {
@@ -65,6 +78,7 @@ impl<R> SobolSampler<R> {
             shuffled: 0,
             key: 0,
             dimension: SOBOL_DIMENSIONS,
+            tables: Tables(byte_tables()),
         }
     }
 
@@ -79,6 +93,7 @@ impl<R> SobolSampler<R> {
             shuffled: 0,
             key: 0,
             dimension: SOBOL_DIMENSIONS,
+            tables: self.tables,
         }
     }
 }
@@ -109,11 +124,10 @@ impl<R: Rng> SobolSampler<R> {
 
     /// The top [`SOBOL_BITS`] bits of dimension `dimension` of the current point:
     /// `sobol_burley::sample(index, dimension, scramble)` times `2^23` (an integer, exactly),
-    /// the crate's steps with the unscrambled Sobol integer read from [`ByteTables`].
+    /// the crate's steps with the unscrambled Sobol integer read from `t`, the dimension's
+    /// [`ByteTables`] entry.
     #[inline]
-    fn coordinate(&self, dimension: u32) -> u32 {
-        // `dimension < SOBOL_DIMENSIONS` (the caller's check): every dimension has its table.
-        let t = &byte_tables()[dimension as usize];
+    fn coordinate(&self, t: &[[u32; 256]; 2], dimension: u32) -> u32 {
         let sobol =
             t[0][(self.shuffled >> 24) as usize] ^ t[1][((self.shuffled >> 16) & 0xff) as usize];
         let key = (dimension >> 2) ^ self.key ^ LANE_KEYS[(dimension & 3) as usize];
@@ -167,10 +181,9 @@ impl<R: Rng> TryRng for SobolSampler<R> {
 
     fn try_next_u64(&mut self) -> Result<u64, Infallible> {
         let low = self.fallback.next_u64();
-        if self.dimension >= SOBOL_DIMENSIONS {
-            return Ok(low);
-        }
-        let high = u64::from(self.coordinate(self.dimension));
+        // Every dimension below SOBOL_DIMENSIONS has its table; beyond, the fallback alone.
+        let Some(t) = self.tables.0.get(self.dimension as usize) else { return Ok(low) };
+        let high = u64::from(self.coordinate(t, self.dimension));
         self.dimension += 1;
         Ok((high << (64 - SOBOL_BITS)) | (low >> SOBOL_BITS))
     }
