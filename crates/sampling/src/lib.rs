@@ -77,7 +77,7 @@ pub use piecewise_linear::{PiecewiseLinear, linear_segment_inverse};
 pub use sobol::{SOBOL_BLOCK, SOBOL_DIMENSIONS, SobolSampler};
 pub use table::ONE_MINUS_EPSILON;
 pub use trig::sin_cos_turn;
-pub use uniform::{clamp_uniform, shifted_uniform, uniform};
+pub use uniform::{GOLDEN_GAMMA, clamp_uniform, mix64, shifted_uniform, split_mix64, uniform};
 pub use warp::{
     invert_cosine_hemisphere, invert_cosine_hemisphere_concentric, invert_uniform_cone,
     invert_uniform_disk_concentric, invert_uniform_hemisphere, invert_uniform_sphere,

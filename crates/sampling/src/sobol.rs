@@ -8,6 +8,8 @@ use std::sync::OnceLock;
 use rand::{Rng, TryRng};
 use sobol_burley::parts;
 
+use crate::split_mix64;
+
 /// Dimensions of a path served from the Sobol table (the Joe-Kuo direction numbers of the
 /// `sobol_burley` crate); later draws of a path come from the fallback generator.
 pub const SOBOL_DIMENSIONS: u32 = sobol_burley::NUM_DIMENSIONS;
@@ -73,7 +75,7 @@ impl<R> SobolSampler<R> {
     pub fn new(seed: u64, fallback: R) -> Self {
         Self {
             fallback,
-            seed_key: mix(seed),
+            seed_key: split_mix64(seed),
             scramble: 0,
             shuffled: 0,
             key: 0,
@@ -103,7 +105,9 @@ impl<R: Rng> SobolSampler<R> {
     /// seed); the next draw is its dimension 0.
     pub fn start_path(&mut self, stream: u64, index: u64) {
         let block = index / SOBOL_BLOCK;
-        let key = mix(mix(self.seed_key ^ stream) ^ block.wrapping_mul(0xD6E8_FEB8_6659_FD93));
+        let key = split_mix64(
+            split_mix64(self.seed_key ^ stream) ^ block.wrapping_mul(0xD6E8_FEB8_6659_FD93),
+        );
         self.scramble = (key ^ (key >> 32)) as u32;
         let index = (index % SOBOL_BLOCK) as u32;
         self.shuffled =
@@ -162,14 +166,6 @@ fn byte_tables() -> &'static ByteTables {
             })
             .collect()
     })
-}
-
-/// SplitMix64's finaliser: a bijective mix of 64 bits.
-fn mix(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
 }
 
 impl<R: Rng> TryRng for SobolSampler<R> {

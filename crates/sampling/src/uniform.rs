@@ -30,9 +30,35 @@ pub fn shifted_uniform(u: f64, j: usize, k: usize) -> f64 {
     if shifted >= 1.0 { shifted - 1.0 } else { shifted }
 }
 
+/// SplitMix64's increment, the golden-ratio gamma `2^64 / phi`.
+pub const GOLDEN_GAMMA: u64 = 0x9E37_79B9_7F4A_7C15;
+
+/// SplitMix64's finaliser (Steele, Lea and Flood 2014): a bijective mix of 64 bits, the one copy
+/// that Spectrace's hashes of seeds, streams and bits use.
+#[inline]
+pub fn mix64(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// SplitMix64's output for the state `x`: [`mix64`] of `x` plus [`GOLDEN_GAMMA`].
+#[inline]
+pub fn split_mix64(x: u64) -> u64 {
+    mix64(x.wrapping_add(GOLDEN_GAMMA))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn split_mix64_is_the_reference_generator() {
+        // SplitMix64 (Steele et al. 2014) from state 0: its published first two outputs.
+        assert_eq!(split_mix64(0), 0xE220_A839_7B1D_CDAF);
+        assert_eq!(split_mix64(GOLDEN_GAMMA), 0x6E78_9E6A_A1B9_65F4);
+        assert_eq!(mix64(0), 0);
+    }
 
     #[test]
     fn shifted_uniforms_wrap_into_the_unit_interval_one_per_stratum() {

@@ -218,10 +218,9 @@ impl ObjectLight {
 /// `sample_emission`): the SplitMix64 hash of both uniforms' bits, as independent of them as a
 /// fresh draw for the purpose (its 53 bits depend on all of theirs).
 fn third_uniform(a: f64, b: f64) -> f64 {
-    let mut z = a.to_bits() ^ b.to_bits().rotate_left(29) ^ 0x9E37_79B9_7F4A_7C15;
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^= z >> 31;
+    let z = spectrace_sampling::mix64(
+        a.to_bits() ^ b.to_bits().rotate_left(29) ^ spectrace_sampling::GOLDEN_GAMMA,
+    );
     (z >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 

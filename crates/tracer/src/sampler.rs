@@ -30,42 +30,31 @@ use std::convert::Infallible;
 use rand::{Rng, TryRng};
 use rand_pcg::Pcg64;
 use serde::{Deserialize, Serialize};
-use spectrace_sampling::SobolSampler;
+use spectrace_sampling::{GOLDEN_GAMMA, SobolSampler, mix64, split_mix64};
 
 use rand::SeedableRng;
 
 /// The generator of chunk `chunk` of a render with seed `seed` (SplitMix64 of both, so nearby
 /// seeds and chunks give unrelated streams).
 pub(crate) fn chunk_rng(seed: u64, chunk: u64) -> Pcg64 {
-    let mut z = seed ^ chunk.wrapping_mul(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    Pcg64::seed_from_u64(z ^ (z >> 31))
+    Pcg64::seed_from_u64(mix64(seed ^ chunk.wrapping_mul(GOLDEN_GAMMA)))
 }
 
 /// The part of every camera path's stream of chunk `chunk` that depends on the seed and the
 /// chunk alone.
 fn pass_key(seed: u64, chunk: u64) -> u64 {
-    split_mix(split_mix(seed ^ 0x5851_F42D_4C95_7F2D) ^ chunk)
+    split_mix64(split_mix64(seed ^ 0x5851_F42D_4C95_7F2D) ^ chunk)
 }
 
 /// The independent stream of item `item` of a chunk whose [`pass_key`] is `z` (a camera path's
 /// own stream): unrelated to every chunk stream and to every other item's.
 #[inline]
 fn keyed_path_rng(z: u64, item: u64) -> Pcg64 {
-    let hi = split_mix(z ^ item.wrapping_mul(0xD6E8_FEB8_6659_FD93));
-    let lo = split_mix(hi ^ item);
+    let hi = split_mix64(z ^ item.wrapping_mul(0xD6E8_FEB8_6659_FD93));
+    let lo = split_mix64(hi ^ item);
     // The state from both halves; the stream (increment) from the item too, so that two paths
     // never share a sequence at an offset.
-    Pcg64::new((u128::from(hi) << 64) | u128::from(lo), u128::from(split_mix(lo ^ z)))
-}
-
-/// SplitMix64's finaliser of `x` (after its increment).
-fn split_mix(x: u64) -> u64 {
-    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
+    Pcg64::new((u128::from(hi) << 64) | u128::from(lo), u128::from(split_mix64(lo ^ z)))
 }
 
 /// Which random numbers the integrators draw (`settings.sampler` in scene files).

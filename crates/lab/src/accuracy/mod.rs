@@ -71,6 +71,7 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 use spectrace_lights::WavelengthSampling;
+use spectrace_lights::sampling::{GOLDEN_GAMMA, mix64};
 use spectrace_renderer::{Scene, choose_integrator, decide_effects, render_xyz};
 use spectrace_spectrum::{SpectralPowerDistribution, Xyz};
 use spectrace_tracer::{
@@ -723,17 +724,10 @@ pub(super) fn fit_slope(points: &[(f64, f64)]) -> Option<f64> {
     spectrace_renderer::pilot::fit_line(points).map(|f| f.slope)
 }
 
-/// splitmix64's finaliser.
-fn mix(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
 /// The seed of sweep point `k` of configuration `c`: derived from the reference seed, never
 /// equal to it.
 fn sweep_seed(seed: u64, c: u64, k: u64) -> u64 {
-    let s = mix(seed ^ mix(0x9E37_79B9_7F4A_7C15 ^ (c << 32) ^ k));
+    let s = mix64(seed ^ mix64(GOLDEN_GAMMA ^ (c << 32) ^ k));
     if s == seed { s ^ 1 } else { s }
 }
 
