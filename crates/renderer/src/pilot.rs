@@ -21,7 +21,8 @@ use std::sync::Mutex;
 use serde::{Deserialize, Serialize};
 use spectrace_lights::LightSource;
 use spectrace_tracer::{
-    ErrorMeasure, IntegratorChoice, MIN_BATCHES, Progress, RenderPlan, render_observed,
+    ErrorMeasure, IntegratorChoice, LiveEstimates, MIN_BATCHES, Progress, RenderPlan,
+    render_observed,
 };
 
 use crate::integrators::{ESTIMATORS, with_kernel};
@@ -194,7 +195,7 @@ fn pilot(
         // spread is the error itself (see `sampler_of`).
         let build = (scene.settings.kernel, true);
         let out = with_kernel(scene, choice, effects, build, |tracer| {
-            render_observed(tracer, plan, observe)
+            render_observed(tracer, plan, observe, LiveEstimates::Reported)
         })
         .map_err(|e| RenderError::Options(e.to_string()));
         scene.lights.reset_count();

@@ -2,7 +2,7 @@
 
 use std::time::Instant;
 
-use spectrace_tracer::{Integrator, RenderOutput, RenderPlan, render_observed};
+use spectrace_tracer::{Integrator, LiveEstimates, RenderOutput, RenderPlan, render_observed};
 
 use crate::{RenderError, duration};
 
@@ -25,8 +25,10 @@ pub(crate) fn render_with_progress(
             bar.set_message(progress_message(e, target, p.seconds));
         }
     };
-    let output =
-        render_observed(tracer, plan, &update).map_err(|e| RenderError::Options(e.to_string()))?;
+    // A hidden bar (`--quiet`, or stderr not a terminal) reads no live estimate.
+    let live = if bar.is_hidden() { LiveEstimates::ForTarget } else { LiveEstimates::Reported };
+    let output = render_observed(tracer, plan, &update, live)
+        .map_err(|e| RenderError::Options(e.to_string()))?;
     bar.finish_and_clear();
     Ok((output, started.elapsed().as_secs_f64()))
 }

@@ -96,8 +96,8 @@ pub use film::{
     SENSOR_SLOTS, Splat, relative_error, spectral_xyz,
 };
 pub use render::{
-    DEFAULT_CHUNK_BEAMS, FALLBACK_MEMORY_LIMIT, MemoryLimit, Progress, RESERVED_THREADS,
-    RenderOutput, RenderPlan, THREAD_ADDRESS_RESERVE, render, render_observed,
+    DEFAULT_CHUNK_BEAMS, FALLBACK_MEMORY_LIMIT, LiveEstimates, MemoryLimit, Progress,
+    RESERVED_THREADS, RenderOutput, RenderPlan, THREAD_ADDRESS_RESERVE, render, render_observed,
 };
 pub use sampler::{ChunkSampler, SamplerKind};
 pub use stats::TraceStats;
