@@ -71,7 +71,9 @@ pub use scene::{Emitter, LightTracerScene};
 pub use sensor::{
     IrradianceSensor, MAX_SENSOR_CELLS, MAX_SENSOR_CELLS_PER_EDGE, SensorSet, SensorSums,
 };
-pub use wavelengths::{CAMERA_LAMBDA_MAX, CAMERA_LAMBDA_MIN, CameraWavelengths, HERO};
+pub use wavelengths::{
+    CAMERA_LAMBDA_MAX, CAMERA_LAMBDA_MIN, CameraWavelengths, HERO, VISIBLE_STEPS,
+};
 
 // The estimators, their settings and their registry.
 pub use effects::{BUNDLE, Effects, EffectsMode, IntegratorChoice, SceneFeatures};

@@ -840,12 +840,8 @@ mod loop_tests {
     #[test]
     fn live_estimates_are_made_only_for_a_reader_or_a_target() {
         // 64 chunks of 100 items on one thread, keeping the error estimate.
-        let base = RenderPlan {
-            beams: 6400,
-            chunk_beams: 100,
-            error_estimate: true,
-            ..plan(1, None)
-        };
+        let base =
+            RenderPlan { beams: 6400, chunk_beams: 100, error_estimate: true, ..plan(1, None) };
         let (reported, estimates) = observed(&base, LiveEstimates::Reported);
         assert!(estimates.iter().any(|e| e.relative_error.is_some()), "{estimates:?}");
         // Nobody reads them and no target needs them: none is made, and the final estimate
